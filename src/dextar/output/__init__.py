@@ -1,0 +1,1 @@
+"""Outputs: atomic file writing, figures, report."""
