@@ -50,7 +50,9 @@ class FiveBar:
             except (TypeError, ValueError):
                 raise GeometryError(f"geometry length {name} = {value!r} is not a number") from None
             if not math.isfinite(value) or value <= 0.0:
-                raise GeometryError(f"geometry length {name} = {value!r} must be positive and finite")
+                raise GeometryError(
+                    f"geometry length {name} = {value!r} must be positive and finite"
+                )
             object.__setattr__(self, name, value)
         # Each leg reaches an annulus about its pivot; the two annuli must overlap.
         r1, R1 = abs(self.l1 - self.L1), self.l1 + self.L1

@@ -15,8 +15,21 @@ from .velocity import (
 from .workspace import WorkspaceMap, plot_workspace, workspace_map
 
 __all__ = [
-    "DEFAULT_SINGULARITY_TOL", "WorkspaceMap", "assembly_mode", "check_singularities",
-    "direct_kinematics", "elbows", "inverse_kinematics", "jacobian", "joint_acceleration",
-    "joint_velocity", "plot_workspace", "singularity_distances", "task_acceleration",
-    "task_velocity", "velocity_matrices", "workspace_map", "working_mode",
+    "DEFAULT_SINGULARITY_TOL",
+    "WorkspaceMap",
+    "assembly_mode",
+    "check_singularities",
+    "direct_kinematics",
+    "elbows",
+    "inverse_kinematics",
+    "jacobian",
+    "joint_acceleration",
+    "joint_velocity",
+    "plot_workspace",
+    "singularity_distances",
+    "task_acceleration",
+    "task_velocity",
+    "velocity_matrices",
+    "workspace_map",
+    "working_mode",
 ]

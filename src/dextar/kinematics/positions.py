@@ -17,14 +17,16 @@ from ..errors import AssemblyError, ReachError
 from ..geometry import FiveBar, parse_assembly_mode, parse_working_mode
 
 
-def _leg_solve(ux: np.ndarray, uy: np.ndarray, l: float, L: float,
-               sign: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _leg_solve(
+    ux: np.ndarray, uy: np.ndarray, l: float, L: float, sign: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Angle of the proximal rod of one leg, the squared distance to the pivot and the mask of
     points out of reach (where the angle is meaningless but finite)."""
     rho2 = ux * ux + uy * uy
     k = 0.5 * (rho2 + (l * l - L * L))
     w2 = (l * l) * rho2 - k * k
-    bad = (w2 < 0.0) | (rho2 <= 1e-24 * (l + L) ** 2)
+    # rounding may leave w2 a hair below zero on the boundary (leg stretched): allow it
+    bad = (w2 < -1e-12 * (l * l) * rho2) | (rho2 <= 1e-24 * (l + L) ** 2)
     w = np.sqrt(np.maximum(w2, 0.0))
     if sign > 0:  # s = +1: elbow to the right of pivot->P, so the perp term enters negated
         w = -w
@@ -32,8 +34,9 @@ def _leg_solve(ux: np.ndarray, uy: np.ndarray, l: float, L: float,
     return np.arctan2(k * uy + w * ux, k * ux - w * uy), rho2, bad
 
 
-def _reach_error(P: np.ndarray, shape: tuple[int, ...], i: int, rho2: float, l: float, L: float,
-                 leg: int) -> ReachError:
+def _reach_error(
+    P: np.ndarray, shape: tuple[int, ...], i: int, rho2: float, l: float, L: float, leg: int
+) -> ReachError:
     rho = float(np.sqrt(rho2))
     rin, rout = abs(l - L), l + L
     out = max(rin - rho, rho - rout, 0.0)
@@ -45,8 +48,9 @@ def _reach_error(P: np.ndarray, shape: tuple[int, ...], i: int, rho2: float, l: 
     )
 
 
-def inverse_kinematics(robot: FiveBar, points: object, mode: str | tuple[int, int] = "+-",
-                       *, unwrap: bool = False) -> np.ndarray:
+def inverse_kinematics(
+    robot: FiveBar, points: object, mode: str | tuple[int, int] = "+-", *, unwrap: bool = False
+) -> np.ndarray:
     """Actuator angles ``(phi, psi)`` that place the end-effector at ``points``.
 
     Parameters
@@ -79,8 +83,9 @@ def inverse_kinematics(robot: FiveBar, points: object, mode: str | tuple[int, in
     q = np.empty(P.shape)
     for blk in blocks(len(P)):
         x, y = P[blk, 0], P[blk, 1]
-        for leg, (dx, l, L, s) in enumerate(((-half, robot.l1, robot.L1, s1),
-                                             (half, robot.l2, robot.L2, s2))):
+        for leg, (dx, l, L, s) in enumerate(
+            ((-half, robot.l1, robot.L1, s1), (half, robot.l2, robot.L2, s2))
+        ):
             ang, rho2, bad = _leg_solve(x + dx, y, l, L, s)
             if bad.any():
                 j = int(first_index(bad))
@@ -140,7 +145,8 @@ def direct_kinematics(robot: FiveBar, q: object, assembly: str | int = "up") -> 
         del2 = vx * vx + vy * vy
         k = 0.5 * (del2 + (L2 * L2 - L1 * L1))
         w2 = (L2 * L2) * del2 - k * k
-        bad = (w2 < 0.0) | (del2 <= 1e-24 * (L1 + L2) ** 2)
+        # rounding may leave w2 a hair below zero on the boundary (rods aligned): allow it
+        bad = (w2 < -1e-12 * (L2 * L2) * del2) | (del2 <= 1e-24 * (L1 + L2) ** 2)
         if bad.any():
             j = int(first_index(bad))
             i = blk.start + j
@@ -149,7 +155,7 @@ def direct_kinematics(robot: FiveBar, q: object, assembly: str | int = "up") -> 
                 f"{np.degrees(qf[i, 1]):.6g}) deg{where(flat_index(i, shape), shape)}: "
                 f"|B - C| = {np.sqrt(del2[j]):.6g} outside [{abs(L1 - L2):.6g}, {L1 + L2:.6g}]"
             )
-        w = np.sqrt(w2)
+        w = np.sqrt(np.maximum(w2, 0.0))
         if sigma < 0:
             w = -w
         inv = 1.0 / del2

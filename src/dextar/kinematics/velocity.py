@@ -81,7 +81,9 @@ def velocity_matrices(robot: FiveBar, q: object, points: object) -> tuple[np.nda
     return A, B
 
 
-def singularity_distances(robot: FiveBar, q: object, points: object) -> tuple[np.ndarray, np.ndarray]:
+def singularity_distances(
+    robot: FiveBar, q: object, points: object
+) -> tuple[np.ndarray, np.ndarray]:
     """Normalised distances to a serial (type 1) and a parallel (type 2) singularity.
 
     Returns
@@ -98,8 +100,9 @@ def _type1(robot: FiveBar, f: _Frame) -> np.ndarray:
     return np.minimum(np.abs(f.b1) / (robot.l1 * robot.L1), np.abs(f.b2) / (robot.l2 * robot.L2))
 
 
-def _raise_if_near(kind: int, dist: np.ndarray, tol: float, q: object, points: object,
-                   context: str = "") -> None:
+def _raise_if_near(
+    kind: int, dist: np.ndarray, tol: float, q: object, points: object, context: str = ""
+) -> None:
     bad = dist < tol
     if not bad.any():
         return
@@ -107,19 +110,28 @@ def _raise_if_near(kind: int, dist: np.ndarray, tol: float, q: object, points: o
     qa, Pa = np.asarray(q, float), np.asarray(points, float)
     qq = qa[idx] if qa.ndim > 1 else qa
     pp = Pa[idx] if Pa.ndim > 1 else Pa
-    name = "serial (type 1): a leg stretched or folded" if kind == 1 else \
-        "parallel (type 2): B, C and P aligned"
+    name = (
+        "serial (type 1): a leg stretched or folded"
+        if kind == 1
+        else "parallel (type 2): B, C and P aligned"
+    )
     raise SingularityError(
         f"{name} singularity{context or where(idx, dist.shape)}: "
         f"q = ({np.degrees(qq[0]):.6g}, {np.degrees(qq[1]):.6g}) deg, "
-        f"P = ({pp[0]:.6g}, {pp[1]:.6g}), normalised distance {float(dist[idx]):.3g} "
+        f"P = ({pp[0]:.6g}, {pp[1]:.6g}), normalised distance {float(np.asarray(dist)[idx] if np.ndim(dist) else dist):.3g} "
         f"below tolerance {tol:g}"
     )
 
 
-def check_singularities(robot: FiveBar, q: object, points: object, *,
-                        tol: float = DEFAULT_SINGULARITY_TOL, type1: bool = True,
-                        type2: bool = True) -> None:
+def check_singularities(
+    robot: FiveBar,
+    q: object,
+    points: object,
+    *,
+    tol: float = DEFAULT_SINGULARITY_TOL,
+    type1: bool = True,
+    type2: bool = True,
+) -> None:
     """Raise :class:`SingularityError` for the first sample within ``tol`` of a singularity."""
     f = _frame(robot, q, points)
     if type1:
@@ -128,8 +140,9 @@ def check_singularities(robot: FiveBar, q: object, points: object, *,
         _raise_if_near(2, np.abs(f.det) / (robot.L1 * robot.L2), tol, q, points)
 
 
-def jacobian(robot: FiveBar, q: object, points: object, *,
-             tol: float = DEFAULT_SINGULARITY_TOL) -> np.ndarray:
+def jacobian(
+    robot: FiveBar, q: object, points: object, *, tol: float = DEFAULT_SINGULARITY_TOL
+) -> np.ndarray:
     """``J = A^-1 B`` (shape (..., 2, 2)): ``Pdot = J qdot``.
 
     Raises :class:`SingularityError` within ``tol`` of a parallel singularity.
@@ -151,8 +164,9 @@ def _solve_A(f: _Frame, rx: np.ndarray, ry: np.ndarray) -> np.ndarray:
     return np.stack([(f.vy * rx - f.uy * ry) * inv, (f.ux * ry - f.vx * rx) * inv], axis=-1)
 
 
-def task_velocity(robot: FiveBar, q: object, points: object, dq: object, *,
-                  tol: float = DEFAULT_SINGULARITY_TOL) -> np.ndarray:
+def task_velocity(
+    robot: FiveBar, q: object, points: object, dq: object, *, tol: float = DEFAULT_SINGULARITY_TOL
+) -> np.ndarray:
     """End-effector velocity ``Pdot`` (..., 2) from actuator rates ``dq`` (..., 2)."""
     f = _frame(robot, q, points)
     _raise_if_near(2, np.abs(f.det) / (robot.L1 * robot.L2), tol, q, points)
@@ -160,8 +174,14 @@ def task_velocity(robot: FiveBar, q: object, points: object, dq: object, *,
     return _solve_A(f, f.b1 * dq[..., 0], f.b2 * dq[..., 1])
 
 
-def joint_velocity(robot: FiveBar, q: object, points: object, dpoints: object, *,
-                   tol: float = DEFAULT_SINGULARITY_TOL) -> np.ndarray:
+def joint_velocity(
+    robot: FiveBar,
+    q: object,
+    points: object,
+    dpoints: object,
+    *,
+    tol: float = DEFAULT_SINGULARITY_TOL,
+) -> np.ndarray:
     """Actuator rates ``qdot`` (..., 2) from end-effector velocity ``dpoints`` (..., 2).
 
     Raises :class:`SingularityError` within ``tol`` of a serial singularity.
@@ -169,11 +189,18 @@ def joint_velocity(robot: FiveBar, q: object, points: object, dpoints: object, *
     f = _frame(robot, q, points)
     _raise_if_near(1, _type1(robot, f), tol, q, points)
     dP = as_points(dpoints, "dpoints")
-    return np.stack([(f.ux * dP[..., 0] + f.uy * dP[..., 1]) / f.b1,
-                     (f.vx * dP[..., 0] + f.vy * dP[..., 1]) / f.b2], axis=-1)
+    return np.stack(
+        [
+            (f.ux * dP[..., 0] + f.uy * dP[..., 1]) / f.b1,
+            (f.vx * dP[..., 0] + f.vy * dP[..., 1]) / f.b2,
+        ],
+        axis=-1,
+    )
 
 
-def _bias(robot: FiveBar, f: _Frame, dq: np.ndarray, dP: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _bias(
+    robot: FiveBar, f: _Frame, dq: np.ndarray, dP: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """The velocity-product term ``b`` of ``A Pddot - B qddot = b``."""
     w1, w2 = dq[..., 0], dq[..., 1]
     # Pdot - Bdot, Bdot = l1 w1 (-s1, c1)
@@ -186,19 +213,43 @@ def _bias(robot: FiveBar, f: _Frame, dq: np.ndarray, dP: np.ndarray) -> tuple[np
     return bias1, bias2
 
 
-def joint_acceleration(robot: FiveBar, q: object, points: object, dq: object, dpoints: object,
-                       ddpoints: object, *, tol: float = DEFAULT_SINGULARITY_TOL) -> np.ndarray:
+def joint_acceleration(
+    robot: FiveBar,
+    q: object,
+    points: object,
+    dq: object,
+    dpoints: object,
+    ddpoints: object,
+    *,
+    tol: float = DEFAULT_SINGULARITY_TOL,
+) -> np.ndarray:
     """Actuator accelerations ``qddot = B^-1 (A Pddot - b)``, shape (..., 2)."""
     f = _frame(robot, q, points)
     _raise_if_near(1, _type1(robot, f), tol, q, points)
-    dq, dP, ddP = as_points(dq, "dq"), as_points(dpoints, "dpoints"), as_points(ddpoints, "ddpoints")
+    dq, dP, ddP = (
+        as_points(dq, "dq"),
+        as_points(dpoints, "dpoints"),
+        as_points(ddpoints, "ddpoints"),
+    )
     bias1, bias2 = _bias(robot, f, dq, dP)
-    return np.stack([(f.ux * ddP[..., 0] + f.uy * ddP[..., 1] - bias1) / f.b1,
-                     (f.vx * ddP[..., 0] + f.vy * ddP[..., 1] - bias2) / f.b2], axis=-1)
+    return np.stack(
+        [
+            (f.ux * ddP[..., 0] + f.uy * ddP[..., 1] - bias1) / f.b1,
+            (f.vx * ddP[..., 0] + f.vy * ddP[..., 1] - bias2) / f.b2,
+        ],
+        axis=-1,
+    )
 
 
-def task_acceleration(robot: FiveBar, q: object, points: object, dq: object, ddq: object, *,
-                      tol: float = DEFAULT_SINGULARITY_TOL) -> tuple[np.ndarray, np.ndarray]:
+def task_acceleration(
+    robot: FiveBar,
+    q: object,
+    points: object,
+    dq: object,
+    ddq: object,
+    *,
+    tol: float = DEFAULT_SINGULARITY_TOL,
+) -> tuple[np.ndarray, np.ndarray]:
     """End-effector velocity and acceleration ``(Pdot, Pddot)`` from ``q, qdot, qddot``.
 
     ``Pddot = A^-1 (B qddot + b)``; both arrays of shape (..., 2).

@@ -46,8 +46,13 @@ class WorkspaceMap:
         return float(self.reachable.sum() * dx * dy)
 
 
-def workspace_map(robot: FiveBar, mode: str | tuple[int, int] = "+-", *, resolution: int = 301,
-                  bounds: tuple[float, float, float, float] | None = None) -> WorkspaceMap:
+def workspace_map(
+    robot: FiveBar,
+    mode: str | tuple[int, int] = "+-",
+    *,
+    resolution: int = 301,
+    bounds: tuple[float, float, float, float] | None = None,
+) -> WorkspaceMap:
     """Sample the workspace of ``robot`` in working mode ``mode``.
 
     Parameters
@@ -99,9 +104,14 @@ def workspace_map(robot: FiveBar, mode: str | tuple[int, int] = "+-", *, resolut
     return WorkspaceMap(robot, x, y, reachable, type2, dex, working_mode_name(signs))
 
 
-def plot_workspace(ws: WorkspaceMap, *, path: np.ndarray | None = None,
-                   pose: tuple[np.ndarray, np.ndarray] | None = None, unit: str = "mm",
-                   ax: Any = None) -> Any:
+def plot_workspace(
+    ws: WorkspaceMap,
+    *,
+    path: np.ndarray | None = None,
+    pose: tuple[np.ndarray, np.ndarray] | None = None,
+    unit: str = "mm",
+    ax: Any = None,
+) -> Any:
     """Draw a :class:`WorkspaceMap`: dexterity colour map, type-1 circles (dashed blue),
     type-2 curves (red), pivots, and optionally a path (n, 2) and a pose ``(q, P)``.
 
@@ -127,8 +137,9 @@ def plot_workspace(ws: WorkspaceMap, *, path: np.ndarray | None = None,
     for centre, l, L in ((r.A, r.l1, r.L1), (r.D, r.l2, r.L2)):
         for rad in {abs(l - L), l + L}:
             if rad > 0:
-                ax.plot(centre[0] + rad * np.cos(theta), centre[1] + rad * np.sin(theta),
-                        "b--", lw=0.8)
+                ax.plot(
+                    centre[0] + rad * np.cos(theta), centre[1] + rad * np.sin(theta), "b--", lw=0.8
+                )
     ax.plot([r.A[0], r.D[0]], [0, 0], "ks", ms=6)
     ax.plot([], [], "r-", label="type-2 (parallel) singularity")
     ax.plot([], [], "b--", label="type-1 (serial) singularity")
@@ -141,11 +152,16 @@ def plot_workspace(ws: WorkspaceMap, *, path: np.ndarray | None = None,
 
         q, P = pose
         B, C = elbows(r, q)
-        ax.plot([r.A[0], B[0], P[0], C[0], r.D[0]], [r.A[1], B[1], P[1], C[1], r.D[1]],
-                "o-", color="orange", lw=2)
+        ax.plot(
+            [r.A[0], B[0], P[0], C[0], r.D[0]],
+            [r.A[1], B[1], P[1], C[1], r.D[1]],
+            "o-",
+            color="orange",
+            lw=2,
+        )
     ax.set_aspect("equal")
     ax.set_xlabel(f"x [{unit}]")
     ax.set_ylabel(f"y [{unit}]")
-    ax.set_title(f"Workspace, working mode \"{ws.mode}\"")
+    ax.set_title(f'Workspace, working mode "{ws.mode}"')
     ax.legend(loc="lower right", fontsize=8)
     return fig

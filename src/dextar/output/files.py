@@ -38,8 +38,9 @@ def write_text(path: str | os.PathLike[str], text: str) -> None:
     write_bytes(path, text.encode("utf-8"))
 
 
-def write_csv(path: str | os.PathLike[str], columns: dict[str, np.ndarray],
-              header_comment: str | None = None) -> None:
+def write_csv(
+    path: str | os.PathLike[str], columns: dict[str, np.ndarray], header_comment: str | None = None
+) -> None:
     """Write equal-length 1-D columns as CSV with a header row (full float precision)."""
     names = list(columns)
     data = np.column_stack([np.asarray(columns[n], dtype=float) for n in names])
