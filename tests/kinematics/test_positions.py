@@ -34,7 +34,7 @@ reachable = st.tuples(st.floats(-140, 140), st.floats(-140, 140)).filter(
 def test_fk_ik_round_trip(p, mode):
     q = dx.inverse_kinematics(ROBOT, p, mode)
     assert dx.working_mode(ROBOT, q, p).tolist() == [1 if c == "+" else -1 for c in mode]
-    if min(dx.singularity_distances(ROBOT, q, p)) < 1e-6:
+    if min(dx.singularity_distances(ROBOT, q, p)) < 1e-3:
         return
     sigma = int(dx.assembly_mode(ROBOT, q, p))
     P = dx.direct_kinematics(ROBOT, q, "up" if sigma > 0 else "down")

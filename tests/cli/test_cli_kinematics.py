@@ -1,0 +1,81 @@
+import json
+import subprocess
+import sys
+
+import pytest
+
+from dextar.cli import main
+
+
+def run(argv, capsys):
+    code = main(argv)
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_ik_json(capsys):
+    code, out, _ = run(["ik", "0", "120", "--json"], capsys)
+    d = json.loads(out)
+    assert code == 0 and d["mode"] == "+-"
+    assert d["phi_deg"] == pytest.approx(60.5118, abs=1e-4)
+    assert d["psi_deg"] == pytest.approx(119.4882, abs=1e-4)
+
+
+def test_fk_json_round_trip(capsys):
+    code, out, _ = run(["fk", "60.51178523", "119.48821477", "--json"], capsys)
+    d = json.loads(out)
+    assert code == 0 and d["assembly"] == "up"
+    assert d["x_mm"] == pytest.approx(0.0, abs=1e-6) and d["y_mm"] == pytest.approx(120.0, abs=1e-6)
+
+
+def test_negative_coordinates_and_mode(capsys):
+    code, out, _ = run(["ik", "-10", "120", "--mode", "--", "--json"], capsys)
+    assert code == 0 and json.loads(out)["mode"] == "--"
+
+
+def test_robot_file(tmp_path, capsys):
+    f = tmp_path / "r.toml"
+    f.write_text('[robot]\nl1 = 80\nl2 = 80\nL1 = 100\nL2 = 100\nd = 50\nworking_mode = "+-"\n')
+    code, out, _ = run(["ik", "0", "150", "--robot", str(f), "--json"], capsys)
+    assert code == 0 and json.loads(out)["phi_deg"] != pytest.approx(60.5118, abs=1e-2)
+
+
+@pytest.mark.parametrize(
+    "content, word",
+    [
+        ("[robot]\nl1 = 'x'\n", "[robot].l1 must be a number"),
+        ("[robot]\nfoo = 1\n", "[robot].foo is not known"),
+        ("[robot]\nl1 = 1\n", "[robot].l2 is required"),
+        ("[robot]\npreset = 'dextar'\nd = -3\n", "d = -3"),
+        ("[robot]\nworking_mode = '+x'\n", "working mode '+x'"),
+        ("[robt]\n", "[robt] is not known"),
+        ("[robot\n", "not valid TOML"),
+    ],
+)
+def test_bad_toml_named(tmp_path, capsys, content, word):
+    f = tmp_path / "bad.toml"
+    f.write_text(content)
+    code, out, err = run(["ik", "0", "120", "--robot", str(f)], capsys)
+    assert code == 2 and out == ""
+    assert word in err and err.count("\n") == 1
+
+
+def test_unreachable_is_one_line_exit_2(capsys):
+    code, _, err = run(["ik", "500", "0"], capsys)
+    assert code == 2 and "out of reach of leg 1" in err and err.count("\n") == 1
+
+
+def test_workspace_writes_png(tmp_path, capsys):
+    out = tmp_path / "ws.png"
+    code, _, _ = run(["workspace", "--out", str(out), "--resolution", "50"], capsys)
+    assert code == 0 and out.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_real_process_no_traceback():
+    r = subprocess.run([sys.executable, "-m", "dextar.cli", "fk", "0", "180"],
+                       capture_output=True, text=True)
+    assert r.returncode == 2 and "Traceback" not in r.stderr
+    assert r.stderr.strip().endswith("outside [0, 174]")
+    r = subprocess.run([sys.executable, "-m", "dextar.cli", "ik", "x"], capture_output=True,
+                       text=True)
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
