@@ -18,7 +18,6 @@ from . import __version__
 from .config import RobotConfig, check_tables, load_toml, robot_from_table
 from .errors import ConfigError, DextarError
 
-
 _MODE_ALIASES = {"pp": "++", "pm": "+-", "mp": "-+", "mm": "--"}
 
 

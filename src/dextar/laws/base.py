@@ -1,0 +1,168 @@
+"""Laws of motion along a path: the arc length ``s(t)`` on ``[0, T]``, from 0 to the path's
+length ``S``, with its first three time derivatives.
+
+Laws act on arc length so that "uniform" means constant speed on any path; on the paper's
+circle ``s = R p``, so a law in ``s`` is the same law in the polar angle ``p``.
+"""
+
+from __future__ import annotations
+
+import math
+from abc import ABC, abstractmethod
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import ParameterError
+
+
+def _positive(name: str, value: float) -> float:
+    value = float(value)
+    if not (math.isfinite(value) and value > 0):
+        raise ParameterError(f"{name} = {value!r} must be positive and finite")
+    return value
+
+
+class Law(ABC):
+    """A law of motion ``s(t)``, ``t`` in ``[0, duration]``, ``s`` from 0 to ``distance``."""
+
+    distance: float
+    duration: float
+    name: str = "law"
+
+    @abstractmethod
+    def _evaluate(self, t: np.ndarray) -> np.ndarray:
+        """Rows ``s, sdot, sddot, sdddot`` at ``t``, shape (4, ...)."""
+
+    def evaluate(self, t: object) -> np.ndarray:
+        """``s, sdot, sddot, sdddot`` at times ``t``, stacked in an array of shape (4, ...)."""
+        t = np.asarray(t, dtype=float)
+        T = self.duration
+        bad = ~np.isfinite(t) | (t < -1e-12 * T) | (t > T * (1 + 1e-12))
+        if bad.any():
+            v = t.reshape(-1)[np.flatnonzero(bad.reshape(-1))[0]]
+            raise ParameterError(f"time t = {v:.6g} outside the law's interval [0, {T:.6g}]")
+        return self._evaluate(np.clip(t, 0.0, T))
+
+    def times(self, samples: int) -> np.ndarray:
+        if int(samples) < 2:
+            raise ParameterError(f"samples = {samples} must be at least 2")
+        return np.linspace(0.0, self.duration, int(samples))
+
+
+@dataclass(frozen=True)
+class UniformLaw(Law):
+    """Constant speed ``S / T``; starts and stops at speed (the paper's Fig. 3)."""
+
+    distance: float
+    duration: float
+    name: str = field(default="uniform", init=False)
+
+    def __post_init__(self) -> None:
+        _positive("distance", self.distance)
+        _positive("duration", self.duration)
+
+    def _evaluate(self, t: np.ndarray) -> np.ndarray:
+        v = self.distance / self.duration
+        return np.stack([v * t, np.full_like(t, v), np.zeros_like(t), np.zeros_like(t)])
+
+
+@dataclass(frozen=True)
+class MinimumJerkLaw(Law):
+    """Rest-to-rest quintic ``s = S (10 u^3 - 15 u^4 + 6 u^5)``, ``u = t / T``: minimum jerk,
+    zero velocity and acceleration at both ends."""
+
+    distance: float
+    duration: float
+    name: str = field(default="min-jerk", init=False)
+
+    def __post_init__(self) -> None:
+        _positive("distance", self.distance)
+        _positive("duration", self.duration)
+
+    def _evaluate(self, t: np.ndarray) -> np.ndarray:
+        S, T = self.distance, self.duration
+        u = t / T
+        return np.stack([
+            S * u**3 * (10 - 15 * u + 6 * u**2),
+            S / T * 30 * u**2 * (1 - u) ** 2,
+            S / T**2 * 60 * u * (1 - u) * (1 - 2 * u),
+            S / T**3 * 60 * (1 - 6 * u + 6 * u**2),
+        ])
+
+
+@dataclass(frozen=True)
+class TrapezoidalLaw(Law):
+    """Trapezoidal velocity: accelerate at ``amax``, cruise at ``v <= vmax``, decelerate.
+
+    With ``duration=None`` the law is the fastest one within the limits (a triangle when
+    ``vmax`` is not reached); with a duration the cruise speed is chosen to arrive at exactly
+    that time, which must be feasible with ``amax`` and ``vmax``.
+    """
+
+    distance: float
+    vmax: float
+    amax: float
+    duration: float = None  # type: ignore[assignment]
+    name: str = field(default="trapezoid", init=False)
+    cruise: float = field(default=0.0, init=False)
+
+    def __post_init__(self) -> None:
+        S = _positive("distance", self.distance)
+        vmax = _positive("vmax", self.vmax)
+        a = _positive("amax", self.amax)
+        if self.duration is None:
+            v = min(vmax, math.sqrt(S * a))
+            T = S / v + v / a
+        else:
+            T = _positive("duration", self.duration)
+            disc = a * a * T * T - 4 * a * S
+            if disc < 0:
+                tmin = 2 * math.sqrt(S / a)
+                raise ParameterError(f"trapezoid: distance {S:.6g} cannot be covered in "
+                                     f"duration {T:.6g} with amax {a:.6g} (needs at least "
+                                     f"{tmin:.6g})")
+            v = 0.5 * (a * T - math.sqrt(disc))
+            if v > vmax * (1 + 1e-12):
+                raise ParameterError(f"trapezoid: duration {T:.6g} needs cruise speed {v:.6g} "
+                                     f"above vmax {vmax:.6g}")
+        object.__setattr__(self, "duration", T)
+        object.__setattr__(self, "cruise", v)
+
+    def _evaluate(self, t: np.ndarray) -> np.ndarray:
+        a, v, T = self.amax, self.cruise, self.duration
+        ta = v / a
+        t_dec = T - ta
+        s = np.where(t < ta, 0.5 * a * t**2,
+                     np.where(t <= t_dec, 0.5 * a * ta**2 + v * (t - ta),
+                              self.distance - 0.5 * a * (T - t) ** 2))
+        ds = np.where(t < ta, a * t, np.where(t <= t_dec, v, a * (T - t)))
+        dds = np.where(t < ta, a, np.where(t <= t_dec, 0.0, -a))
+        return np.stack([s, ds, dds, np.zeros_like(t)])
+
+
+def law_cost(law: Law, path: object, mass: float, eta: float, *, nodes: int = 2000,
+             edges: np.ndarray | None = None) -> tuple[float, float]:
+    """The two parts of the paper's functional for any law along ``path``:
+    ``(m/2) Int |rdot|^2 dt`` and ``(eta m^2 / 2) Int |rddot|^2 dt``, with
+    ``|rdot| = sdot`` and ``|rddot|^2 = sddot^2 + kappa^2 sdot^4`` (Gauss-Legendre quadrature
+    on ``nodes`` equal panels, or on the given panel ``edges``; exact for polynomial laws of
+    degree <= 3 per panel on lines and arcs)."""
+    x, w = np.polynomial.legendre.leggauss(8)
+    if edges is None:
+        edges = np.linspace(0.0, law.duration, nodes + 1)
+    h = np.diff(edges)
+    t = (0.5 * (edges[:-1] + edges[1:]))[:, None] + 0.5 * h[:, None] * x[None, :]
+    s, ds, dds, _ = law.evaluate(t)
+    kappa = _curvature_at_s(path, s)
+    kin = 0.5 * mass * np.sum(0.5 * h * ((ds**2) @ w))
+    acc2 = dds**2 + kappa**2 * ds**4
+    inert = 0.5 * eta * mass**2 * np.sum(0.5 * h * (acc2 @ w))
+    return float(kin), float(inert)
+
+
+def _curvature_at_s(path: object, s: np.ndarray) -> np.ndarray:
+    k = getattr(path, "constant_curvature", None)
+    if k is not None:
+        return np.full_like(s, k)
+    return path.curvature(path.parameter_at(s))[0]  # type: ignore[attr-defined]

@@ -1,0 +1,255 @@
+"""Plane paths ``r(p)`` with exact derivatives, arc length and curvature.
+
+Every path has a parameter interval ``[p0, p1]`` (``p1 > p0``) and gives, vectorised over ``p``,
+``r, r', r'', r'''`` (derivatives with respect to ``p``). From them: speed ``|r'|``, signed
+curvature ``kappa = (r' x r'') / |r'|^3`` and its derivative along the arc ``dkappa/ds``; the
+arc length ``s(p)`` and its inverse ``p(s)`` (closed forms where they exist, else Gauss-Legendre
+quadrature on a fine table with Hermite interpolation and a Newton polish).
+"""
+
+from __future__ import annotations
+
+import math
+from abc import ABC, abstractmethod
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+from scipy.interpolate import CubicHermiteSpline, make_interp_spline
+
+from ..errors import ParameterError
+from .expression import Expression
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+class Path(ABC):
+    """A plane path ``r(p)``, ``p`` in ``[p0, p1]``; subclasses give :meth:`derivatives`."""
+
+    p0: float
+    p1: float
+    #: Curvature when it is the same everywhere (lines, arcs), else None.
+    constant_curvature: float | None = None
+
+    @abstractmethod
+    def derivatives(self, p: object) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``r, r', r'', r'''`` at ``p`` (shape (...,)), each of shape (..., 2)."""
+
+    def _check_parameter(self, p: object) -> np.ndarray:
+        p = np.asarray(p, dtype=float)
+        span = self.p1 - self.p0
+        bad = ~np.isfinite(p) | (p < self.p0 - 1e-9 * span) | (p > self.p1 + 1e-9 * span)
+        if bad.any():
+            v = p.reshape(-1)[np.flatnonzero(bad.reshape(-1))[0]]
+            raise ParameterError(f"path parameter p = {v:.6g} outside [{self.p0:.6g}, "
+                                 f"{self.p1:.6g}]")
+        return p
+
+    def position(self, p: object) -> np.ndarray:
+        return self.derivatives(p)[0]
+
+    def speed(self, p: object) -> np.ndarray:
+        """``ds/dp = |r'(p)|``."""
+        return np.linalg.norm(self.derivatives(p)[1], axis=-1)
+
+    def curvature(self, p: object) -> tuple[np.ndarray, np.ndarray]:
+        """Signed curvature ``kappa`` and ``dkappa/ds`` at ``p``."""
+        _, r1, r2, r3 = self.derivatives(p)
+        v2 = np.sum(r1 * r1, axis=-1)
+        v = np.sqrt(v2)
+        c12 = _cross(r1, r2)
+        kappa = c12 / (v2 * v)
+        dkappa_dp = _cross(r1, r3) / (v2 * v) - 3.0 * c12 * np.sum(r1 * r2, axis=-1) / (v2 * v2 * v)
+        return kappa, dkappa_dp / v
+
+    # ---------------------------------------------------------------- arc length
+    @cached_property
+    def _table(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Parameter nodes, arc length at the nodes and speed at the nodes."""
+        n = 4096
+        nodes = np.linspace(self.p0, self.p1, n + 1)
+        x, w = np.polynomial.legendre.leggauss(6)
+        h = np.diff(nodes)
+        mid = 0.5 * (nodes[:-1] + nodes[1:])
+        pts = mid[:, None] + 0.5 * h[:, None] * x[None, :]
+        seg = 0.5 * h * (self.speed(pts) @ w)
+        s = np.concatenate([[0.0], np.cumsum(seg)])
+        v = self.speed(nodes)
+        if (v <= 1e-12 * max(1.0, float(v.max()))).any():
+            i = int(np.flatnonzero(v <= 1e-12 * max(1.0, float(v.max())))[0])
+            raise ParameterError(f"path is not regular: |r'(p)| = 0 at p = {nodes[i]:.6g}")
+        return nodes, s, v
+
+    @property
+    def length(self) -> float:
+        return float(self._table[1][-1])
+
+    def arc_length(self, p: object) -> np.ndarray:
+        """Arc length ``s(p)`` from ``p0``."""
+        return self._forward(self._check_parameter(p))
+
+    @cached_property
+    def _forward(self) -> CubicHermiteSpline:
+        nodes, s, v = self._table
+        return CubicHermiteSpline(nodes, s, v)
+
+    @cached_property
+    def _inverse(self) -> CubicHermiteSpline:
+        nodes, s, v = self._table
+        return CubicHermiteSpline(s, nodes, 1.0 / v)
+
+    def parameter_at(self, s: object) -> np.ndarray:
+        """The parameter ``p(s)`` at arc length ``s`` (inverse of :meth:`arc_length`)."""
+        s = np.asarray(s, dtype=float)
+        total = self.length
+        if (~np.isfinite(s) | (s < -1e-9 * total) | (s > total * (1 + 1e-9))).any():
+            raise ParameterError(f"arc length outside [0, {total:.6g}]")
+        p = np.clip(self._inverse(np.clip(s, 0.0, total)), self.p0, self.p1)
+        for _ in range(2):  # Newton polish on s(p) - s = 0
+            p = np.clip(p - (self.arc_length(p) - s) / self.speed(p), self.p0, self.p1)
+        return p
+
+    def sample(self, n: int = 400) -> np.ndarray:
+        """``n`` points along the path, shape (n, 2)."""
+        return self.position(np.linspace(self.p0, self.p1, n))
+
+
+@dataclass(frozen=True)
+class Arc(Path):
+    """Circular arc ``r(p) = c + R (cos p, sin p)``, ``p`` the polar angle in radians.
+
+    The paper's semicircle is ``Arc(center=(0, 0), radius=R, p0=0, p1=pi)``.
+    """
+
+    radius: float
+    p0: float = 0.0
+    p1: float = math.pi
+    center: tuple[float, float] = (0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.radius) and self.radius > 0):
+            raise ParameterError(f"arc radius {self.radius!r} must be positive and finite")
+        if not (math.isfinite(self.p0) and math.isfinite(self.p1) and self.p1 > self.p0):
+            raise ParameterError(f"arc angles must satisfy start < end, got {self.p0!r}, "
+                                 f"{self.p1!r}")
+        object.__setattr__(self, "center", tuple(float(c) for c in self.center))
+
+    @property
+    def constant_curvature(self) -> float:  # type: ignore[override]
+        return 1.0 / self.radius
+
+    def derivatives(self, p: object) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        p = self._check_parameter(p)
+        R = self.radius
+        c, s = np.cos(p), np.sin(p)
+        r = np.stack([self.center[0] + R * c, self.center[1] + R * s], axis=-1)
+        return (r, np.stack([-R * s, R * c], -1), np.stack([-R * c, -R * s], -1),
+                np.stack([R * s, -R * c], -1))
+
+    @property
+    def length(self) -> float:
+        return self.radius * (self.p1 - self.p0)
+
+    def arc_length(self, p: object) -> np.ndarray:
+        return self.radius * (self._check_parameter(p) - self.p0)
+
+    def parameter_at(self, s: object) -> np.ndarray:
+        return self.p0 + np.asarray(s, dtype=float) / self.radius
+
+
+@dataclass(frozen=True)
+class Line(Path):
+    """Straight segment ``r(p) = a + p (b - a)``, ``p`` in ``[0, 1]``."""
+
+    start: tuple[float, float]
+    end: tuple[float, float]
+    p0: float = field(default=0.0, init=False)
+    p1: float = field(default=1.0, init=False)
+    constant_curvature: float = field(default=0.0, init=False)
+
+    def __post_init__(self) -> None:
+        a, b = np.asarray(self.start, float), np.asarray(self.end, float)
+        if a.shape != (2,) or b.shape != (2,) or not (np.isfinite(a).all() and np.isfinite(b).all()):
+            raise ParameterError("line start and end must be two finite points (x, y)")
+        if np.allclose(a, b):
+            raise ParameterError("line start and end must differ")
+        object.__setattr__(self, "start", tuple(a.tolist()))
+        object.__setattr__(self, "end", tuple(b.tolist()))
+
+    def derivatives(self, p: object) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        p = self._check_parameter(p)
+        a, b = np.asarray(self.start), np.asarray(self.end)
+        r = a + p[..., None] * (b - a)
+        d = np.broadcast_to(b - a, r.shape).copy()
+        z = np.zeros_like(r)
+        return r, d, z, z.copy()
+
+    @property
+    def length(self) -> float:
+        return float(np.hypot(self.end[0] - self.start[0], self.end[1] - self.start[1]))
+
+    def arc_length(self, p: object) -> np.ndarray:
+        return self.length * self._check_parameter(p)
+
+    def parameter_at(self, s: object) -> np.ndarray:
+        return np.asarray(s, dtype=float) / self.length
+
+
+@dataclass(frozen=True)
+class Spline(Path):
+    """Quintic (C4) interpolating spline through waypoints, parametrised by chord length.
+
+    The end conditions set the third and fourth derivatives to zero ("natural" quintic).
+    """
+
+    waypoints: tuple[tuple[float, float], ...]
+    p0: float = field(default=0.0, init=False)
+    p1: float = field(default=1.0, init=False)
+
+    def __post_init__(self) -> None:
+        w = np.asarray(self.waypoints, dtype=float)
+        if w.ndim != 2 or w.shape[1] != 2 or len(w) < 2:
+            raise ParameterError("spline waypoints must be at least two points (x, y)")
+        if not np.isfinite(w).all():
+            raise ParameterError("spline waypoints must be finite")
+        chord = np.linalg.norm(np.diff(w, axis=0), axis=1)
+        if (chord <= 0).any():
+            i = int(np.flatnonzero(chord <= 0)[0])
+            raise ParameterError(f"spline waypoints {i} and {i + 1} coincide")
+        object.__setattr__(self, "waypoints", tuple(map(tuple, w.tolist())))
+        knots = np.concatenate([[0.0], np.cumsum(chord)])
+        object.__setattr__(self, "p1", float(knots[-1]))
+        bc = [(3, np.zeros(2)), (4, np.zeros(2))]
+        object.__setattr__(self, "_spl", make_interp_spline(knots, w, k=5, bc_type=(bc, bc)))
+
+    def derivatives(self, p: object) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        p = self._check_parameter(p)
+        spl = self._spl  # type: ignore[attr-defined]
+        return tuple(spl(p, nu=k) for k in range(4))  # type: ignore[return-value]
+
+
+@dataclass(frozen=True)
+class ExpressionPath(Path):
+    """A path given as text, ``x(p)`` and ``y(p)``, differentiated symbolically.
+
+    >>> path = ExpressionPath("0.3*cos(p)", "1.2 + 0.2*sin(2*p)", 0.0, 3.0)
+    """
+
+    x: str
+    y: str
+    p0: float = 0.0
+    p1: float = 1.0
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.p0) and math.isfinite(self.p1) and self.p1 > self.p0):
+            raise ParameterError(f"expression path needs p0 < p1, got {self.p0!r}, {self.p1!r}")
+        object.__setattr__(self, "_ex", Expression.parse(self.x))
+        object.__setattr__(self, "_ey", Expression.parse(self.y))
+
+    def derivatives(self, p: object) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        p = self._check_parameter(p)
+        xs = self._ex(p)  # type: ignore[attr-defined]
+        ys = self._ey(p)  # type: ignore[attr-defined]
+        return tuple(np.stack([a, b], -1) for a, b in zip(xs, ys, strict=True))  # type: ignore
