@@ -96,6 +96,12 @@ def singularity_distances(
     return _type1(robot, f), np.abs(f.det) / (robot.L1 * robot.L2)
 
 
+def parallel_indicator(robot: FiveBar, q: object, points: object) -> np.ndarray:
+    """Signed ``det A / (L1 L2)``, shape (...,): its sign flips across a parallel singularity,
+    so a change of sign between two samples of a motion reveals a crossing between them."""
+    return _frame(robot, q, points).det / (robot.L1 * robot.L2)
+
+
 def _type1(robot: FiveBar, f: _Frame) -> np.ndarray:
     return np.minimum(np.abs(f.b1) / (robot.l1 * robot.L1), np.abs(f.b2) / (robot.l2 * robot.L2))
 

@@ -1,0 +1,156 @@
+import numpy as np
+import pytest
+
+from dextar.errors import ConvergenceError, ParameterError
+from dextar.laws import (
+    MinimumJerkLaw,
+    TrapezoidalLaw,
+    UniformLaw,
+    law_cost,
+    line_solution,
+    solve_optimal_law,
+)
+from dextar.paths import Arc, ExpressionPath, Line, Spline
+
+SEMI = Arc(120 / 87, 0.0, np.pi)  # the paper's semicircle in units of L = 87 mm
+
+
+def paper_law(eta=0.1):
+    return solve_optimal_law(SEMI, duration=1.0, eta=eta, mass=1.0)
+
+
+@pytest.mark.parametrize("eta", [1e-5, 1e-3, 0.1, 10.0, 1e3, 1e5])
+def test_semicircle_satisfies_paper_ode_15(eta):
+    law = paper_law(eta)
+    R = SEMI.radius
+    t = np.linspace(0, 1, 2001)
+    s, ds, dds, _ = law.evaluate(t)
+    p, dp, ddp = s / R, ds / R, dds / R
+    p4 = law.fourth_derivative(t) / R
+    gamma2 = 1.0 / eta
+    rhs = (6 * dp**2 + gamma2) * ddp
+    assert np.abs(p4 - rhs).max() / (1 + np.abs(p4).max()) < 1e-8
+    # boundary conditions (16)
+    assert abs(p[0]) < 1e-8 and abs(p[-1] - np.pi) < 1e-8
+    assert abs(dp[0]) < 1e-8 and abs(dp[-1]) < 1e-8
+
+
+def test_rest_to_rest_symmetry():
+    law = paper_law()
+    t = np.linspace(0, 1, 501)
+    s = law.evaluate(t)[0] / SEMI.radius
+    np.testing.assert_allclose(s + s[::-1], np.pi, atol=1e-10)
+
+
+def test_optimal_cost_below_other_laws():
+    eta = 0.1
+    law = paper_law(eta)
+    S = SEMI.length
+    others = [MinimumJerkLaw(S, 1.0), TrapezoidalLaw(S, vmax=2 * S, amax=6 * S, duration=1.0)]
+    # and perturbations of the optimum that keep rest at both ends
+    t = np.linspace(0, 1, 4001)
+    assert law.cost == pytest.approx(law.kinetic + law.inertial)
+    for other in others:
+        assert sum(law_cost(other, SEMI, 1.0, eta)) > law.cost
+    # a perturbation u(t) = t^2 (1 - t)^2 sin(k pi t) added to s raises the cost
+    base = law.evaluate(t)
+    for eps in (1e-2, -1e-2):
+        dbump = eps * (2 * t * (1 - t) ** 2 - 2 * t**2 * (1 - t))
+        ddbump = eps * (2 * (1 - t) ** 2 - 8 * t * (1 - t) + 2 * t**2)
+        ds, dds = base[1] + dbump, base[2] + ddbump
+        k = 1 / SEMI.radius
+        J = 0.5 * np.trapezoid(ds**2, t) + 0.5 * eta * np.trapezoid(dds**2 + k**2 * ds**4, t)
+        assert J > law.cost
+
+
+def test_cost_parts_match_paper_definitions():
+    law = paper_law()
+    t = np.linspace(0, 1, 200001)
+    _, ds, dds, _ = law.evaluate(t)
+    kin = 0.5 * np.trapezoid(ds**2, t)
+    inert = 0.5 * 0.1 * np.trapezoid(dds**2 + ds**4 / SEMI.radius**2, t)
+    assert law.kinetic == pytest.approx(kin, rel=1e-8)
+    assert law.inertial == pytest.approx(inert, rel=1e-8)
+
+
+@pytest.mark.parametrize("eta", [1e-4, 0.1, 100.0])
+def test_line_matches_closed_form(eta):
+    line = Line((0.2, 1.0), (0.8, 1.4))
+    T, m = 2.0, 1.5
+    law = solve_optimal_law(line, duration=T, eta=eta, mass=m)
+    G = T / np.sqrt(eta * m)
+    t = np.linspace(0, T, 401)
+    S = line.length
+    exact = line_solution(G, t / T) * np.array([S, S / T, S / T**2, S / T**3])[:, None]
+    got = law.evaluate(t)
+    for k in range(3):
+        assert np.abs(got[k] - exact[k]).max() <= 1e-8 * (1 + np.abs(exact[k]).max())
+
+
+def test_line_closed_form_is_the_hyperbolic_formula():
+    # independent check of line_solution: sigma'''' = G^2 sigma'' and the end conditions
+    G = 4.0
+    tau = np.linspace(0, 1, 11)
+    y = line_solution(G, tau)
+    a = 1 / (2 * np.sinh(G / 2) - G * np.cosh(G / 2))
+    direct = 0.5 - a * G * np.cosh(G / 2) * (tau - 0.5) + a * np.sinh(G * (tau - 0.5))
+    np.testing.assert_allclose(y[0], direct, atol=1e-14)
+    assert y[0][0] == pytest.approx(0, abs=1e-14) and y[0][-1] == pytest.approx(1, abs=1e-14)
+    assert abs(y[1][0]) < 1e-13 and abs(y[1][-1]) < 1e-13
+
+
+@pytest.mark.parametrize("path", [
+    Spline(((0.0, 1.0), (0.3, 1.2), (0.6, 1.0), (1.0, 1.3))),
+    ExpressionPath("0.3*cos(p)", "1.2 + 0.2*sin(2*p)", 0.0, 3.0),
+])
+def test_general_paths_euler_lagrange(path):
+    eta = 0.01
+    law = solve_optimal_law(path, eta=eta)
+    t = np.linspace(0.01, 0.99, 301)
+    s, ds, dds, _ = law.evaluate(t)
+    kappa, dkappa = path.curvature(path.parameter_at(s))
+    rhs = (1 / eta + 6 * kappa**2 * ds**2) * dds + 3 * kappa * dkappa * ds**4
+    s4 = law.fourth_derivative(t)
+    assert np.abs(s4 - rhs).max() / (1 + np.abs(rhs).max()) < 1e-4
+    assert law.cost < sum(law_cost(MinimumJerkLaw(path.length, 1.0), path, 1.0, eta))
+
+
+def test_simple_laws():
+    S, T = 2.0, 1.5
+    t = np.linspace(0, T, 1001)
+    for law in (UniformLaw(S, T), MinimumJerkLaw(S, T), TrapezoidalLaw(S, 2.0, 4.0, T)):
+        s, ds, dds, ddds = law.evaluate(t)
+        assert s[0] == pytest.approx(0, abs=1e-12) and s[-1] == pytest.approx(S, rel=1e-12)
+        np.testing.assert_allclose(np.gradient(s, t)[1:-1], ds[1:-1], atol=2e-3 * S / T)
+    mj = MinimumJerkLaw(S, T).evaluate(t)
+    assert mj[1][0] == mj[1][-1] == 0 and abs(mj[2][0]) < 1e-12
+    tz = TrapezoidalLaw(S, vmax=1.0, amax=2.0)
+    assert tz.duration == pytest.approx(S / 1.0 + 1.0 / 2.0)
+    assert np.abs(tz.evaluate(np.linspace(0, tz.duration, 999))[1]).max() <= 1.0 + 1e-12
+
+
+def test_law_errors():
+    with pytest.raises(ParameterError, match="cannot be covered"):
+        TrapezoidalLaw(10.0, vmax=100.0, amax=1.0, duration=1.0)
+    with pytest.raises(ParameterError, match="eta"):
+        solve_optimal_law(SEMI, eta=-1.0)
+    with pytest.raises(ParameterError, match="too small"):
+        solve_optimal_law(SEMI, eta=1e-12)
+    with pytest.raises(ParameterError, match="outside"):
+        UniformLaw(1.0, 1.0).evaluate([2.0])
+
+
+def test_convergence_failure_is_an_error():
+    # stiff boundary layers (eta = 1e-5) cannot be resolved with at most 32 nodes: the solver
+    # must say so rather than return an under-resolved law
+    with pytest.raises(ConvergenceError, match="did not converge for eta = 1e-05"):
+        solve_optimal_law(SEMI, eta=1e-5, max_nodes=32)
+
+
+def test_hard_path_converges_or_fails_loudly():
+    hard = ExpressionPath("p**3", "p**2", 0.001, 1.0)  # curvature ~ 1/p near the start
+    try:
+        law = solve_optimal_law(hard, eta=1e-4)
+    except ConvergenceError:
+        return
+    assert law.residual <= 1e-8
