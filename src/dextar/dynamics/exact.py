@@ -1,0 +1,348 @@
+"""Exact inverse dynamics of the closed five-bar chain in the coordinates ``q = (phi, psi)``.
+
+Method (Kane's equations / virtual power). Every velocity in the mechanism is linear in
+``qdot``: ``Bdot = J_B qdot``, ``Cdot = J_C qdot``, ``Pdot = J_P qdot`` with ``J_P = A^-1 B``
+(see :mod:`dextar.kinematics.velocity`), and the distal rods turn at
+``omega_3 = (P - B) x (Pdot - Bdot) / L1^2``. The generalised force that realises
+``qddot`` is the sum over the bodies of their inertia forces (minus gravity) projected on these
+partial velocities:
+
+    tau = sum_i J_Gi^T m_i (a_Gi - g) + (d omega_i / d qdot)^T I_i alpha_i
+          + rotor and friction terms.
+
+A distal rod with centre ``G = B + lambda (P - B)`` is equivalent to the forces
+``(1 - lambda) f`` at B and ``lambda f`` at P, and its rotary inertia to the couple
+``k (-(P-B)_y, (P-B)_x)`` at P and its opposite at B, ``k = I alpha / L^2``; so only the
+three points B, C, P carry forces and ``tau = J_B^T F_B + J_C^T F_C + J_P^T F_P + ...``.
+The same quantities give the reaction forces in the passive joints by Newton-Euler, which the
+tests use as an independent check of the torques.
+
+All functions are vectorised over samples (arrays of shape (n, 2)) and processed in
+cache-sized blocks; a single state may be given as floats for the integrators.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .._arrays import as_points, blocks
+from ..errors import AssemblyError, ParameterError, SingularityError
+from ..geometry import FiveBar, parse_assembly_mode
+from ..kinematics import DEFAULT_SINGULARITY_TOL
+from .inertia import Inertia
+
+
+@dataclass(frozen=True)
+class Model:
+    """A robot with its inertia, assembled in one assembly mode.
+
+    ``tol`` is the smallest normalised distance to a parallel singularity the dynamics accept.
+    """
+
+    robot: FiveBar
+    inertia: Inertia
+    assembly: str | int = "up"
+    tol: float = DEFAULT_SINGULARITY_TOL
+
+    def __post_init__(self) -> None:
+        parse_assembly_mode(self.assembly)
+        if not (self.tol >= 0):
+            raise ParameterError(f"singularity tolerance {self.tol!r} must be >= 0")
+
+
+class _Np:
+    """Array operations for the kernel (numpy)."""
+
+    @staticmethod
+    def cos_sin(a: Any) -> tuple[Any, Any]:
+        t = np.tan(0.5 * a)
+        t2 = t * t
+        inv = 1.0 / (1.0 + t2)
+        return (1.0 - t2) * inv, 2.0 * t * inv
+
+    sqrt = staticmethod(np.sqrt)
+    sign = staticmethod(np.sign)
+
+    @staticmethod
+    def clip0(x: Any) -> Any:
+        return np.maximum(x, 0.0)
+
+
+class _Py:
+    """Scalar operations for the kernel (plain floats, for the integrators)."""
+
+    @staticmethod
+    def cos_sin(a: float) -> tuple[float, float]:
+        return math.cos(a), math.sin(a)
+
+    sqrt = staticmethod(math.sqrt)
+
+    @staticmethod
+    def sign(x: float) -> float:
+        return (x > 0) - (x < 0)
+
+    @staticmethod
+    def clip0(x: float) -> float:
+        return x if x > 0.0 else 0.0
+
+
+def _kernel(model: Model, q1: Any, q2: Any, w1: Any, w2: Any, a1: Any, a2: Any, *,
+            gravity: bool, friction: bool, xp: Any, extra: bool = False) -> dict[str, Any]:
+    """Torques (and, with ``extra``, everything the energies and reactions need)."""
+    r, ine = model.robot, model.inertia
+    l1, l2, L1, L2 = r.l1, r.l2, r.L1, r.L2
+    half = 0.5 * r.d
+    sigma = parse_assembly_mode(model.assembly)
+    c1, s1 = xp.cos_sin(q1)
+    c2, s2 = xp.cos_sin(q2)
+    Bx, By = half + l1 * c1, l1 * s1
+    Cx, Cy = l2 * c2 - half, l2 * s2
+    # direct kinematics: P from the circles (B, L1) and (C, L2)
+    vx, vy = Bx - Cx, By - Cy
+    del2 = vx * vx + vy * vy
+    k = 0.5 * (del2 + (L2 * L2 - L1 * L1))
+    wsq = (L2 * L2) * del2 - k * k
+    h = xp.sqrt(xp.clip0(wsq))
+    if sigma < 0:
+        h = -h
+    inv = 1.0 / del2
+    Px = Cx + (k * vx - h * vy) * inv
+    Py = Cy + (k * vy + h * vx) * inv
+    ux, uy = Px - Bx, Py - By  # P - B
+    ex, ey = Px - Cx, Py - Cy  # P - C
+    b1 = l1 * (c1 * uy - s1 * ux)
+    b2 = l2 * (c2 * ey - s2 * ex)
+    det = ux * ey - uy * ex
+    idet = 1.0 / det
+    # velocities
+    r1, r2 = b1 * w1, b2 * w2
+    dPx = (ey * r1 - uy * r2) * idet
+    dPy = (ux * r2 - ex * r1) * idet
+    dBx, dBy = -l1 * s1 * w1, l1 * c1 * w1
+    dCx, dCy = -l2 * s2 * w2, l2 * c2 * w2
+    gx1, gy1 = dPx - dBx, dPy - dBy
+    gx2, gy2 = dPx - dCx, dPy - dCy
+    bias1 = -(gx1 * gx1 + gy1 * gy1) - l1 * w1 * w1 * (ux * c1 + uy * s1)
+    bias2 = -(gx2 * gx2 + gy2 * gy2) - l2 * w2 * w2 * (ex * c2 + ey * s2)
+    r1 = b1 * a1 + bias1
+    r2 = b2 * a2 + bias2
+    ddPx = (ey * r1 - uy * r2) * idet
+    ddPy = (ux * r2 - ex * r1) * idet
+    ww1, ww2 = w1 * w1, w2 * w2
+    ddBx, ddBy = -l1 * (s1 * a1 + c1 * ww1), l1 * (c1 * a1 - s1 * ww1)
+    ddCx, ddCy = -l2 * (s2 * a2 + c2 * ww2), l2 * (c2 * a2 - s2 * ww2)
+    gx, gy = ine.gravity if gravity else (0.0, 0.0)
+    rod1, rod2 = ine.proximal
+    rod3, rod4 = ine.distal
+    lam3, lam4 = rod3.com / L1, rod4.com / L2
+    # distal rod 3 (B -> P)
+    f3x = rod3.mass * (ddBx + lam3 * (ddPx - ddBx) - gx)
+    f3y = rod3.mass * (ddBy + lam3 * (ddPy - ddBy) - gy)
+    alpha3 = (ux * (ddPy - ddBy) - uy * (ddPx - ddBx)) / (L1 * L1)
+    k3 = rod3.inertia * alpha3 / (L1 * L1)
+    # distal rod 4 (C -> P)
+    f4x = rod4.mass * (ddCx + lam4 * (ddPx - ddCx) - gx)
+    f4y = rod4.mass * (ddCy + lam4 * (ddPy - ddCy) - gy)
+    alpha4 = (ex * (ddPy - ddCy) - ey * (ddPx - ddCx)) / (L2 * L2)
+    k4 = rod4.inertia * alpha4 / (L2 * L2)
+    mP = ine.point_mass
+    fPx, fPy = mP * (ddPx - gx), mP * (ddPy - gy)
+    FPx = fPx + lam3 * f3x + lam4 * f4x - k3 * uy - k4 * ey
+    FPy = fPy + lam3 * f3y + lam4 * f4y + k3 * ux + k4 * ex
+    FBx, FBy = (1.0 - lam3) * f3x + k3 * uy, (1.0 - lam3) * f3y - k3 * ux
+    FCx, FCy = (1.0 - lam4) * f4x + k4 * ey, (1.0 - lam4) * f4y - k4 * ex
+    J1 = ine.rotor[0] + rod1.about_joint
+    J2 = ine.rotor[1] + rod2.about_joint
+    tau1 = (l1 * (c1 * FBy - s1 * FBx) + b1 * (ey * FPx - ex * FPy) * idet + J1 * a1
+            - rod1.mass * rod1.com * (c1 * gy - s1 * gx))
+    tau2 = (l2 * (c2 * FCy - s2 * FCx) + b2 * (ux * FPy - uy * FPx) * idet + J2 * a2
+            - rod2.mass * rod2.com * (c2 * gy - s2 * gx))
+    if friction:
+        tau1 = tau1 + ine.viscous[0] * w1 + ine.coulomb[0] * xp.sign(w1)
+        tau2 = tau2 + ine.viscous[1] * w2 + ine.coulomb[1] * xp.sign(w2)
+    out = {"tau1": tau1, "tau2": tau2, "det": det, "wsq": wsq, "del2": del2}
+    if extra:
+        out.update(locals())
+    return out
+
+
+def _check_state(model: Model, res: dict[str, Any], q: np.ndarray, offset: int,
+                 t: np.ndarray | None) -> None:
+    r = model.robot
+    bad_fk = res["wsq"] < -1e-12 * (r.L2 * r.L2) * res["del2"]
+    dist = np.abs(res["det"]) / (r.L1 * r.L2)
+    bad_sing = dist < model.tol
+    for bad, kind in ((bad_fk, "fk"), (bad_sing, "sing")):
+        if np.any(bad):
+            j = int(np.flatnonzero(bad)[0])
+            i = offset + j
+            when = f"at t = {t[i]:.6g} (sample {i})" if t is not None else f"at sample {i}"
+            qd = np.degrees(q[i])
+            if kind == "fk":
+                raise AssemblyError(f"distal rods cannot meet {when}: q = ({qd[0]:.6g}, "
+                                    f"{qd[1]:.6g}) deg")
+            raise SingularityError(
+                f"parallel (type 2) singularity {when}: q = ({qd[0]:.6g}, {qd[1]:.6g}) deg, "
+                f"normalised distance {dist[j]:.3g} below tolerance {model.tol:g}; the torques "
+                "would be unbounded")
+
+
+def _run(model: Model, q: object, dq: object, ddq: object, *, gravity: bool, friction: bool,
+         t: object = None, keys: tuple[str, ...] = ("tau1", "tau2")) -> dict[str, np.ndarray]:
+    q0 = as_points(q, "q")
+    shape = q0.shape[:-1]
+    qf = q0.reshape(-1, 2)
+    dqf = as_points(dq, "dq").reshape(-1, 2)
+    ddqf = as_points(ddq, "ddq").reshape(-1, 2)
+    if not (len(dqf) == len(ddqf) == len(qf)):
+        raise ParameterError(f"q, dq, ddq must have the same number of samples, got "
+                             f"{len(qf)}, {len(dqf)}, {len(ddqf)}")
+    tt = None if t is None else np.asarray(t, dtype=float).reshape(-1)
+    extra = any(k not in ("tau1", "tau2") for k in keys)
+    out = {k: np.empty(len(qf)) for k in keys}
+    for blk in blocks(len(qf)):
+        res = _kernel(model, qf[blk, 0], qf[blk, 1], dqf[blk, 0], dqf[blk, 1], ddqf[blk, 0],
+                      ddqf[blk, 1], gravity=gravity, friction=friction, xp=_Np, extra=extra)
+        _check_state(model, res, qf, blk.start, tt)
+        for k in keys:
+            out[k][blk] = res[k]
+    return {k: v.reshape(shape) for k, v in out.items()}
+
+
+def inverse_dynamics(model: Model, q: object, dq: object, ddq: object, *,
+                     t: object = None) -> np.ndarray:
+    """Motor torques ``tau = M(q) qddot + c(q, qdot) + g(q) + friction``.
+
+    Parameters
+    ----------
+    q, dq, ddq : array_like, shape (..., 2)
+        Actuator angles, rates and accelerations.
+    t : array_like, optional
+        Sample times, only to name the time in an error.
+
+    Returns
+    -------
+    tau : ndarray, shape (..., 2)
+
+    Raises
+    ------
+    SingularityError
+        Within ``model.tol`` of a parallel singularity (names the sample, time and q).
+    """
+    out = _run(model, q, dq, ddq, gravity=True, friction=True, t=t)
+    return np.stack([out["tau1"], out["tau2"]], axis=-1)
+
+
+def mass_matrix(model: Model, q: object) -> np.ndarray:
+    """The inertia matrix ``M(q)``, shape (..., 2, 2), symmetric positive definite."""
+    q = as_points(q, "q")
+    z = np.zeros_like(q)
+    cols = []
+    for k in range(2):
+        e = np.zeros_like(q)
+        e[..., k] = 1.0
+        out = _run(model, q, z, e, gravity=False, friction=False)
+        cols.append(np.stack([out["tau1"], out["tau2"]], axis=-1))
+    return np.stack(cols, axis=-1)
+
+
+def bias_forces(model: Model, q: object, dq: object) -> np.ndarray:
+    """Velocity-product torques ``c(q, qdot)`` (Coriolis and centrifugal), shape (..., 2)."""
+    q = as_points(q, "q")
+    out = _run(model, q, dq, np.zeros_like(q), gravity=False, friction=False)
+    return np.stack([out["tau1"], out["tau2"]], axis=-1)
+
+
+def gravity_torques(model: Model, q: object) -> np.ndarray:
+    """Gravity torques ``g(q)``, shape (..., 2) (what the motors must hold at rest)."""
+    q = as_points(q, "q")
+    z = np.zeros_like(q)
+    out = _run(model, q, z, z, gravity=True, friction=False)
+    return np.stack([out["tau1"], out["tau2"]], axis=-1)
+
+
+def kinetic_energy(model: Model, q: object, dq: object) -> np.ndarray:
+    """Exact kinetic energy of the whole mechanism (rods, rotors, point mass at P)."""
+    q = as_points(q, "q")
+    keys = ("dPx", "dPy", "dBx", "dBy", "dCx", "dCy", "ux", "uy", "ex", "ey")
+    o = _run(model, q, dq, np.zeros_like(q), gravity=False, friction=False, keys=keys)
+    dq = as_points(dq, "dq")
+    ine, r = model.inertia, model.robot
+    rod1, rod2 = ine.proximal
+    rod3, rod4 = ine.distal
+    T = 0.5 * (ine.rotor[0] + rod1.about_joint) * dq[..., 0] ** 2
+    T += 0.5 * (ine.rotor[1] + rod2.about_joint) * dq[..., 1] ** 2
+    T += 0.5 * ine.point_mass * (o["dPx"] ** 2 + o["dPy"] ** 2)
+    for rod, L, (bx, by), (px, py) in (
+            (rod3, r.L1, ("dBx", "dBy"), ("ux", "uy")), (rod4, r.L2, ("dCx", "dCy"), ("ex", "ey"))):
+        lam = rod.com / L
+        vx = o[bx] + lam * (o["dPx"] - o[bx])
+        vy = o[by] + lam * (o["dPy"] - o[by])
+        omega = (o[px] * (o["dPy"] - o[by]) - o[py] * (o["dPx"] - o[bx])) / (L * L)
+        T += 0.5 * rod.mass * (vx * vx + vy * vy) + 0.5 * rod.inertia * omega * omega
+    return T
+
+
+@dataclass(frozen=True)
+class Reactions:
+    """Forces in the passive joints, each of shape (..., 2).
+
+    Attributes
+    ----------
+    B, C : ndarray
+        Force of the proximal rod on the distal rod at the elbow (AB on BP at B, DC on CP at C).
+    P1, P2 : ndarray
+        Force of each distal rod (BP, CP) on the end-effector at P.
+    """
+
+    B: np.ndarray
+    C: np.ndarray
+    P1: np.ndarray
+    P2: np.ndarray
+
+
+def joint_reactions(model: Model, q: object, dq: object, ddq: object) -> Reactions:
+    """Reaction forces in the passive joints B, C and P by Newton-Euler on the distal rods
+    and the end-effector (for sizing bearings)."""
+    keys = ("f3x", "f3y", "f4x", "f4y", "fPx", "fPy", "ux", "uy", "ex", "ey", "alpha3",
+            "alpha4", "det")
+    o = _run(model, q, dq, ddq, gravity=True, friction=False, keys=keys)
+    r, ine = model.robot, model.inertia
+    rod3, rod4 = ine.distal
+    L1, L2 = r.L1, r.L2
+    lam3, lam4 = rod3.com / L1, rod4.com / L2
+    ux, uy, ex, ey = o["ux"], o["uy"], o["ex"], o["ey"]
+    # normal components from the moment balance of each distal rod about its elbow
+    t3 = -(lam3 * (ux * o["f3y"] - uy * o["f3x"]) + rod3.inertia * o["alpha3"]) / L1
+    t4 = -(lam4 * (ex * o["f4y"] - ey * o["f4x"]) + rod4.inertia * o["alpha4"]) / L2
+    wx = o["fPx"] - t3 * (-uy / L1) - t4 * (-ey / L2)
+    wy = o["fPy"] - t3 * (ux / L1) - t4 * (ex / L2)
+    a3 = L1 * (wx * ey - wy * ex) / o["det"]
+    a4 = L2 * (ux * wy - uy * wx) / o["det"]
+    P1 = np.stack([(a3 * ux - t3 * uy) / L1, (a3 * uy + t3 * ux) / L1], axis=-1)
+    P2 = np.stack([(a4 * ex - t4 * ey) / L2, (a4 * ey + t4 * ex) / L2], axis=-1)
+    B = np.stack([o["f3x"], o["f3y"]], axis=-1) + P1
+    C = np.stack([o["f4x"], o["f4y"]], axis=-1) + P2
+    return Reactions(B, C, P1, P2)
+
+
+def state_dynamics(model: Model, q: tuple[float, float], dq: tuple[float, float]
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """``M(q)`` (2x2) and ``h(q, qdot) = c + g + friction`` (2,) at one state, on plain floats
+    (fast enough to call from an ODE integrator)."""
+    q1, q2 = float(q[0]), float(q[1])
+    w1, w2 = float(dq[0]), float(dq[1])
+    h = _kernel(model, q1, q2, w1, w2, 0.0, 0.0, gravity=True, friction=True, xp=_Py)
+    dist = abs(h["det"]) / (model.robot.L1 * model.robot.L2)
+    if h["wsq"] < 0 or dist < model.tol:
+        raise SingularityError(
+            f"parallel (type 2) singularity: q = ({math.degrees(q1):.6g}, "
+            f"{math.degrees(q2):.6g}) deg, normalised distance {dist:.3g}")
+    m1 = _kernel(model, q1, q2, 0.0, 0.0, 1.0, 0.0, gravity=False, friction=False, xp=_Py)
+    m2 = _kernel(model, q1, q2, 0.0, 0.0, 0.0, 1.0, gravity=False, friction=False, xp=_Py)
+    M = np.array([[m1["tau1"], m2["tau1"]], [m1["tau2"], m2["tau2"]]])
+    return M, np.array([h["tau1"], h["tau2"]])

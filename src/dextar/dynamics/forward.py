@@ -1,0 +1,103 @@
+"""Forward dynamics: integrate ``M(q) qddot = tau(t, q, qdot) - h(q, qdot)``."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.integrate import solve_ivp
+from scipy.interpolate import CubicSpline
+
+from ..errors import ConvergenceError, ParameterError, SingularityError
+from .exact import Model, state_dynamics
+
+TorqueFunction = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
+
+
+@dataclass(frozen=True)
+class ForwardResult:
+    """Integrated motion.
+
+    Attributes
+    ----------
+    t : ndarray, shape (n,)
+    q, dq, ddq : ndarray, shape (n, 2)
+    tau : ndarray, shape (n, 2)
+        The torques applied.
+    nfev : int
+        Right-hand-side evaluations.
+    message : str
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+    dq: np.ndarray
+    ddq: np.ndarray
+    tau: np.ndarray
+    nfev: int
+    message: str
+
+
+def torques_from_samples(t: np.ndarray, tau: np.ndarray) -> TorqueFunction:
+    """A torque function interpolating samples ``tau`` (n, 2) at times ``t`` (n,) by cubic
+    splines (open loop: the state is ignored)."""
+    t = np.asarray(t, dtype=float)
+    tau = np.asarray(tau, dtype=float)
+    if tau.shape != (t.size, 2):
+        raise ParameterError(f"torque samples must have shape ({t.size}, 2), got {tau.shape}")
+    spl = CubicSpline(t, tau, axis=0)
+
+    def fn(time: float, _q: np.ndarray, _dq: np.ndarray) -> np.ndarray:
+        return spl(time)
+
+    return fn
+
+
+def forward_dynamics(model: Model, torque: TorqueFunction, q0: object, dq0: object,
+                     t_eval: object, *, rtol: float = 1e-10, atol: float = 1e-12,
+                     method: str = "DOP853", max_step: float = np.inf) -> ForwardResult:
+    """Integrate the motion from ``(q0, dq0)`` under ``torque(t, q, dq)``.
+
+    Parameters
+    ----------
+    torque : callable
+        ``torque(t, q, dq) -> (2,)``; see :func:`torques_from_samples` for sampled torques.
+    q0, dq0 : array_like, shape (2,)
+    t_eval : array_like, shape (n,)
+        Output times, increasing; the integration runs from ``t_eval[0]`` to ``t_eval[-1]``.
+
+    Raises
+    ------
+    SingularityError
+        If the motion reaches a parallel singularity (names the time).
+    ConvergenceError
+        If the integrator fails.
+    """
+    t_eval = np.asarray(t_eval, dtype=float)
+    if t_eval.ndim != 1 or t_eval.size < 2 or np.any(np.diff(t_eval) <= 0):
+        raise ParameterError("t_eval must be an increasing sequence of at least two times")
+    y0 = np.concatenate([np.asarray(q0, float).reshape(2), np.asarray(dq0, float).reshape(2)])
+    if not np.isfinite(y0).all():
+        raise ParameterError("initial state must be finite")
+    nfev = 0
+
+    def rhs(time: float, y: np.ndarray) -> np.ndarray:
+        nonlocal nfev
+        nfev += 1
+        q, dq = y[:2], y[2:]
+        try:
+            M, h = state_dynamics(model, q, dq)
+        except SingularityError as exc:
+            raise SingularityError(f"forward dynamics at t = {time:.6g}: {exc}") from None
+        tau = np.asarray(torque(time, q, dq), dtype=float)
+        return np.concatenate([dq, np.linalg.solve(M, tau - h)])
+
+    sol = solve_ivp(rhs, (t_eval[0], t_eval[-1]), y0, method=method, t_eval=t_eval, rtol=rtol,
+                    atol=atol, max_step=max_step)
+    if not sol.success:
+        raise ConvergenceError(f"forward dynamics failed at t = {sol.t[-1]:.6g}: {sol.message}")
+    q, dq = sol.y[:2].T, sol.y[2:].T
+    tau = np.array([torque(ti, qi, dqi) for ti, qi, dqi in zip(sol.t, q, dq, strict=True)])
+    ddq = np.array([rhs(ti, yi)[2:] for ti, yi in zip(sol.t, sol.y.T, strict=True)])
+    return ForwardResult(sol.t, q, dq, ddq, tau, nfev, str(sol.message))

@@ -1,0 +1,146 @@
+"""Inertial parameters of the five-bar, in the run's units.
+
+Four rods (proximal AB and DC, distal BP and CP), each with a mass, a centre of mass (distance
+along the rod from its proximal joint) and an inertia about the centre of mass; the
+end-effector mass and a payload at P; rotor inertia of each motor as seen at the joint; viscous
+and Coulomb friction at the motors; an in-plane gravity vector.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+from ..errors import ParameterError
+from ..geometry import FiveBar
+
+
+def _check(name: str, value: float, *, positive: bool = False) -> float:
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name} = {value!r} is not a number") from None
+    if not math.isfinite(value):
+        raise ParameterError(f"{name} = {value!r} must be finite")
+    if value < 0 or (positive and value == 0):
+        raise ParameterError(f"{name} = {value!r} must be {'positive' if positive else '>= 0'}")
+    return value
+
+
+@dataclass(frozen=True)
+class Rod:
+    """A rod: ``mass``, centre of mass at ``com`` from its proximal joint, ``inertia`` about
+    the centre of mass (perpendicular to the plane)."""
+
+    mass: float
+    com: float
+    inertia: float
+
+    def validated(self, name: str) -> Rod:
+        m = _check(f"{name} mass", self.mass)
+        c = float(self.com)
+        if not math.isfinite(c):
+            raise ParameterError(f"{name} centre of mass {self.com!r} must be finite")
+        i = _check(f"{name} inertia", self.inertia)
+        if m == 0 and (i > 0):
+            raise ParameterError(f"{name}: a massless rod cannot have inertia {i:g}")
+        return Rod(m, c, i)
+
+    @staticmethod
+    def uniform(mass: float, length: float) -> Rod:
+        """A uniform slender rod: centre at mid-length, inertia ``m L^2 / 12``."""
+        return Rod(mass, 0.5 * length, mass * length * length / 12.0)
+
+    @property
+    def about_joint(self) -> float:
+        """Inertia about the proximal joint, ``I + m c^2``."""
+        return self.inertia + self.mass * self.com**2
+
+
+@dataclass(frozen=True)
+class Inertia:
+    """All the inertial, friction and gravity parameters of a five-bar.
+
+    Attributes
+    ----------
+    proximal : (Rod, Rod)
+        Rods AB (leg 1) and DC (leg 2).
+    distal : (Rod, Rod)
+        Rods BP and CP; ``com`` measured from B and C.
+    effector_mass, payload : float
+        Point masses at P.
+    rotor : (float, float)
+        Rotor inertia of the motors at A and D (as seen at the joint).
+    viscous, coulomb : (float, float)
+        Motor friction: ``tau_f = viscous * qdot + coulomb * sign(qdot)``.
+    gravity : (float, float)
+        In-plane gravity vector (zero when the robot lies horizontally).
+    """
+
+    proximal: tuple[Rod, Rod]
+    distal: tuple[Rod, Rod]
+    effector_mass: float = 1.0
+    payload: float = 0.0
+    rotor: tuple[float, float] = (0.0, 0.0)
+    viscous: tuple[float, float] = (0.0, 0.0)
+    coulomb: tuple[float, float] = (0.0, 0.0)
+    gravity: tuple[float, float] = field(default=(0.0, 0.0))
+
+    def __post_init__(self) -> None:
+        names = (("proximal rod AB", "proximal rod DC"), ("distal rod BP", "distal rod CP"))
+        for attr, labels in zip(("proximal", "distal"), names, strict=True):
+            rods = getattr(self, attr)
+            if len(rods) != 2:
+                raise ParameterError(f"{attr} must hold two rods")
+            object.__setattr__(self, attr, tuple(r.validated(n) for r, n in
+                                                 zip(rods, labels, strict=True)))
+        object.__setattr__(self, "effector_mass", _check("effector mass", self.effector_mass))
+        object.__setattr__(self, "payload", _check("payload", self.payload))
+        for attr in ("rotor", "viscous", "coulomb"):
+            pair = tuple(getattr(self, attr))
+            if len(pair) != 2:
+                raise ParameterError(f"{attr} must be a pair (motor A, motor D)")
+            object.__setattr__(self, attr, tuple(_check(f"{attr} {k + 1}", v)
+                                                 for k, v in enumerate(pair)))
+        g = tuple(float(v) for v in self.gravity)
+        if len(g) != 2 or not all(math.isfinite(v) for v in g):
+            raise ParameterError(f"gravity {self.gravity!r} must be a finite 2-vector")
+        object.__setattr__(self, "gravity", g)
+
+    @property
+    def point_mass(self) -> float:
+        """Mass at P: end-effector plus payload."""
+        return self.effector_mass + self.payload
+
+    @property
+    def has_friction(self) -> bool:
+        return any(self.viscous) or any(self.coulomb)
+
+    @classmethod
+    def uniform(cls, robot: FiveBar, *, proximal_mass: float, distal_mass: float,
+                effector_mass: float = 1.0, **kwargs: object) -> Inertia:
+        """Uniform rods of the given masses (the same on both legs)."""
+        return cls(
+            proximal=(Rod.uniform(proximal_mass, robot.l1), Rod.uniform(proximal_mass, robot.l2)),
+            distal=(Rod.uniform(distal_mass, robot.L1), Rod.uniform(distal_mass, robot.L2)),
+            effector_mass=effector_mass, **kwargs)  # type: ignore[arg-type]
+
+    def with_(self, **changes: object) -> Inertia:
+        return replace(self, **changes)  # type: ignore[arg-type]
+
+    def scaled_masses(self, factor: float) -> Inertia:
+        """Every mass and inertia (rods, effector, payload, rotors) times ``factor``."""
+        def rod(r: Rod) -> Rod:
+            return Rod(r.mass * factor, r.com, r.inertia * factor)
+        return replace(self, proximal=tuple(map(rod, self.proximal)),  # type: ignore[arg-type]
+                       distal=tuple(map(rod, self.distal)),  # type: ignore[arg-type]
+                       effector_mass=self.effector_mass * factor, payload=self.payload * factor,
+                       rotor=tuple(r * factor for r in self.rotor))  # type: ignore[arg-type]
+
+
+def paper_inertia(robot: FiveBar, *, effector_mass: float = 1.0, distal_ratio: float = 0.1,
+                  proximal_ratio: float = 0.08) -> Inertia:
+    """The paper's Fig. 9 masses: distal rods ``0.1 m``, proximal rods ``0.08 m``, uniform rods,
+    no rotor inertia, no friction, no gravity."""
+    return Inertia.uniform(robot, proximal_mass=proximal_ratio * effector_mass,
+                           distal_mass=distal_ratio * effector_mass, effector_mass=effector_mass)

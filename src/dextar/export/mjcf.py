@@ -1,0 +1,112 @@
+"""MuJoCo (MJCF) model of a five-bar and the state mapping between dextar and MuJoCo.
+
+Each leg is a chain of two hinge bodies (proximal rod at its pivot, distal rod at the elbow);
+the loop is closed by an equality ``connect`` between sites at the two distal tips. The point
+mass at P (end-effector plus payload) is lumped into the distal rod BP at its tip (a point mass
+has no rotary inertia, so riding on either rod is the same). Motors at A and D drive the joints
+``phi`` and ``psi`` with unit gear; rotor inertia becomes joint ``armature``, viscous friction
+joint ``damping``. Units are those of the robot and inertia given (the run's units).
+
+Joint order in ``qpos``: ``phi, theta1, psi, theta2``, where ``theta1`` and ``theta2`` are the
+distal rods' angles relative to their proximal rods.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..dynamics.exact import Model
+from ..kinematics import direct_kinematics, elbows, task_velocity
+from ..output.files import write_text
+
+#: Constraint softness: as stiff as MuJoCo allows (impedance 0.9999).
+SOLREF = "0.0005 1"
+SOLIMP = "0.9999 0.9999 0.001 0.5 2"
+
+
+def _fmt(*values: float) -> str:
+    return " ".join(f"{v:.17g}" for v in values)
+
+
+def _inertial(mass: float, com: float, izz: float) -> str:
+    # a planar rod along local x: principal inertias (tiny, izz, izz) keep MuJoCo's
+    # triangle inequality; MuJoCo needs strictly positive values
+    m = max(mass, 1e-12)
+    i = max(izz, 1e-15)
+    return (f'<inertial pos="{_fmt(com, 0, 0)}" mass="{m:.17g}" '
+            f'diaginertia="{_fmt(1e-3 * i, i, i)}"/>')
+
+
+def to_mjcf(model: Model, *, name: str = "dextar") -> str:
+    """The MJCF text of ``model`` (geometry, inertia, gravity, rotor inertia, viscous
+    friction)."""
+    r, ine = model.robot, model.inertia
+    p1, p2 = ine.proximal
+    d1, d2 = ine.distal
+    mP = ine.point_mass
+    # distal rod BP with the point mass at its tip
+    m13 = d1.mass + mP
+    c13 = (d1.mass * d1.com + mP * r.L1) / m13 if m13 > 0 else 0.0
+    i13 = d1.inertia + d1.mass * (d1.com - c13) ** 2 + mP * (r.L1 - c13) ** 2
+    gx, gy = ine.gravity
+    rad = 0.02 * min(r.l1, r.l2)
+    leg = []
+    for k, (pivot, prox, dist, l, L, mass_d, com_d, inert_d) in enumerate((
+            (r.A, p1, d1, r.l1, r.L1, m13, c13, i13),
+            (r.D, p2, d2, r.l2, r.L2, d2.mass, d2.com, d2.inertia)), start=1):
+        joint = "phi" if k == 1 else "psi"
+        leg.append(f"""    <body name="proximal{k}" pos="{_fmt(pivot[0], pivot[1], 0)}">
+      <joint name="{joint}" type="hinge" axis="0 0 1" armature="{ine.rotor[k - 1]:.17g}" damping="{ine.viscous[k - 1]:.17g}"/>
+      {_inertial(prox.mass, prox.com, prox.inertia)}
+      <geom type="capsule" fromto="0 0 0 {l:.17g} 0 0" size="{rad:.6g}" mass="0" contype="0" conaffinity="0"/>
+      <body name="distal{k}" pos="{l:.17g} 0 0">
+        <joint name="theta{k}" type="hinge" axis="0 0 1"/>
+        {_inertial(mass_d, com_d, inert_d)}
+        <geom type="capsule" fromto="0 0 0 {L:.17g} 0 0" size="{rad:.6g}" mass="0" contype="0" conaffinity="0"/>
+        <site name="tip{k}" pos="{L:.17g} 0 0"/>
+      </body>
+    </body>""")
+    legs = "\n".join(leg)
+    return f"""<mujoco model="{name}">
+  <!-- five-bar exported by dextar; units are the run's units -->
+  <compiler angle="radian"/>
+  <option gravity="{_fmt(gx, gy, 0)}" timestep="0.0001" integrator="RK4">
+    <flag contact="disable"/>
+  </option>
+  <worldbody>
+{legs}
+  </worldbody>
+  <equality>
+    <connect name="closure" site1="tip1" site2="tip2" solref="{SOLREF}" solimp="{SOLIMP}"/>
+  </equality>
+  <actuator>
+    <motor name="motor_A" joint="phi" gear="1"/>
+    <motor name="motor_D" joint="psi" gear="1"/>
+  </actuator>
+</mujoco>
+"""
+
+
+def write_mjcf(model: Model, path: str) -> None:
+    """Write :func:`to_mjcf` atomically to ``path``."""
+    write_text(path, to_mjcf(model))
+
+
+def mujoco_state(model: Model, q: np.ndarray, dq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``qpos`` and ``qvel`` (each (n, 4)) of the MuJoCo model for actuator states ``q, dq``
+    (n, 2)."""
+    r = model.robot
+    q, dq = np.atleast_2d(q), np.atleast_2d(dq)
+    P = direct_kinematics(r, q, model.assembly)
+    B, C = elbows(r, q)
+    dP = task_velocity(r, q, P, dq, tol=0.0)
+    u, v = P - B, P - C
+    th3 = np.arctan2(u[:, 1], u[:, 0])
+    th4 = np.arctan2(v[:, 1], v[:, 0])
+    dB = r.l1 * dq[:, :1] * np.stack([-np.sin(q[:, 0]), np.cos(q[:, 0])], -1)
+    dC = r.l2 * dq[:, 1:] * np.stack([-np.sin(q[:, 1]), np.cos(q[:, 1])], -1)
+    w3 = (u[:, 0] * (dP - dB)[:, 1] - u[:, 1] * (dP - dB)[:, 0]) / r.L1**2
+    w4 = (v[:, 0] * (dP - dC)[:, 1] - v[:, 1] * (dP - dC)[:, 0]) / r.L2**2
+    qpos = np.stack([q[:, 0], th3 - q[:, 0], q[:, 1], th4 - q[:, 1]], -1)
+    qvel = np.stack([dq[:, 0], w3 - dq[:, 0], dq[:, 1], w4 - dq[:, 1]], -1)
+    return qpos, qvel
