@@ -51,9 +51,9 @@ def to_mjcf(model: Model, *, name: str = "dextar") -> str:
     gx, gy = ine.gravity
     rad = 0.02 * min(r.l1, r.l2)
     leg = []
-    for k, (pivot, prox, dist, l, L, mass_d, com_d, inert_d) in enumerate((
-            (r.A, p1, d1, r.l1, r.L1, m13, c13, i13),
-            (r.D, p2, d2, r.l2, r.L2, d2.mass, d2.com, d2.inertia)), start=1):
+    for k, (pivot, prox, l, L, mass_d, com_d, inert_d) in enumerate((
+            (r.A, p1, r.l1, r.L1, m13, c13, i13),
+            (r.D, p2, r.l2, r.L2, d2.mass, d2.com, d2.inertia)), start=1):
         joint = "phi" if k == 1 else "psi"
         leg.append(f"""    <body name="proximal{k}" pos="{_fmt(pivot[0], pivot[1], 0)}">
       <joint name="{joint}" type="hinge" axis="0 0 1" armature="{ine.rotor[k - 1]:.17g}" damping="{ine.viscous[k - 1]:.17g}"/>
