@@ -14,6 +14,7 @@ from .geometry import DEXTAR_MM, FiveBar, preset
 from .kinematics import (
     assembly_mode,
     direct_kinematics,
+    elbows,
     inverse_kinematics,
     jacobian,
     joint_acceleration,
@@ -41,6 +42,7 @@ __all__ = [
     "SingularityError",
     "assembly_mode",
     "direct_kinematics",
+    "elbows",
     "inverse_kinematics",
     "jacobian",
     "joint_acceleration",

@@ -205,8 +205,10 @@ def _run(model: Model, q: object, dq: object, ddq: object, *, gravity: bool, fri
     extra = any(k not in ("tau1", "tau2") for k in keys)
     out = {k: np.empty(len(qf)) for k in keys}
     for blk in blocks(len(qf)):
-        res = _kernel(model, qf[blk, 0], qf[blk, 1], dqf[blk, 0], dqf[blk, 1], ddqf[blk, 0],
-                      ddqf[blk, 1], gravity=gravity, friction=friction, xp=_Np, extra=extra)
+        with np.errstate(divide="ignore", invalid="ignore"):  # checked right below
+            res = _kernel(model, qf[blk, 0], qf[blk, 1], dqf[blk, 0], dqf[blk, 1],
+                          ddqf[blk, 0], ddqf[blk, 1], gravity=gravity, friction=friction,
+                          xp=_Np, extra=extra)
         _check_state(model, res, qf, blk.start, tt)
         for k in keys:
             out[k][blk] = res[k]
