@@ -169,3 +169,202 @@ def _protect_negatives(argv: list[str]) -> list[str]:
 
 if __name__ == "__main__":
     raise SystemExit(main())
+
+
+# ----------------------------------------------------------------------------- stages
+def _scenario(path: str | None) -> Any:
+    from .scenario import load_scenario
+
+    return load_scenario(path)
+
+
+def _units_note(sc: Any) -> str:
+    u = sc.units
+    n = u.names
+    if u.system == "paper":
+        return (f"paper units: length L = {u.length_mm:g} mm, mass m = {u.mass_kg:g} kg, "
+                f"time T = {u.time_s:g} s; angles in rad")
+    return f"SI units: {n['length']}, {n['mass']}, {n['time']}; torques in N m; angles in rad"
+
+
+def _check_csv_out(out: str) -> Path:
+    p = Path(out)
+    if p.suffix.lower() != ".csv":
+        raise ConfigError(f"--out {out!r} must end in .csv")
+    if p.is_dir():
+        raise ConfigError(f"--out {out!r} is a directory")
+    return p
+
+
+def cmd_plan(args: argparse.Namespace) -> int:
+    from .laws import OptimalLaw, law_cost
+    from .output.files import write_text
+    from .output.tables import csv_text
+
+    out = _check_csv_out(args.out)
+    sc = _scenario(args.config)
+    law = sc.law()
+    tr = sc.trajectory(law)
+    write_text(out, csv_text(tr.columns()))
+    if isinstance(law, OptimalLaw):
+        kin, inert = law.kinetic, law.inertial
+    else:
+        kin, inert = law_cost(law, sc.path, sc.inertia.point_mass, sc.law_spec["eta"])
+    e = sc.units.names["energy"]
+    payload = {"out": str(out), "samples": int(tr.t.size), "law": law.name,
+               "cost": kin + inert, "cost_kinetic": kin, "cost_inertial": inert,
+               "units": sc.units.describe()}
+    _emit(args, payload, f"cost Phi = {kin + inert:.10g} (kinetic {kin:.10g}, inertial "
+          f"{inert:.10g}) [{e} x {sc.units.names['time']}]\nwrote {out}: {tr.t.size} samples, "
+          f"{law.name} law, working mode {tr.mode} ({_units_note(sc)})")
+    return 0
+
+
+def cmd_torques(args: argparse.Namespace) -> int:
+    from .analysis import analyze
+    from .output.files import write_text
+    from .output.tables import csv_text
+
+    out = _check_csv_out(args.out)
+    sc = _scenario(args.config)
+    an = analyze(sc)
+    write_text(out, csv_text(an.columns()))
+    peak = np.abs(an.tau).max(axis=0)
+    payload: dict[str, Any] = {"out": str(out), "samples": int(an.trajectory.t.size),
+                               "peak_torque": [float(v) for v in peak],
+                               "units": sc.units.describe()}
+    text = (f"wrote {out}: {an.trajectory.t.size} samples; peak |tau| = {peak[0]:.6g}, "
+            f"{peak[1]:.6g} [{sc.units.names['torque']}] ({_units_note(sc)})")
+    if an.paper is not None:
+        payload["paper_model_error"] = an.paper.error
+        text += (f"\npaper model (42) error: max {an.paper.error['max_relative']:.1%}, RMS "
+                 f"{an.paper.error['rms_relative']:.1%} of the peak exact torque")
+    else:
+        text += "\nno paper-model columns: the paper's model needs a symmetric robot"
+    _emit(args, payload, text)
+    return 0
+
+
+def cmd_simulate(args: argparse.Namespace) -> int:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from .control import simulate_computed_torque
+    from .dynamics import Model
+    from .output.figures import png_bytes
+    from .output.outdir import OutputDir
+    from .output.tables import csv_text
+
+    sc = _scenario(args.config)
+    tr = sc.trajectory()
+    c = sc.control
+    controller = Model(sc.robot, sc.inertia, tr.assembly)
+    plant_inertia = sc.inertia.scaled_masses(1.0 + c["mass_error"])
+    plant_inertia = plant_inertia.with_(payload=plant_inertia.payload + c["payload"])
+    plant = Model(sc.robot, plant_inertia, tr.assembly)
+    res = simulate_computed_torque(tr, controller, plant, natural_frequency=c["natural_frequency"],
+                                   damping=c["damping"], torque_limit=c["torque_limit"],
+                                   initial_error=c["initial_error"])
+    mm = sc.units.length_mm
+    cols = {"t": res.t, "phi_des": tr.q[:, 0], "psi_des": tr.q[:, 1], "phi": res.q[:, 0],
+            "psi": res.q[:, 1], "err_phi": res.joint_error[:, 0],
+            "err_psi": res.joint_error[:, 1], "task_error_mm": res.task_error * mm,
+            "tau1": res.tau[:, 0], "tau2": res.tau[:, 1],
+            "saturated": res.saturated.astype(float)}
+    summ = res.summary()
+    report = {"units": sc.units.describe(), "control": {k: v for k, v in c.items()},
+              "max_task_error_mm": summ["max_task_error"] * mm,
+              "rms_task_error_mm": summ["rms_task_error"] * mm,
+              "final_task_error_mm": summ["final_task_error"] * mm,
+              "max_joint_error_deg": float(np.degrees(summ["max_joint_error_rad"])),
+              "saturated_fraction": summ["saturated_fraction"]}
+    fig, axes = plt.subplots(2, 1, figsize=(6.4, 6), sharex=True)
+    axes[0].plot(res.t, res.task_error * mm)
+    axes[0].set_ylabel("task-space error [mm]")
+    axes[1].plot(res.t, np.degrees(res.joint_error))
+    axes[1].set_ylabel("joint error [deg]")
+    axes[1].legend([r"$\varphi$", r"$\psi$"])
+    axes[1].set_xlabel(f"time [{sc.units.names['time']}]")
+    axes[0].set_title(f"Computed-torque tracking: masses {c['mass_error']:+.0%}, unmodelled "
+                      f"payload {c['payload_kg']:g} kg", fontsize=10)
+    fig.tight_layout()
+    with OutputDir(args.out, force=args.force) as od:
+        od.write_text("tracking.csv", csv_text(cols))
+        od.write_bytes("tracking.png", png_bytes(fig))
+        od.write_text("tracking.json", json.dumps(report, indent=2, default=str) + "\n")
+    plt.close(fig)
+    _emit(args, report, f"wrote {args.out}/tracking.csv, tracking.png, tracking.json: max "
+          f"task error {report['max_task_error_mm']:.4g} mm, max joint error "
+          f"{report['max_joint_error_deg']:.4g} deg")
+    return 0
+
+
+def cmd_export(args: argparse.Namespace) -> int:
+    from .dynamics import Model
+    from .export.mjcf import write_mjcf
+
+    sc = _scenario(args.config)
+    out = Path(args.out)
+    if out.suffix.lower() != ".xml":
+        raise ConfigError(f"--out {args.out!r} must end in .xml")
+    write_mjcf(Model(sc.robot, sc.inertia, sc.assembly), str(out))
+    _emit(args, {"out": str(out), "units": sc.units.describe()},
+          f"wrote {out} (MuJoCo model in {_units_note(sc)})")
+    return 0
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    from .output.run import run
+
+    sc = _scenario(args.config)
+    s = run(sc, args.out, force=args.force, quiet=args.quiet)
+    if args.json:
+        print(json.dumps({"out": args.out, "files": s["files"]}))
+    elif not args.quiet:
+        claims = s.get("claims", [])
+        lines = [f"wrote {len(s['files'])} files to {args.out}/ (open report.html)",
+                 f"cost Phi = {s['cost']['total']:.8g}; peak |tau| exact = "
+                 f"{max(s['torques']['exact']['peak']):.6g} {s['units']['torque_unit']}"]
+        lines += [f"  {c['verdict']:>11}: {c['claim']} ({c['value']:.3g})" for c in claims]
+        print("\n".join(lines))
+    return 0
+
+
+def _register_stages(sub: Any) -> None:
+    def cfg(sp: argparse.ArgumentParser) -> None:
+        sp.add_argument("config", nargs="?", help="TOML config (default: the paper's example)")
+        sp.add_argument("--json", action="store_true", help="print one JSON object")
+
+    sp = sub.add_parser("plan", help="law of motion along the path: samples to CSV, cost")
+    cfg(sp)
+    sp.add_argument("--out", required=True, help="CSV file")
+    sp.set_defaults(func=cmd_plan)
+
+    sp = sub.add_parser("torques", help="exact and paper-model motor torques to CSV")
+    cfg(sp)
+    sp.add_argument("--out", required=True, help="CSV file")
+    sp.set_defaults(func=cmd_torques)
+
+    sp = sub.add_parser("simulate", help="computed-torque tracking against a perturbed plant")
+    cfg(sp)
+    sp.add_argument("--out", default="dextar-sim", help="output directory")
+    sp.add_argument("--force", action="store_true", help="write into an existing directory")
+    sp.set_defaults(func=cmd_simulate)
+
+    sp = sub.add_parser("export", help="export the robot model (mjcf: MuJoCo XML)")
+    sp.add_argument("format", choices=["mjcf"])
+    cfg(sp)
+    sp.add_argument("--out", required=True, help="XML file")
+    sp.set_defaults(func=cmd_export)
+
+    sp = sub.add_parser("run", help="reproduce the paper end to end and write a report")
+    cfg(sp)
+    sp.add_argument("--out", default="dextar-out", help="output directory (default dextar-out)")
+    sp.add_argument("--force", action="store_true", help="write into an existing directory")
+    sp.add_argument("--quiet", action="store_true", help="no progress or summary output")
+    sp.set_defaults(func=cmd_run)
+
+
+_EXTRA_COMMANDS.append(_register_stages)

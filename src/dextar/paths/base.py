@@ -156,7 +156,8 @@ class Arc(Path):
         return self.radius * (self._check_parameter(p) - self.p0)
 
     def parameter_at(self, s: object) -> np.ndarray:
-        return self.p0 + np.asarray(s, dtype=float) / self.radius
+        p = self.p0 + np.asarray(s, dtype=float) / self.radius
+        return np.clip(p, self.p0, self.p1)
 
 
 @dataclass(frozen=True)
@@ -194,7 +195,7 @@ class Line(Path):
         return self.length * self._check_parameter(p)
 
     def parameter_at(self, s: object) -> np.ndarray:
-        return np.asarray(s, dtype=float) / self.length
+        return np.clip(np.asarray(s, dtype=float) / self.length, 0.0, 1.0)
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,134 @@
+"""One stage on top of the others: a scenario's trajectory, exact torques, the paper's model
+beside them, the energy comparisons of the paper's Figs. 6 and 7, and the validation residuals
+(power balance and forward re-simulation)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .dynamics import Model, inverse_dynamics, kinetic_energy
+from .dynamics.forward import forward_dynamics, torques_from_samples
+from .dynamics.paper import (
+    PaperModel,
+    base_angle,
+    effector_energy_const_beta,
+    effector_energy_fd,
+    paper_model,
+    torque_error,
+    triangle_energies,
+)
+from .laws import Law
+from .scenario import Scenario
+from .trajectory import Trajectory, sample_trajectory
+
+# central differences of order 8 on 9 points, for dT/dt in the power balance
+_FD8 = np.array([1 / 280, -4 / 105, 1 / 5, -4 / 5, 0.0, 4 / 5, -1 / 5, 4 / 105, -1 / 280])
+
+
+@dataclass(frozen=True)
+class PaperComparison:
+    """The paper's simplified model beside the exact one, on the same trajectory."""
+
+    model: PaperModel
+    beta: np.ndarray
+    tau: np.ndarray
+    error: dict[str, float]
+    T_exact: np.ndarray
+    T_fd: np.ndarray
+    T_approx: np.ndarray
+    T_S: np.ndarray
+    T_r: np.ndarray
+    fig7: dict[str, float]
+
+
+@dataclass(frozen=True)
+class Analysis:
+    scenario: Scenario
+    law: Law
+    trajectory: Trajectory
+    model: Model
+    tau: np.ndarray
+    power: np.ndarray
+    energy: np.ndarray
+    paper: PaperComparison | None
+
+    def columns(self) -> dict[str, np.ndarray]:
+        """The torques columns: plan columns, exact and paper torques, powers, energy."""
+        cols = dict(self.trajectory.columns())
+        cols["tau1"], cols["tau2"] = self.tau[:, 0], self.tau[:, 1]
+        if self.paper is not None:
+            cols["tau1_paper"], cols["tau2_paper"] = self.paper.tau[:, 0], self.paper.tau[:, 1]
+        cols["power1"], cols["power2"] = self.power[:, 0], self.power[:, 1]
+        cols["kinetic_energy"] = self.energy
+        return cols
+
+
+def analyze(scenario: Scenario, law: Law | None = None) -> Analysis:
+    """Trajectory and torques of ``scenario`` (with the paper comparison when the robot is
+    symmetric)."""
+    law = law or scenario.law()
+    tr = scenario.trajectory(law)
+    model = Model(scenario.robot, scenario.inertia, tr.assembly)
+    tau = inverse_dynamics(model, tr.q, tr.dq, tr.ddq, t=tr.t)
+    power = tau * tr.dq
+    energy = kinetic_energy(model, tr.q, tr.dq)
+    paper = _paper(scenario, law, tr, model, tau) if scenario.robot.is_symmetric else None
+    return Analysis(scenario, law, tr, model, tau, power, energy, paper)
+
+
+def _paper(sc: Scenario, law: Law, tr: Trajectory, model: Model, tau: np.ndarray
+           ) -> PaperComparison:
+    t0 = sc.paper["beta0_time"] * law.duration
+    mid = sample_trajectory(sc.robot, sc.path, law, mode=sc.mode, times=np.array([t0]))
+    beta0 = float(base_angle(sc.robot, mid.q)[0])
+    pm = paper_model(sc.robot, sc.inertia, beta0)
+    tau_p = pm.torques(tr.q, tr.dq, tr.ddq)
+    m = sc.inertia.point_mass
+    T_exact = 0.5 * m * np.sum(tr.dP**2, axis=-1)
+    T_fd = effector_energy_fd(sc.robot, m, tr.t, tr.q)
+    T_approx = effector_energy_const_beta(sc.robot, m, beta0, tr.q, tr.dq)
+    ratio, lam = sc.paper["fig7_distal_mass_ratio"], sc.paper["fig7_lambda"]
+    mL = ratio * m
+    JL = mL * sc.robot.L1**2 / 2
+    T_S, T_r = triangle_energies(sc.robot, mL, JL, lam, tr.q, tr.dq, tr.dP)
+    return PaperComparison(pm, base_angle(sc.robot, tr.q), tau_p, torque_error(tau, tau_p),
+                           T_exact, T_fd, T_approx, T_S, T_r,
+                           {"distal_mass": mL, "JL": JL, "lambda": lam})
+
+
+def power_balance_residual(an: Analysis, *, interior: int = 201) -> float:
+    """``max |tau . qdot - dT/dt| / max |tau . qdot|`` on ``interior`` times, with ``dT/dt``
+    from an 8th-order central difference of the exact energy along the law (needs no
+    gravity and no friction; returns NaN-free 0-based residual only then)."""
+    sc, law = an.scenario, an.law
+    T = law.duration
+    h = 1e-3 * T
+    t = np.linspace(5 * h, T - 5 * h, interior)
+    model = Model(sc.robot, sc.inertia.with_(gravity=(0.0, 0.0), viscous=(0.0, 0.0),
+                                             coulomb=(0.0, 0.0)), an.trajectory.assembly)
+    rate = np.zeros_like(t)
+    for k, c in enumerate(_FD8):
+        if c:
+            tr = sample_trajectory(sc.robot, sc.path, law, mode=sc.mode, times=t + (k - 4) * h)
+            rate += c * kinetic_energy(model, tr.q, tr.dq)
+    rate /= h
+    tr = sample_trajectory(sc.robot, sc.path, law, mode=sc.mode, times=t)
+    power = np.sum(inverse_dynamics(model, tr.q, tr.dq, tr.ddq) * tr.dq, axis=-1)
+    return float(np.abs(power - rate).max() / np.abs(power).max())
+
+
+def forward_error(an: Analysis) -> dict[str, Any]:
+    """Re-simulate the motion under the sampled exact torques (cubic-spline interpolated)
+    and compare with the trajectory."""
+    tr = an.trajectory
+    res = forward_dynamics(an.model, torques_from_samples(tr.t, an.tau), tr.q[0], tr.dq[0],
+                           tr.t)
+    span = np.ptp(tr.q, axis=0)
+    span = np.where(span > 0, span, 1.0)
+    return {"final_error_relative_to_range": float((np.abs(res.q[-1] - tr.q[-1]) / span).max()),
+            "max_error_relative_to_range": float((np.abs(res.q - tr.q).max(axis=0) / span).max()),
+            "max_error_rad": float(np.abs(res.q - tr.q).max()),
+            "rhs_evaluations": int(res.nfev)}
