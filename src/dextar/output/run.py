@@ -221,23 +221,23 @@ def _claims(an: Analysis, s: dict[str, Any]) -> list[dict[str, Any]]:
 def _figures(an: Analysis, uniform: Any, od: OutputDir) -> dict[str, bytes]:
     import matplotlib.pyplot as plt
 
-    from . import figures as F
+    from . import figures as fg
 
     wanted = an.scenario.output["figures"]
     makers: dict[str, Callable[[], Any]] = {
-        "fig3": lambda: F.fig3(an, uniform), "fig4": lambda: F.fig4(an),
-        "fig5": lambda: F.fig5(an), "fig6": lambda: F.fig6(an), "fig7": lambda: F.fig7(an),
-        "fig8": lambda: F.fig8(an), "fig9": lambda: F.fig9(an),
-        "workspace": lambda: F.workspace_figure(an)}
+        "fig3": lambda: fg.fig3(an, uniform), "fig4": lambda: fg.fig4(an),
+        "fig5": lambda: fg.fig5(an), "fig6": lambda: fg.fig6(an), "fig7": lambda: fg.fig7(an),
+        "fig8": lambda: fg.fig8(an), "fig9": lambda: fg.fig9(an),
+        "workspace": lambda: fg.workspace_figure(an)}
     pngs: dict[str, bytes] = {}
     for name, make in makers.items():
         if name not in wanted or (name in ("fig6", "fig7") and an.paper is None):
             continue
         fig = make()
-        pngs[name] = F.png_bytes(fig)
+        pngs[name] = fg.png_bytes(fig)
         od.write_bytes(f"{name}.png", pngs[name])
         if name != "workspace":
-            od.write_bytes(f"{name}.svg", F.svg_bytes(fig))
+            od.write_bytes(f"{name}.svg", fg.svg_bytes(fig))
         plt.close(fig)
     return pngs
 
