@@ -30,7 +30,10 @@ _FD8 = np.array([1 / 280, -4 / 105, 1 / 5, -4 / 5, 0.0, 4 / 5, -1 / 5, 4 / 105, 
 
 @dataclass(frozen=True)
 class PaperComparison:
-    """The paper's simplified model beside the exact one, on the same trajectory."""
+    """The paper's simplified model beside the exact one, on the same trajectory.
+
+    ``error`` compares the paper's torques with the exact inertial torques (gravity and
+    friction, which the paper's model leaves out, are excluded from both)."""
 
     model: PaperModel
     beta: np.ndarray
@@ -86,6 +89,12 @@ def _paper(sc: Scenario, law: Law, tr: Trajectory, model: Model, tau: np.ndarray
     beta0 = float(base_angle(sc.robot, mid.q)[0])
     pm = paper_model(sc.robot, sc.inertia, beta0)
     tau_p = pm.torques(tr.q, tr.dq, tr.ddq)
+    ine = sc.inertia
+    if any(ine.gravity) or ine.has_friction:
+        # the paper's model is inertial only: compare with the exact inertial torques
+        inertial = Model(sc.robot, ine.with_(gravity=(0.0, 0.0), viscous=(0.0, 0.0),
+                                             coulomb=(0.0, 0.0)), tr.assembly)
+        tau = inverse_dynamics(inertial, tr.q, tr.dq, tr.ddq, t=tr.t)
     m = sc.inertia.point_mass
     T_exact = 0.5 * m * np.sum(tr.dP**2, axis=-1)
     T_fd = effector_energy_fd(sc.robot, m, tr.t, tr.q)

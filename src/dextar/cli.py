@@ -136,6 +136,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     # negative numbers are values, not options: "dextar ik -10 120"
     argv = list(sys.argv[1:] if argv is None else argv)
     args = parser.parse_args(_protect_negatives(argv))
+    _terminate_as_interrupt()
     try:
         return int(args.func(args))
     except DextarError as exc:
@@ -148,6 +149,19 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         sys.stderr.write(f"dextar {args.command}: interrupted\n")
         return 130
+
+
+def _terminate_as_interrupt() -> None:
+    """SIGTERM unwinds like Ctrl-C, so staging files are removed on the way out."""
+    import signal
+
+    def handler(signum: int, frame: object) -> None:
+        raise KeyboardInterrupt
+
+    try:
+        signal.signal(signal.SIGTERM, handler)
+    except ValueError:  # not in the main thread (embedded use)
+        pass
 
 
 def _protect_negatives(argv: list[str]) -> list[str]:
@@ -167,8 +181,6 @@ def _protect_negatives(argv: list[str]) -> list[str]:
     return out
 
 
-if __name__ == "__main__":
-    raise SystemExit(main())
 
 
 # ----------------------------------------------------------------------------- stages
@@ -368,3 +380,7 @@ def _register_stages(sub: Any) -> None:
 
 
 _EXTRA_COMMANDS.append(_register_stages)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

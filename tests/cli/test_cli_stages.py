@@ -1,0 +1,121 @@
+import csv
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from dextar.cli import main
+
+PLAN_COLUMNS = ["t", "p", "dp", "ddp", "x", "y", "dx", "dy", "ddx", "ddy", "phi", "psi",
+                "dphi", "dpsi", "ddphi", "ddpsi"]
+
+
+def read_csv(path):
+    with open(path) as fh:
+        rows = list(csv.reader(fh))
+    return rows[0], np.array(rows[1:], dtype=float)
+
+
+def test_plan_default_is_paper(tmp_path, capsys):
+    out = tmp_path / "plan.csv"
+    assert main(["plan", "--out", str(out), "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    head, data = read_csv(out)
+    assert head[:16] == PLAN_COLUMNS
+    assert data.shape == (1001, 16)
+    assert d["law"] == "optimal" and d["cost"] == pytest.approx(d["cost_kinetic"] + d["cost_inertial"])
+    # p from 0 to pi, x = R cos p with R = 120/87
+    np.testing.assert_allclose(data[[0, -1], 1], [0, np.pi], atol=1e-9)
+    np.testing.assert_allclose(data[:, 4], 120 / 87 * np.cos(data[:, 1]), atol=1e-12)
+
+
+@pytest.mark.parametrize("table, law", [
+    ('[law]\ntype = "uniform"\n', "uniform"),
+    ('[law]\ntype = "min-jerk"\nduration = 2.0\n', "min-jerk"),
+    ('[law]\ntype = "trapezoid"\nvmax = 1000.0\namax = 4000.0\n', "trapezoid"),
+    ('[path]\ntype = "line"\nstart = [-50.0, 100.0]\nend = [50.0, 120.0]\n', "optimal"),
+    ('[path]\ntype = "expression"\nx = "40*cos(p)"\ny = "110 + 20*sin(p)"\np0 = 0\np1 = 3\n',
+     "optimal"),
+    ('[path]\ntype = "spline"\nwaypoints = [[40.0, 100.0], [0.0, 120.0], [-40.0, 100.0]]\n',
+     "optimal"),
+])
+def test_plan_configs(tmp_path, capsys, table, law):
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(table)
+    out = tmp_path / "p.csv"
+    assert main(["plan", str(cfg), "--out", str(out), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["law"] == law
+    head, data = read_csv(out)
+    assert np.isfinite(data).all() and head[:16] == PLAN_COLUMNS
+
+
+def test_torques_columns(tmp_path, capsys):
+    out = tmp_path / "t.csv"
+    assert main(["torques", "--out", str(out)]) == 0
+    head, data = read_csv(out)
+    for c in ("tau1", "tau2", "tau1_paper", "tau2_paper", "power1", "power2", "kinetic_energy"):
+        assert c in head
+    cols = dict(zip(head, data.T, strict=True))
+    np.testing.assert_allclose(cols["power1"], cols["tau1"] * cols["dphi"])
+    assert "paper model (42) error" in capsys.readouterr().out
+
+
+def test_simulate_and_export(tmp_path, capsys):
+    out = tmp_path / "sim"
+    assert main(["simulate", "--out", str(out), "--json"]) == 0
+    rep = json.loads(capsys.readouterr().out)
+    assert 0 < rep["max_task_error_mm"] < 5.0
+    assert (out / "tracking.png").read_bytes()[:4] == b"\x89PNG"
+    head, data = read_csv(out / "tracking.csv")
+    assert "task_error_mm" in head and len(data) == 1001
+    xml = tmp_path / "m.xml"
+    assert main(["export", "mjcf", "--out", str(xml)]) == 0
+    text = xml.read_text()
+    assert "<connect" in text and 'joint="phi"' in text and 'joint="psi"' in text
+
+
+def test_export_loads_in_mujoco(tmp_path):
+    mujoco = pytest.importorskip("mujoco")
+    xml = tmp_path / "m.xml"
+    cfg = tmp_path / "c.toml"
+    cfg.write_text("[gravity]\nvector = [0.0, -9810.0]\n[inertia]\nrotor_inertia = 50.0\n"
+                   "[output]\nunits = \"si\"\n")
+    assert main(["export", "mjcf", str(cfg), "--out", str(xml)]) == 0
+    m = mujoco.MjModel.from_xml_path(str(xml))
+    assert m.nu == 2 and m.neq == 1 and m.njnt == 4
+    assert m.opt.gravity[1] == pytest.approx(-9.81)
+
+
+@pytest.mark.parametrize("content, word", [
+    ('[law]\ntype = "fast"\n', "[law].type"),
+    ('[law]\neta = -1.0\n', "[law].eta must be positive"),
+    ('[path]\ntype = "line"\nstart = [0.0, 100.0]\n', "[path].end is required"),
+    ('[path]\nradius = "big"\n', "[path].radius must be a number"),
+    ('[inertia]\ndistal_mass = -0.1\n', "distal rod BP mass"),
+    ('[inertia]\nproximal_mass = [0.1, 0.2, 0.3]\n', "[inertia].proximal_mass"),
+    ('[output]\nunits = "imperial"\n', "[output].units"),
+    ('[output]\nfigures = ["fig99"]\n', "fig99"),
+    ('[path]\nradius = 200.0\n', "leaves the workspace at t = "),
+    ('[gravity]\nvector = 9.81\n', "[gravity].vector"),
+    ('[control]\nnatural_frequency_hz = 0\n', "natural_frequency_hz"),
+])
+def test_bad_configs_named(tmp_path, capsys, content, word):
+    cfg = tmp_path / "bad.toml"
+    cfg.write_text(content)
+    code = main(["torques", str(cfg), "--out", str(tmp_path / "x.csv")])
+    err = capsys.readouterr().err
+    assert code == 2 and word in err and err.count("\n") == 1
+    assert not (tmp_path / "x.csv").exists()
+
+
+def test_missing_config_file(capsys):
+    assert main(["plan", "/nonexistent/c.toml", "--out", "/tmp/x.csv"]) == 2
+    assert "does not exist" in capsys.readouterr().err
+
+
+def test_no_traceback_for_bad_out(tmp_path):
+    r = subprocess.run([sys.executable, "-m", "dextar.cli", "plan", "--out",
+                        str(tmp_path / "x.txt")], capture_output=True, text=True)
+    assert r.returncode == 2 and "Traceback" not in r.stderr and ".csv" in r.stderr
