@@ -209,7 +209,6 @@ def _check_csv_out(out: str) -> Path:
 
 
 def cmd_plan(args: argparse.Namespace) -> int:
-    from .laws import OptimalLaw, law_cost
     from .output.files import write_text
     from .output.tables import csv_text
 
@@ -218,10 +217,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
     law = sc.law()
     tr = sc.trajectory(law)
     write_text(out, csv_text(tr.columns()))
-    if isinstance(law, OptimalLaw):
-        kin, inert = law.kinetic, law.inertial
-    else:
-        kin, inert = law_cost(law, sc.path, sc.inertia.point_mass, sc.law_spec["eta"])
+    kin, inert = law.cost_parts(sc.path, sc.inertia.point_mass, sc.law_spec["eta"])
     e = sc.units.names["energy"]
     payload = {"out": str(out), "samples": int(tr.t.size), "law": law.name,
                "cost": kin + inert, "cost_kinetic": kin, "cost_inertial": inert,

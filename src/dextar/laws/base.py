@@ -44,6 +44,10 @@ class Law(ABC):
             raise ParameterError(f"time t = {v:.6g} outside the law's interval [0, {T:.6g}]")
         return self._evaluate(np.clip(t, 0.0, T))
 
+    def cost_parts(self, path: object, mass: float, eta: float) -> tuple[float, float]:
+        """The functional's kinetic and inertial parts for this law along ``path``."""
+        return law_cost(self, path, mass, eta)
+
     def times(self, samples: int) -> np.ndarray:
         if int(samples) < 2:
             raise ParameterError(f"samples = {samples} must be at least 2")

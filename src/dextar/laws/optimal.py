@@ -134,6 +134,11 @@ class OptimalLaw(Law):
     def cost(self) -> float:
         return self.kinetic + self.inertial
 
+    def cost_parts(self, path: object, mass: float, eta: float) -> tuple[float, float]:
+        if mass == self.mass and eta == self.eta:
+            return self.kinetic, self.inertial
+        return law_cost(self, path, mass, eta)
+
     def _sigma(self, t: np.ndarray, k: int) -> np.ndarray:
         return self.sigma(t / self.duration, k)
 

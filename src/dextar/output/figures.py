@@ -23,17 +23,26 @@ def _labels(an: Analysis) -> dict[str, str]:
             "len": n["length"]}
 
 
-def _angles(tr: Trajectory, title: str, an: Analysis) -> Any:
+def _time_plot(an: Analysis, title: str, ylabel: str,
+               curves: list[tuple[np.ndarray, np.ndarray, str, str]], *,
+               title_size: float = 12) -> Any:
+    """One figure of curves ``(t, y, style, label)`` against time."""
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
-    ax.plot(tr.t, np.degrees(tr.q[:, 0]), label=r"$\varphi(t)$ (motor A)")
-    ax.plot(tr.t, np.degrees(tr.q[:, 1]), label=r"$\psi(t)$ (motor D)")
+    for t, y, style, label in curves:
+        ax.plot(t, y, style, label=label, lw=2.0 if "-" == style[-1:] else 1.5)
     ax.set_xlabel(_labels(an)["t"])
-    ax.set_ylabel("angle [deg]")
-    ax.set_title(title)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize=title_size)
     ax.grid(alpha=0.3)
-    ax.legend()
+    ax.legend(fontsize=8)
     fig.tight_layout()
     return fig
+
+
+def _angles(tr: Trajectory, title: str, an: Analysis) -> Any:
+    return _time_plot(an, title, "angle [deg]", [
+        (tr.t, np.degrees(tr.q[:, 0]), "-", r"$\varphi(t)$ (motor A)"),
+        (tr.t, np.degrees(tr.q[:, 1]), "-", r"$\psi(t)$ (motor D)")])
 
 
 def fig3(an: Analysis, uniform: Trajectory) -> Any:
@@ -48,8 +57,7 @@ def fig4(an: Analysis) -> Any:
     tr, r = an.trajectory, an.scenario.robot
     fig, ax = plt.subplots(figsize=(7.6, 5.0))
     ax.plot(tr.P[:, 0], tr.P[:, 1], "k-", lw=1, label="path")
-    T = an.law.duration
-    times = np.linspace(0, T, 9)
+    times = np.linspace(0, an.law.duration, 9)
     idx = [int(np.argmin(np.abs(tr.t - t))) for t in times]
     colors = plt.cm.viridis(np.linspace(0, 1, len(idx)))
     for i, c in zip(idx, colors, strict=True):
@@ -70,66 +78,37 @@ def fig4(an: Analysis) -> Any:
 
 def fig6(an: Analysis) -> Any:
     p, t = an.paper, an.trajectory.t
-    fig, ax = plt.subplots(figsize=(6.4, 4.2))
-    ax.plot(t, p.T_exact, "k-", lw=2.5, label=r"$T_{exact} = m|\dot P|^2/2$")
-    ax.plot(t, p.T_fd, "c--", lw=1.5, label=r"$T_{comp}$: (30), finite differences")
-    ax.plot(t, p.T_approx, "r-.", lw=1.5, label=r"$T_{approx}$: (32), constant $\beta_0$")
-    ax.set_xlabel(_labels(an)["t"])
-    ax.set_ylabel(_labels(an)["E"])
-    ax.set_title("Fig. 6: kinetic energy of the end-effector")
-    ax.grid(alpha=0.3)
-    ax.legend()
-    fig.tight_layout()
-    return fig
+    return _time_plot(an, "Fig. 6: kinetic energy of the end-effector", _labels(an)["E"], [
+        (t, p.T_exact, "k-", r"$T_{exact} = m|\dot P|^2/2$"),
+        (t, p.T_fd, "c--", r"$T_{comp}$: (30), finite differences"),
+        (t, p.T_approx, "r-.", r"$T_{approx}$: (32), constant $\beta_0$")])
 
 
 def fig7(an: Analysis) -> Any:
-    p, t = an.paper, an.trajectory.t
-    fig, ax = plt.subplots(figsize=(6.4, 4.2))
-    ax.plot(t, p.T_exact + p.T_S, "b-", label=r"$T_P + T_S$ (end-effector + translation of CPB)")
-    ax.plot(t, p.T_r, "r--", label=r"$T_r$ (rotation of CPB)")
-    ax.set_xlabel(_labels(an)["t"])
-    ax.set_ylabel(_labels(an)["E"])
-    f = p.fig7
-    ax.set_title(f"Fig. 7: energies of CPB ($m_L$ = {f['distal_mass']:.3g}, "
-                 f"$J_L$ = {f['JL']:.3g}, $\\lambda$ = {f['lambda']:.2g})", fontsize=10)
-    ax.grid(alpha=0.3)
-    ax.legend()
-    fig.tight_layout()
-    return fig
+    p, t, f = an.paper, an.trajectory.t, an.paper.fig7
+    title = (f"Fig. 7: energies of CPB ($m_L$ = {f['distal_mass']:.3g}, $J_L$ = {f['JL']:.3g}, "
+             f"$\\lambda$ = {f['lambda']:.2g})")
+    return _time_plot(an, title, _labels(an)["E"], [
+        (t, p.T_exact + p.T_S, "b-", r"$T_P + T_S$ (end-effector + translation of CPB)"),
+        (t, p.T_r, "r--", r"$T_r$ (rotation of CPB)")], title_size=10)
 
 
 def fig8(an: Analysis) -> Any:
     tr = an.trajectory
-    fig, ax = plt.subplots(figsize=(6.4, 4.2))
-    ax.plot(tr.t, tr.dq[:, 0], label=r"$\dot\varphi(t)$")
-    ax.plot(tr.t, tr.dq[:, 1], label=r"$\dot\psi(t)$")
-    ax.set_xlabel(_labels(an)["t"])
-    ax.set_ylabel(_labels(an)["w"])
-    ax.set_title("Fig. 8: angular velocities of the rods, optimal law")
-    ax.grid(alpha=0.3)
-    ax.legend()
-    fig.tight_layout()
-    return fig
+    return _time_plot(an, "Fig. 8: angular velocities of the rods, optimal law",
+                      _labels(an)["w"], [(tr.t, tr.dq[:, 0], "-", r"$\dot\varphi(t)$"),
+                                         (tr.t, tr.dq[:, 1], "-", r"$\dot\psi(t)$")])
 
 
 def fig9(an: Analysis) -> Any:
-    tr = an.trajectory
-    fig, ax = plt.subplots(figsize=(6.4, 4.2))
-    ax.plot(tr.t, an.tau[:, 0], "b-", lw=2, label=r"$M_1$ exact")
-    ax.plot(tr.t, an.tau[:, 1], "g-", lw=2, label=r"$M_2$ exact")
+    tr, ine = an.trajectory, an.scenario.inertia
+    curves = [(tr.t, an.tau[:, 0], "b-", r"$M_1$ exact"), (tr.t, an.tau[:, 1], "g-", r"$M_2$ exact")]
     if an.paper is not None:
-        ax.plot(tr.t, an.paper.tau[:, 0], "b--", lw=1.2, label=r"$M_1$ paper (42)")
-        ax.plot(tr.t, an.paper.tau[:, 1], "g--", lw=1.2, label=r"$M_2$ paper (42)")
-    ax.set_xlabel(_labels(an)["t"])
-    ax.set_ylabel(_labels(an)["tau"])
-    ine = an.scenario.inertia
-    ax.set_title(f"Fig. 9: motor torques ($m_L$ = {ine.distal[0].mass:.3g}, "
-                 f"$m_l$ = {ine.proximal[0].mass:.3g})", fontsize=10)
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    return fig
+        curves += [(tr.t, an.paper.tau[:, 0], "b--", r"$M_1$ paper (42)"),
+                   (tr.t, an.paper.tau[:, 1], "g--", r"$M_2$ paper (42)")]
+    title = (f"Fig. 9: motor torques ($m_L$ = {ine.distal[0].mass:.3g}, "
+             f"$m_l$ = {ine.proximal[0].mass:.3g})")
+    return _time_plot(an, title, _labels(an)["tau"], curves, title_size=10)
 
 
 def workspace_figure(an: Analysis) -> Any:

@@ -18,7 +18,7 @@ import numpy as np
 from .. import __version__
 from ..analysis import Analysis, analyze, forward_error, power_balance_residual
 from ..errors import DextarError
-from ..laws import OptimalLaw, law_cost
+from ..laws import OptimalLaw
 from ..scenario import Scenario
 from .outdir import OutputDir
 from .tables import csv_text
@@ -118,12 +118,9 @@ def _summary(an: Analysis, validation: dict[str, Any], timings: dict[str, float]
              ) -> dict[str, Any]:
     sc, law, tr = an.scenario, an.law, an.trajectory
     ine = sc.inertia
-    if isinstance(law, OptimalLaw):
-        kin, inert = law.kinetic, law.inertial
-        solver = {"residual": law.residual, "nodes": law.nodes, "message": law.message}
-    else:
-        kin, inert = law_cost(law, sc.path, ine.point_mass, sc.law_spec["eta"])
-        solver = None
+    kin, inert = law.cost_parts(sc.path, ine.point_mass, sc.law_spec["eta"])
+    solver = ({"residual": law.residual, "nodes": law.nodes, "message": law.message}
+              if isinstance(law, OptimalLaw) else None)
     s: dict[str, Any] = {
         "dextar_version": __version__,
         "config": sc.source,
