@@ -113,6 +113,13 @@ class Scenario:
             return UniformLaw(S, T)
         if kind == "min-jerk":
             return MinimumJerkLaw(S, T)
+        if kind == "time-optimal":
+            from .time_optimal import solve_time_optimal_law
+
+            return solve_time_optimal_law(self.model(), self.path,
+                                          torque_limit=spec["torque_limit"],
+                                          speed_limit=spec.get("speed_limit"), mode=self.mode,
+                                          grid=spec["grid"])
         if kind == "trapezoid":
             if "vmax" not in spec or "amax" not in spec:
                 raise ConfigError("config keys [law].vmax and [law].amax are required for a "
@@ -180,7 +187,7 @@ def scenario_from_dict(doc: dict[str, Any]) -> Scenario:
                               f"{', '.join(FIGURES)}")
     law_t = take(doc.get("law", {}), "law", {
         "type": str, "duration": NUMBER, "eta": NUMBER, "samples": int, "vmax": NUMBER,
-        "amax": NUMBER})
+        "amax": NUMBER, "torque_limit": PAIR, "speed_limit_deg_s": PAIR, "grid": int})
     inert_t = take(doc.get("inertia", {}), "inertia", {
         "effector_mass": NUMBER, "payload": NUMBER, "proximal_mass": PAIR, "distal_mass": PAIR,
         "proximal_com": PAIR, "distal_com": PAIR, "proximal_inertia": PAIR,
@@ -252,9 +259,9 @@ def _path(t: dict[str, Any], units: Units) -> tuple[Path, dict[str, Any]]:
 
 def _law(t: dict[str, Any], units: Units, samples: int) -> dict[str, Any]:
     kind = t.get("type", "optimal")
-    if kind not in ("uniform", "min-jerk", "trapezoid", "optimal"):
-        raise ConfigError(f"config key [law].type must be uniform, min-jerk, trapezoid or "
-                          f"optimal, got {kind!r}")
+    if kind not in ("uniform", "min-jerk", "trapezoid", "optimal", "time-optimal"):
+        raise ConfigError(f"config key [law].type must be uniform, min-jerk, trapezoid, "
+                          f"optimal or time-optimal, got {kind!r}")
     eta_si = float(t.get("eta", 0.1))
     if not eta_si > 0:
         raise ConfigError(f"config key [law].eta must be positive, got {eta_si}")
@@ -270,6 +277,22 @@ def _law(t: dict[str, Any], units: Units, samples: int) -> dict[str, Any]:
             spec[key] = conv(float(t[key]))
     if kind == "trapezoid" and "duration" in t:
         spec["fixed_duration"] = spec["duration"]
+    if kind == "time-optimal":
+        if "torque_limit" not in t:
+            raise ConfigError("config key [law].torque_limit is required for a time-optimal law")
+        limits = _pair(t, "law", "torque_limit", 0.0)
+        if min(limits) <= 0:
+            raise ConfigError("config key [law].torque_limit must be positive")
+        spec["torque_limit"] = tuple(units.torque(v) for v in limits)
+        spec["torque_limit_nm"] = list(limits)
+        if "speed_limit_deg_s" in t:
+            w = _pair(t, "law", "speed_limit_deg_s", 0.0)
+            if min(w) <= 0:
+                raise ConfigError("config key [law].speed_limit_deg_s must be positive")
+            spec["speed_limit"] = tuple(math.radians(v) * units.time_s for v in w)
+        spec["grid"] = int(t.get("grid", 400))
+        if spec["grid"] < 10:
+            raise ConfigError("config key [law].grid must be at least 10")
     return spec
 
 

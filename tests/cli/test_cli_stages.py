@@ -35,6 +35,8 @@ def test_plan_default_is_paper(tmp_path, capsys):
     ('[law]\ntype = "uniform"\n', "uniform"),
     ('[law]\ntype = "min-jerk"\nduration = 2.0\n', "min-jerk"),
     ('[law]\ntype = "trapezoid"\nvmax = 1000.0\namax = 4000.0\n', "trapezoid"),
+    ('[law]\ntype = "time-optimal"\ntorque_limit = 0.15\nspeed_limit_deg_s = 400\n',
+     "time-optimal"),
     ('[path]\ntype = "line"\nstart = [-50.0, 100.0]\nend = [50.0, 120.0]\n', "optimal"),
     ('[path]\ntype = "expression"\nx = "40*cos(p)"\ny = "110 + 20*sin(p)"\np0 = 0\np1 = 3\n',
      "optimal"),
@@ -91,6 +93,7 @@ def test_export_loads_in_mujoco(tmp_path):
 @pytest.mark.parametrize("content, word", [
     ('[law]\ntype = "fast"\n', "[law].type"),
     ('[law]\neta = -1.0\n', "[law].eta must be positive"),
+    ('[law]\ntype = "time-optimal"\n', "[law].torque_limit is required"),
     ('[path]\ntype = "line"\nstart = [0.0, 100.0]\n', "[path].end is required"),
     ('[path]\nradius = "big"\n', "[path].radius must be a number"),
     ('[inertia]\ndistal_mass = -0.1\n', "distal rod BP mass"),

@@ -128,7 +128,9 @@ def _summary(an: Analysis, validation: dict[str, Any], timings: dict[str, float]
         "robot": {"geometry_mm": sc.robot_mm.as_dict(), "geometry": sc.robot.as_dict(),
                   "working_mode": tr.mode, "assembly_mode": tr.assembly},
         "path": {**sc.path_spec, "length": sc.path.length},
-        "law": {k: v for k, v in sc.law_spec.items()},
+        "law": {**sc.law_spec, "name": law.name, "duration": law.duration,
+                **({"max_torque_ratio": law.max_torque_ratio}
+                   if hasattr(law, "max_torque_ratio") else {})},
         "inertia": {
             "effector_mass": ine.effector_mass, "payload": ine.payload,
             "proximal": [vars(r) for r in ine.proximal], "distal": [vars(r) for r in ine.distal],

@@ -1,0 +1,69 @@
+import numpy as np
+import pytest
+
+import dextar as dx
+from dextar.dynamics import Model, inverse_dynamics, paper_inertia
+from dextar.laws import MinimumJerkLaw
+from dextar.paths import Arc, Line
+from dextar.time_optimal import solve_time_optimal_law
+from dextar.trajectory import sample_trajectory
+
+ROBOT = dx.DEXTAR_MM.scaled(1 / 87)
+SEMI = Arc(120 / 87, 0.0, np.pi)
+MODEL = Model(ROBOT, paper_inertia(ROBOT))
+
+
+def peak_torque(model, path, law, n=2001):
+    tr = sample_trajectory(ROBOT, path, law, samples=n)
+    return np.abs(inverse_dynamics(model, tr.q, tr.dq, tr.ddq)).max(axis=0)
+
+
+@pytest.fixture(scope="module")
+def law():
+    return solve_time_optimal_law(MODEL, SEMI, torque_limit=(20.0, 20.0), grid=400)
+
+
+def test_faster_than_any_scaled_min_jerk(law):
+    lo, hi = 0.2, 5.0  # bisection: shortest min-jerk duration within the limits
+    for _ in range(40):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if peak_torque(MODEL, SEMI, MinimumJerkLaw(SEMI.length, mid)).max() \
+            > 20.0 else (lo, mid)
+    assert law.duration < hi
+    assert law.duration < 0.8 * hi  # bang-bang beats the smooth law by a margin
+
+
+def test_limits_respected_up_to_discretisation(law):
+    ratio = peak_torque(MODEL, SEMI, law, n=8001) / 20.0
+    assert ratio.max() <= law.max_torque_ratio + 1e-3
+    assert law.max_torque_ratio < 1.0 + 5.0 / 400
+
+
+def test_a_limit_is_active_everywhere(law):
+    """Time optimality: at (almost) every grid point one motor is at its limit."""
+    tr = sample_trajectory(ROBOT, SEMI, law, times=law.knots_t[1:-1])
+    ratio = np.abs(inverse_dynamics(MODEL, tr.q, tr.dq, tr.ddq)).max(axis=1) / 20.0
+    assert np.median(ratio) > 0.99 and ratio.min() > 0.9
+
+
+def test_rest_to_rest_and_consistent(law):
+    y = law.evaluate(np.array([0.0, law.duration]))
+    assert y[1][0] == 0.0 and y[1][1] == pytest.approx(0.0, abs=1e-9)
+    assert y[0][1] == pytest.approx(SEMI.length, rel=1e-9)
+    t = np.linspace(0, law.duration, 20001)
+    s, ds, _, _ = law.evaluate(t)
+    np.testing.assert_allclose(np.gradient(s, t)[1:-1], ds[1:-1], atol=1e-3 * ds.max())
+
+
+def test_speed_limit():
+    law = solve_time_optimal_law(MODEL, SEMI, torque_limit=(20.0, 20.0), speed_limit=(5.0, 5.0))
+    tr = sample_trajectory(ROBOT, SEMI, law, samples=4001)
+    assert np.abs(tr.dq).max() <= 5.0 * (1 + 1e-4)  # exact at the grid points
+    assert np.abs(tr.dq).max() > 4.99  # and it is used
+
+
+def test_gravity_beyond_limits_is_an_error():
+    heavy = Model(ROBOT, paper_inertia(ROBOT).with_(gravity=(0.0, -100.0)))
+    line = Line((-0.4, 1.2), (0.4, 1.3))
+    with pytest.raises(dx.ParameterError, match="torque limits"):
+        solve_time_optimal_law(heavy, line, torque_limit=(1.0, 1.0))
