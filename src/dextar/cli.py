@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -149,6 +150,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         sys.stderr.write(f"dextar {args.command}: interrupted\n")
         return 130
+    except Exception as exc:  # a bug, not bad input: still one line, no traceback
+        if os.environ.get("DEXTAR_DEBUG"):
+            raise
+        sys.stderr.write(f"dextar {args.command}: internal error: {type(exc).__name__}: {exc} "
+                         "(set DEXTAR_DEBUG=1 for a traceback)\n")
+        return 2
 
 
 def _terminate_as_interrupt() -> None:
