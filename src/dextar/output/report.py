@@ -63,32 +63,35 @@ def render_report(an: Analysis, s: dict[str, Any], pngs: dict[str, bytes]) -> st
     ]
     g = s["robot"]["geometry_mm"]
     law = s["law"]
+    M, L, T = u["mass_unit"], u["length_unit"], u["time_unit"]
+    E, Q = u["energy_unit"], u["torque_unit"]
     rows = [(f"{k} [mm]", v) for k, v in g.items()]
     rows += [("working mode", s["robot"]["working_mode"]),
              ("assembly mode", s["robot"]["assembly_mode"]),
              ("path", {k: v for k, v in s["path"].items()}),
-             ("law", law["type"]), ("duration [s]", law["duration_s"]),
+             ("law", law["type"]), (f"duration [{T}]", law["duration"]),
              ("eta [s^2/kg]", law["eta_s2_per_kg"]), ("samples", s["samples"]),
-             ("end-effector mass", s["inertia"]["effector_mass"]),
-             ("payload", s["inertia"]["payload"]),
-             ("proximal rods (mass, com, inertia)", [list(r.values())
-                                                     for r in s["inertia"]["proximal"]]),
-             ("distal rods (mass, com, inertia)", [list(r.values())
-                                                   for r in s["inertia"]["distal"]]),
-             ("rotor inertia", s["inertia"]["rotor"]), ("gravity", s["inertia"]["gravity"])]
+             (f"end-effector mass [{M}]", s["inertia"]["effector_mass"]),
+             (f"payload [{M}]", s["inertia"]["payload"]),
+             (f"proximal rods AB, DC (mass [{M}], com [{L}], inertia [{M} {L}^2])",
+              [list(r.values()) for r in s["inertia"]["proximal"]]),
+             (f"distal rods BP, CP (mass [{M}], com [{L}], inertia [{M} {L}^2])",
+              [list(r.values()) for r in s["inertia"]["distal"]]),
+             (f"rotor inertia [{M} {L}^2]", s["inertia"]["rotor"]),
+             (f"gravity [{L}/{T}^2]", s["inertia"]["gravity"])]
     parts.append(_table(rows))
     parts.append("<h2>Results</h2>")
     c = s["cost"]
-    rows = [("cost Phi (total)", c["total"]), ("kinetic part", c["kinetic"]),
+    rows = [(f"cost Phi (total) [{E} {T}]", c["total"]), ("kinetic part", c["kinetic"]),
             ("inertial part", c["inertial"]),
-            ("peak |tau| exact (motor A, D)", s["torques"]["exact"]["peak"]),
-            ("RMS tau exact (motor A, D)", s["torques"]["exact"]["rms"]),
-            ("peak |power| (motor A, D)", s["peak_power"])]
+            (f"peak |tau| exact (motor A, D) [{Q}]", s["torques"]["exact"]["peak"]),
+            (f"RMS tau exact (motor A, D) [{Q}]", s["torques"]["exact"]["rms"]),
+            (f"peak |power| (motor A, D) [{E}/{T}]", s["peak_power"])]
     if "optimal_law_solver" in s:
         rows.append(("optimal-law ODE residual", s["optimal_law_solver"]["residual"]))
     if "paper_model" in s:
         pm = s["paper_model"]
-        rows += [("peak |tau| paper (42)", s["torques"]["paper"]["peak"]),
+        rows += [(f"peak |tau| paper (42) [{Q}]", s["torques"]["paper"]["peak"]),
                  ("beta range along the path [deg]", s["beta_range_deg"]),
                  ("beta0 [deg]", pm["beta0_deg"]),
                  ("C1, C2, C3, C4", [pm["C1"], pm["C2"], pm["C3"], pm["C4"]]),
