@@ -127,3 +127,18 @@ def test_killed_run_leaves_no_partial_file(tmp_path, sig):
     if sig == signal.SIGTERM:
         assert proc.returncode != 0 and b"Traceback" not in proc.stderr.read()
         assert not list(tmp_path.glob(".out.staging-*"))
+
+
+def test_run_general_robot_without_paper_model(tmp_path, capsys):
+    cfg = tmp_path / "g.toml"
+    cfg.write_text('[robot]\nl1 = 70.0\nl2 = 75.0\nL1 = 90.0\nL2 = 85.0\nd = 50.0\n'
+                   '[path]\ntype = "line"\nstart = [-40.0, 100.0]\nend = [40.0, 120.0]\n'
+                   '[output]\nunits = "si"\nfigures = ["fig3", "fig9"]\n')
+    out = tmp_path / "o"
+    assert main(["run", str(cfg), "--out", str(out), "--quiet"]) == 0
+    s = json.loads((out / "summary.json").read_text())
+    assert "not symmetric" in s["paper_model"]["not_applicable"]
+    assert "claims" not in s and (out / "fig9.png").exists() and not (out / "fig6.png").exists()
+    head, data = read_csv(out / "trajectory.csv")
+    assert "tau1" in head and "tau1_paper" not in head and np.isfinite(data).all()
+    assert "not applicable" in (out / "report.html").read_text()

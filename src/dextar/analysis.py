@@ -17,6 +17,7 @@ from .dynamics.paper import (
     effector_energy_const_beta,
     effector_energy_fd,
     paper_model,
+    paper_model_limits,
     torque_error,
     triangle_energies,
 )
@@ -78,7 +79,8 @@ def analyze(scenario: Scenario, law: Law | None = None) -> Analysis:
     tau = inverse_dynamics(model, tr.q, tr.dq, tr.ddq, t=tr.t)
     power = tau * tr.dq
     energy = kinetic_energy(model, tr.q, tr.dq)
-    paper = _paper(scenario, law, tr, model, tau) if scenario.robot.is_symmetric else None
+    applies = paper_model_limits(scenario.robot, scenario.inertia) is None
+    paper = _paper(scenario, law, tr, model, tau) if applies else None
     return Analysis(scenario, law, tr, model, tau, power, energy, paper)
 
 

@@ -255,7 +255,10 @@ def cmd_torques(args: argparse.Namespace) -> int:
         text += (f"\npaper model (42) error: max {an.paper.error['max_relative']:.1%}, RMS "
                  f"{an.paper.error['rms_relative']:.1%} of the peak exact torque")
     else:
-        text += "\nno paper-model columns: the paper's model needs a symmetric robot"
+        from .dynamics.paper import paper_model_limits
+
+        why = paper_model_limits(sc.robot, sc.inertia)
+        text += f"\nno paper-model columns: the paper's simplified model does not apply ({why})"
     _emit(args, payload, text)
     return 0
 

@@ -323,7 +323,7 @@ def _inertia(t: dict[str, Any], doc: dict[str, Any], units: Units, g: FiveBar,
             effector_mass=units.mass(effector_kg),
             payload=units.mass(float(t.get("payload", 0.0))),
             rotor=tuple(units.inertia(v) for v in rotor),  # type: ignore[arg-type]
-            viscous=tuple(units.torque(v) * units.time_s for v in visc),  # type: ignore[arg-type]
+            viscous=tuple(units.torque(v) / units.time_s for v in visc),  # type: ignore[arg-type]
             coulomb=tuple(units.torque(v) for v in coul),  # type: ignore[arg-type]
             gravity=tuple(units.acceleration(v) for v in gvec))  # type: ignore[arg-type]
     except DextarError as exc:

@@ -119,6 +119,21 @@ def _require_symmetric(robot: FiveBar) -> None:
                              f"(l1 = l2, L1 = L2); got {robot.as_dict()}")
 
 
+def paper_model_limits(robot: FiveBar, inertia: Inertia) -> str | None:
+    """Why the paper's model does not apply to ``robot`` and ``inertia`` (None if it does)."""
+    if not robot.is_symmetric:
+        return "the robot is not symmetric (l1 = l2, L1 = L2)"
+    r3, r4 = inertia.distal
+    p1, p2 = inertia.proximal
+    if not (math.isclose(r3.mass, r4.mass) and math.isclose(r3.com, r4.com)
+            and math.isclose(p1.about_joint, p2.about_joint)
+            and math.isclose(inertia.rotor[0], inertia.rotor[1])):
+        return "the two legs carry different rods or motors"
+    if inertia.point_mass <= 0:
+        return "there is no mass at P"
+    return None
+
+
 def paper_model(robot: FiveBar, inertia: Inertia, beta0: float, *,
                 lam: float | None = None) -> PaperModel:
     """The paper's model for ``robot`` and ``inertia`` with base angle ``beta0``.
@@ -127,14 +142,10 @@ def paper_model(robot: FiveBar, inertia: Inertia, beta0: float, *,
     fraction (0.5 for uniform rods). Rotor inertias enter as ``Je`` and the proximal rods'
     inertia about their pivots as ``Jl``; gravity and friction are not part of the model.
     """
-    _require_symmetric(robot)
-    r3, r4 = inertia.distal
-    p1, p2 = inertia.proximal
-    if not (math.isclose(r3.mass, r4.mass) and math.isclose(p1.about_joint, p2.about_joint)
-            and math.isclose(inertia.rotor[0], inertia.rotor[1])):
-        raise ParameterError("the paper's model assumes the same rods and motors on both legs")
-    if inertia.point_mass <= 0:
-        raise ParameterError("the paper's model needs a positive mass at P")
+    reason = paper_model_limits(robot, inertia)
+    if reason is not None:
+        raise ParameterError(f"the paper's simplified model does not apply: {reason}")
+    r3, p1 = inertia.distal[0], inertia.proximal[0]
     lam = r3.com / robot.L1 if lam is None else float(lam)
     return PaperModel(l=robot.l1, L=robot.L1, d=robot.d, m=inertia.point_mass, mL=r3.mass,
                       Jl=p1.about_joint, Je=inertia.rotor[0], lam=lam, beta0=float(beta0))

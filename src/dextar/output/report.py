@@ -89,7 +89,7 @@ def render_report(an: Analysis, s: dict[str, Any], pngs: dict[str, bytes]) -> st
             (f"peak |power| (motor A, D) [{E}/{T}]", s["peak_power"])]
     if "optimal_law_solver" in s:
         rows.append(("optimal-law ODE residual", s["optimal_law_solver"]["residual"]))
-    if "paper_model" in s:
+    if "beta0_deg" in s.get("paper_model", {}):
         pm = s["paper_model"]
         rows += [(f"peak |tau| paper (42) [{Q}]", s["torques"]["paper"]["peak"]),
                  ("beta range along the path [deg]", s["beta_range_deg"]),
@@ -97,6 +97,9 @@ def render_report(an: Analysis, s: dict[str, Any], pngs: dict[str, bytes]) -> st
                  ("C1, C2, C3, C4", [pm["C1"], pm["C2"], pm["C3"], pm["C4"]]),
                  ("paper torque error: max / RMS (relative to peak)",
                   [pm["error_vs_exact"]["max_relative"], pm["error_vs_exact"]["rms_relative"]])]
+    if "not_applicable" in s.get("paper_model", {}):
+        rows.append(("paper's simplified model", "not applicable: "
+                     + s["paper_model"]["not_applicable"]))
     parts.append(_table(rows))
     if "claims" in s:
         parts.append("<h2>The paper's claims against the exact model</h2><table><tr><th>claim"

@@ -17,6 +17,7 @@ import numpy as np
 
 from .. import __version__
 from ..analysis import Analysis, analyze, forward_error, power_balance_residual
+from ..dynamics.paper import paper_model_limits
 from ..errors import DextarError
 from ..laws import OptimalLaw
 from ..scenario import Scenario
@@ -157,7 +158,9 @@ def _summary(an: Analysis, validation: dict[str, Any], timings: dict[str, float]
     }
     if solver is None:
         s.pop("optimal_law_solver")
-    if an.paper is not None:
+    if an.paper is None:
+        s["paper_model"] = {"not_applicable": paper_model_limits(sc.robot, sc.inertia)}
+    else:
         p = an.paper
         pm = p.model
         s["torques"]["paper"] = _stats(p.tau)
