@@ -54,3 +54,29 @@ def test_mujoco_gives_back_our_accelerations(law, changes):
     assert rel < 1e-3
     # and the constraint is satisfied by the state we set
     assert np.abs(data.efc_pos).max() < 1e-10 if data.nefc else True
+
+
+def test_mujoco_general_robot_and_rods():
+    """An asymmetric five-bar with non-uniform rods, gravity and rotors, on random motions."""
+    from dextar.dynamics import Inertia, Rod
+    from dextar.geometry import FiveBar
+
+    from .conftest import random_joint_motion
+
+    robot = FiveBar(l1=0.8, l2=0.9, L1=1.1, L2=1.0, d=0.6)
+    ine = Inertia(proximal=(Rod(0.08, 0.3, 0.004), Rod(0.11, 0.5, 0.006)),
+                  distal=(Rod(0.1, 0.6, 0.009), Rod(0.07, 0.35, 0.005)), effector_mass=1.0,
+                  payload=0.3, rotor=(0.01, 0.02), gravity=(0.5, -2.0))
+    model = Model(robot, ine)
+    t = np.linspace(0, 1, 30)
+    q, dq, ddq = random_joint_motion(np.random.default_rng(11), t)
+    tau = inverse_dynamics(model, q, dq, ddq)
+    mm = mujoco.MjModel.from_xml_string(to_mjcf(model))
+    data = mujoco.MjData(mm)
+    qpos, qvel = mujoco_state(model, q, dq)
+    got = np.empty_like(ddq)
+    for i in range(len(t)):
+        data.qpos[:], data.qvel[:], data.ctrl[:] = qpos[i], qvel[i], tau[i]
+        mujoco.mj_forward(mm, data)
+        got[i] = data.qacc[[0, 2]]
+    assert np.abs(got - ddq).max() / np.abs(ddq).max() < 1e-3

@@ -107,7 +107,8 @@ def render_report(an: Analysis, s: dict[str, Any], pngs: dict[str, bytes]) -> st
         for cl in s["claims"]:
             note = f"<br><small>{html.escape(cl['note'])}</small>" if "note" in cl else ""
             parts.append(f"<tr><td>{html.escape(cl['claim'])}{note}</td><td>"
-                         f"{html.escape(cl['measure'])}</td><td>{cl['value']:.3g}</td>"
+                         f"{html.escape(cl['measure'])}<br><small>"
+                         f"{html.escape(cl['criterion'])}</small></td><td>{cl['value']:.3g}</td>"
                          f"<td class='{cl['verdict']}'>{cl['verdict']}</td></tr>")
         parts.append("</table>")
     v = s["validation"]
