@@ -10,7 +10,7 @@ from scipy.integrate import solve_ivp
 from scipy.interpolate import CubicSpline
 
 from ..errors import ConvergenceError, ParameterError, SingularityError
-from .exact import Model, state_dynamics
+from .exact import Model, inverse_dynamics, mass_matrix, state_dynamics
 
 TorqueFunction = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
 
@@ -99,5 +99,6 @@ def forward_dynamics(model: Model, torque: TorqueFunction, q0: object, dq0: obje
         raise ConvergenceError(f"forward dynamics failed at t = {sol.t[-1]:.6g}: {sol.message}")
     q, dq = sol.y[:2].T, sol.y[2:].T
     tau = np.array([torque(ti, qi, dqi) for ti, qi, dqi in zip(sol.t, q, dq, strict=True)])
-    ddq = np.array([rhs(ti, yi)[2:] for ti, yi in zip(sol.t, sol.y.T, strict=True)])
+    h = inverse_dynamics(model, q, dq, np.zeros_like(q), t=sol.t)
+    ddq = np.linalg.solve(mass_matrix(model, q), (tau - h)[..., None])[..., 0]
     return ForwardResult(sol.t, q, dq, ddq, tau, nfev, str(sol.message))
