@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from .dynamics import Model, inverse_dynamics, kinetic_energy
+from .dynamics import Model, Reactions, inverse_dynamics, joint_reactions, kinetic_energy
 from .dynamics.forward import forward_dynamics, torques_from_samples
 from .dynamics.paper import (
     PaperModel,
@@ -57,16 +57,27 @@ class Analysis:
     tau: np.ndarray
     power: np.ndarray
     energy: np.ndarray
+    reactions: Reactions
     paper: PaperComparison | None
 
+    def reaction_magnitudes(self) -> dict[str, np.ndarray]:
+        """Magnitudes of the passive-joint forces: at B and C (proximal on distal rod) and
+        at P (each distal rod on the end-effector)."""
+        r = self.reactions
+        return {"force_B": np.linalg.norm(r.B, axis=-1), "force_C": np.linalg.norm(r.C, axis=-1),
+                "force_P1": np.linalg.norm(r.P1, axis=-1),
+                "force_P2": np.linalg.norm(r.P2, axis=-1)}
+
     def columns(self) -> dict[str, np.ndarray]:
-        """The torques columns: plan columns, exact and paper torques, powers, energy."""
+        """The torques columns: plan columns, exact and paper torques, powers, energy and the
+        passive-joint force magnitudes."""
         cols = dict(self.trajectory.columns())
         cols["tau1"], cols["tau2"] = self.tau[:, 0], self.tau[:, 1]
         if self.paper is not None:
             cols["tau1_paper"], cols["tau2_paper"] = self.paper.tau[:, 0], self.paper.tau[:, 1]
         cols["power1"], cols["power2"] = self.power[:, 0], self.power[:, 1]
         cols["kinetic_energy"] = self.energy
+        cols.update(self.reaction_magnitudes())
         return cols
 
 
@@ -79,9 +90,10 @@ def analyze(scenario: Scenario, law: Law | None = None) -> Analysis:
     tau = inverse_dynamics(model, tr.q, tr.dq, tr.ddq, t=tr.t)
     power = tau * tr.dq
     energy = kinetic_energy(model, tr.q, tr.dq)
+    reactions = joint_reactions(model, tr.q, tr.dq, tr.ddq)
     applies = paper_model_limits(scenario.robot, scenario.inertia) is None
     paper = _paper(scenario, law, tr, model, tau) if applies else None
-    return Analysis(scenario, law, tr, model, tau, power, energy, paper)
+    return Analysis(scenario, law, tr, model, tau, power, energy, reactions, paper)
 
 
 def _paper(sc: Scenario, law: Law, tr: Trajectory, model: Model, tau: np.ndarray

@@ -57,7 +57,8 @@ def test_torques_columns(tmp_path, capsys):
     out = tmp_path / "t.csv"
     assert main(["torques", "--out", str(out)]) == 0
     head, data = read_csv(out)
-    for c in ("tau1", "tau2", "tau1_paper", "tau2_paper", "power1", "power2", "kinetic_energy"):
+    for c in ("tau1", "tau2", "tau1_paper", "tau2_paper", "power1", "power2", "kinetic_energy",
+              "force_B", "force_C", "force_P1", "force_P2"):
         assert c in head
     cols = dict(zip(head, data.T, strict=True))
     np.testing.assert_allclose(cols["power1"], cols["tau1"] * cols["dphi"])

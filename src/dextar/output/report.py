@@ -86,7 +86,8 @@ def render_report(an: Analysis, s: dict[str, Any], pngs: dict[str, bytes]) -> st
             ("inertial part", c["inertial"]),
             (f"peak |tau| exact (motor A, D) [{Q}]", s["torques"]["exact"]["peak"]),
             (f"RMS tau exact (motor A, D) [{Q}]", s["torques"]["exact"]["rms"]),
-            (f"peak |power| (motor A, D) [{E}/{T}]", s["peak_power"])]
+            (f"peak |power| (motor A, D) [{E}/{T}]", s["peak_power"]),
+            (f"peak passive-joint forces [{M} {L}/{T}^2]", s["peak_joint_forces"])]
     if "optimal_law_solver" in s:
         rows.append(("optimal-law ODE residual", s["optimal_law_solver"]["residual"]))
     if "beta0_deg" in s.get("paper_model", {}):

@@ -145,6 +145,7 @@ def _summary(an: Analysis, validation: dict[str, Any], timings: dict[str, float]
         "samples": int(tr.t.size),
         "torques": {"exact": _stats(an.tau)},
         "peak_power": [float(v) for v in np.abs(an.power).max(axis=0)],
+        "peak_joint_forces": {k: float(v.max()) for k, v in an.reaction_magnitudes().items()},
         "validation": validation,
         "assumptions": [
             "rods are uniform unless the config says otherwise (com at mid-length, I = m L^2/12)",
