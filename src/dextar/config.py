@@ -41,7 +41,7 @@ def check_tables(doc: dict[str, Any], known: set[str]) -> None:
             raise ConfigError(f"config key {name!r} must be a table [{name}]")
 
 
-def take(table: dict[str, Any], name: str, spec: dict[str, tuple[type, ...] | type],
+def take(table: dict[str, Any], name: str, spec: dict[str, Any],
          required: tuple[str, ...] = ()) -> dict[str, Any]:
     """Check ``table`` (the TOML table ``[name]``) against ``spec`` (key -> allowed types).
 
@@ -75,7 +75,7 @@ class RobotConfig:
     assembly_mode: str = "up"
 
 
-ROBOT_KEYS: dict[str, tuple[type, ...] | type] = {
+ROBOT_KEYS: dict[str, Any] = {
     "preset": str, "l1": NUMBER, "l2": NUMBER, "L1": NUMBER, "L2": NUMBER, "d": NUMBER,
     "working_mode": str, "assembly_mode": str,
 }

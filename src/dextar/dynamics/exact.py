@@ -332,8 +332,7 @@ def joint_reactions(model: Model, q: object, dq: object, ddq: object) -> Reactio
     return Reactions(B, C, P1, P2)
 
 
-def state_dynamics(model: Model, q: tuple[float, float], dq: tuple[float, float]
-                   ) -> tuple[np.ndarray, np.ndarray]:
+def state_dynamics(model: Model, q: Any, dq: Any) -> tuple[np.ndarray, np.ndarray]:
     """``M(q)`` (2x2) and ``h(q, qdot) = c + g + friction`` (2,) at one state, on plain floats
     (fast enough to call from an ODE integrator)."""
     q1, q2 = float(q[0]), float(q[1])

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._arrays import as_points, blocks, cos_sin, cross, first_index, flat_index, where
+from .._arrays import as_points, blocks, cos_sin, cross, flat_index, where
 from ..errors import AssemblyError, ReachError
 from ..geometry import FiveBar, parse_assembly_mode, parse_working_mode
 
@@ -88,7 +88,7 @@ def inverse_kinematics(
         ):
             ang, rho2, bad = _leg_solve(x + dx, y, l, L, s)
             if bad.any():
-                j = int(first_index(bad))
+                j = int(np.flatnonzero(bad)[0])
                 raise _reach_error(P, shape, blk.start + j, float(rho2[j]), l, L, leg + 1)
             q[blk, leg] = ang
     q = q.reshape(P0.shape)
@@ -148,7 +148,7 @@ def direct_kinematics(robot: FiveBar, q: object, assembly: str | int = "up") -> 
         # rounding may leave w2 a hair below zero on the boundary (rods aligned): allow it
         bad = (w2 < -1e-12 * (L2 * L2) * del2) | (del2 <= 1e-24 * (L1 + L2) ** 2)
         if bad.any():
-            j = int(first_index(bad))
+            j = int(np.flatnonzero(bad)[0])
             i = blk.start + j
             raise AssemblyError(
                 f"distal rods cannot meet for q = ({np.degrees(qf[i, 0]):.6g}, "

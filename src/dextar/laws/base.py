@@ -107,7 +107,7 @@ class TrapezoidalLaw(Law):
     distance: float
     vmax: float
     amax: float
-    duration: float = None  # type: ignore[assignment]
+    duration: float | None = None  # type: ignore[assignment]
     name: str = field(default="trapezoid", init=False)
     cruise: float = field(default=0.0, init=False)
 

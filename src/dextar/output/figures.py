@@ -78,6 +78,7 @@ def fig4(an: Analysis) -> Any:
 
 def fig6(an: Analysis) -> Any:
     p, t = an.paper, an.trajectory.t
+    assert p is not None, "Fig. 6 needs the paper's model"
     return _time_plot(an, "Fig. 6: kinetic energy of the end-effector", _labels(an)["E"], [
         (t, p.T_exact, "k-", r"$T_{exact} = m|\dot P|^2/2$"),
         (t, p.T_fd, "c--", r"$T_{comp}$: (30), finite differences"),
@@ -85,7 +86,9 @@ def fig6(an: Analysis) -> Any:
 
 
 def fig7(an: Analysis) -> Any:
-    p, t, f = an.paper, an.trajectory.t, an.paper.fig7
+    p, t = an.paper, an.trajectory.t
+    assert p is not None, "Fig. 7 needs the paper's model"
+    f = p.fig7
     title = (f"Fig. 7: energies of CPB ($m_L$ = {f['distal_mass']:.3g}, $J_L$ = {f['JL']:.3g}, "
              f"$\\lambda$ = {f['lambda']:.2g})")
     return _time_plot(an, title, _labels(an)["E"], [
@@ -143,8 +146,8 @@ def animation_gif(an: Analysis, frames: int = 41) -> bytes:
                      [r.A[1], B[i, 1], tr.P[i, 1], C[i, 1], r.D[1]])
         label.set_text(f"t = {tr.t[i]:.3f} {an.scenario.units.names['time']}")
         fig.canvas.draw()
-        rgba = np.asarray(fig.canvas.buffer_rgba())
-        images.append(Image.fromarray(rgba[..., :3]).convert("P", palette=Image.ADAPTIVE))
+        rgba = np.asarray(fig.canvas.buffer_rgba())  # type: ignore[attr-defined]
+        images.append(Image.fromarray(rgba[..., :3]).convert("P", palette=Image.Palette.ADAPTIVE))
     plt.close(fig)
     buf = io.BytesIO()
     images[0].save(buf, format="GIF", save_all=True, append_images=images[1:], duration=80,
