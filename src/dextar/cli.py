@@ -79,9 +79,7 @@ def cmd_workspace(args: argparse.Namespace) -> int:
 
     rc = _robot(args.robot)
     mode = args.mode or rc.working_mode
-    out = Path(args.out)
-    if out.suffix.lower() not in (".png", ".svg"):
-        raise ConfigError(f"--out {str(out)!r} must end in .png or .svg")
+    out = _out_file(args.out, ".png", ".svg")
     ws = workspace_map(rc.geometry_mm, mode, resolution=args.resolution)
     save_figure(plot_workspace(ws), out, dpi=150)
     area = ws.reachable_area
@@ -206,10 +204,11 @@ def _units_note(sc: Any) -> str:
     return f"SI units: {n['length']}, {n['mass']}, {n['time']}; torques in N m; angles in rad"
 
 
-def _check_csv_out(out: str) -> Path:
+def _out_file(out: str, *suffixes: str) -> Path:
+    """The ``--out`` file, refused unless it ends in one of ``suffixes``."""
     p = Path(out)
-    if p.suffix.lower() != ".csv":
-        raise ConfigError(f"--out {out!r} must end in .csv")
+    if p.suffix.lower() not in suffixes:
+        raise ConfigError(f"--out {out!r} must end in {' or '.join(suffixes)}")
     if p.is_dir():
         raise ConfigError(f"--out {out!r} is a directory")
     return p
@@ -219,7 +218,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
     from .output.files import write_text
     from .output.tables import csv_text
 
-    out = _check_csv_out(args.out)
+    out = _out_file(args.out, ".csv")
     sc = _scenario(args.config)
     law = sc.law()
     tr = sc.trajectory(law)
@@ -240,7 +239,7 @@ def cmd_torques(args: argparse.Namespace) -> int:
     from .output.files import write_text
     from .output.tables import csv_text
 
-    out = _check_csv_out(args.out)
+    out = _out_file(args.out, ".csv")
     sc = _scenario(args.config)
     an = analyze(sc)
     write_text(out, csv_text(an.columns()))
@@ -324,9 +323,7 @@ def cmd_export(args: argparse.Namespace) -> int:
     from .export.mjcf import write_mjcf
 
     sc = _scenario(args.config)
-    out = Path(args.out)
-    if out.suffix.lower() != ".xml":
-        raise ConfigError(f"--out {args.out!r} must end in .xml")
+    out = _out_file(args.out, ".xml")
     write_mjcf(Model(sc.robot, sc.inertia, sc.assembly), str(out))
     _emit(args, {"out": str(out), "units": sc.units.describe()},
           f"wrote {out} (MuJoCo model in {_units_note(sc)})")
