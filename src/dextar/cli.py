@@ -16,7 +16,7 @@ from typing import Any, NoReturn
 import numpy as np
 
 from . import __version__
-from .config import RobotConfig, check_tables, load_toml, robot_from_table
+from .config import TABLES, RobotConfig, check_tables, load_toml, robot_from_table
 from .errors import ConfigError, DextarError
 
 _MODE_ALIASES = {"pp": "++", "pm": "+-", "mp": "-+", "mm": "--"}
@@ -40,8 +40,7 @@ def _robot(path: str | None) -> RobotConfig:
     if path is None:
         return robot_from_table(None)
     doc = load_toml(path)
-    check_tables(doc, {"robot", "path", "law", "inertia", "gravity", "friction", "control",
-                       "output", "motion"})
+    check_tables(doc, TABLES)
     return robot_from_table(doc.get("robot"))
 
 

@@ -17,6 +17,10 @@ from .geometry import FiveBar, parse_assembly_mode, parse_working_mode, preset
 
 NUMBER = (int, float)
 
+#: Every table a config file may hold (each command reads the ones it needs).
+TABLES = {"robot", "path", "law", "inertia", "friction", "gravity", "control", "paper",
+          "output"}
+
 
 def load_toml(path: str | Path) -> dict[str, Any]:
     """Read a TOML file; a missing file or a syntax error becomes a :class:`ConfigError`."""

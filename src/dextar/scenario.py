@@ -13,12 +13,20 @@ kg mm^2, gravity in mm/s^2). The run itself computes in one of two unit systems:
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 
-from .config import NUMBER, ConfigError, check_tables, load_toml, robot_from_table, take
+from .config import (
+    NUMBER,
+    TABLES,
+    ConfigError,
+    check_tables,
+    load_toml,
+    robot_from_table,
+    take,
+)
 from .dynamics import Inertia, Model, Rod
 from .errors import DextarError
 from .geometry import FiveBar
@@ -26,8 +34,6 @@ from .laws import Law, MinimumJerkLaw, TrapezoidalLaw, UniformLaw, solve_optimal
 from .paths import Arc, ExpressionPath, Line, Path, Spline
 from .trajectory import Trajectory, sample_trajectory
 
-TABLES = {"robot", "path", "law", "inertia", "friction", "gravity", "control", "paper",
-          "output"}
 FIGURES = ("fig3", "fig4", "fig5", "fig6", "fig7", "fig8", "fig9", "workspace", "animation")
 PAIR = (int, float, list)
 
@@ -98,7 +104,6 @@ class Scenario:
     paper: dict[str, Any]
     output: dict[str, Any]
     source: str = "defaults (the paper's example)"
-    raw: dict[str, Any] = field(default_factory=dict, repr=False)
 
     @property
     def effector_mass(self) -> float:
@@ -162,13 +167,7 @@ def load_scenario(path: str | None = None) -> Scenario:
         raise
     except DextarError as exc:
         raise ConfigError(f"config {path or '(defaults)'}: {exc}") from None
-    return sc if path is None else _with_source(sc, str(path))
-
-
-def _with_source(sc: Scenario, source: str) -> Scenario:
-    from dataclasses import replace
-
-    return replace(sc, source=source)
+    return sc if path is None else replace(sc, source=str(path))
 
 
 def scenario_from_dict(doc: dict[str, Any]) -> Scenario:
@@ -217,7 +216,7 @@ def scenario_from_dict(doc: dict[str, Any]) -> Scenario:
     output = {"units": system, "samples": samples, "figures": list(figures),
               "animation_frames": int(out.get("animation_frames", 41))}
     return Scenario(units, g_mm, robot, rc.working_mode, rc.assembly_mode, path, path_spec,
-                    law_spec, inertia, control, paper, output, raw=doc)
+                    law_spec, inertia, control, paper, output)
 
 
 def _path(t: dict[str, Any], units: Units) -> tuple[Path, dict[str, Any]]:

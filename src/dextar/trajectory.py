@@ -147,13 +147,13 @@ def sample_trajectory(robot: FiveBar, path: Path, law: Law, *, mode: str = "+-",
 
 
 def _check_reach(robot: FiveBar, t: np.ndarray, P: np.ndarray) -> None:
-    for leg, (cx, l, L) in enumerate(((0.5 * robot.d, robot.l1, robot.L1),
-                                      (-0.5 * robot.d, robot.l2, robot.L2)), start=1):
-        rho = np.hypot(P[:, 0] - cx, P[:, 1])
-        bad = (rho < abs(l - L)) | (rho > l + L)
+    for leg, pivot in ((1, robot.A), (2, robot.D)):
+        rin, rout = robot.reach(leg)
+        rho = np.hypot(P[:, 0] - pivot[0], P[:, 1])
+        bad = (rho < rin) | (rho > rout)
         if bad.any():
             i = int(np.flatnonzero(bad)[0])
-            out = max(abs(l - L) - rho[i], rho[i] - (l + L))
+            out = max(rin - rho[i], rho[i] - rout)
             raise ReachError(
                 f"the path leaves the workspace at t = {t[i]:.6g} (sample {i}): point "
                 f"({P[i, 0]:.6g}, {P[i, 1]:.6g}) is out of reach of leg {leg} by {out:.6g}")

@@ -79,3 +79,11 @@ def test_real_process_no_traceback():
     r = subprocess.run([sys.executable, "-m", "dextar.cli", "ik", "x"], capture_output=True,
                        text=True)
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
+
+
+def test_every_example_config_serves_the_robot_option(capsys):
+    from pathlib import Path
+
+    for cfg in sorted((Path(__file__).resolve().parents[2] / "examples").glob("*.toml")):
+        code, _, err = run(["ik", "0", "120", "--robot", str(cfg)], capsys)
+        assert code == 0, (cfg.name, err)

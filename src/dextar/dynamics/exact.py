@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from .._arrays import as_points, blocks
+from .._arrays import as_points, blocks, cos_sin
 from ..errors import AssemblyError, ParameterError, SingularityError
 from ..geometry import FiveBar, parse_assembly_mode
 from ..kinematics import DEFAULT_SINGULARITY_TOL
@@ -57,13 +57,7 @@ class Model:
 class _Np:
     """Array operations for the kernel (numpy)."""
 
-    @staticmethod
-    def cos_sin(a: Any) -> tuple[Any, Any]:
-        t = np.tan(0.5 * a)
-        t2 = t * t
-        inv = 1.0 / (1.0 + t2)
-        return (1.0 - t2) * inv, 2.0 * t * inv
-
+    cos_sin = staticmethod(cos_sin)
     sqrt = staticmethod(np.sqrt)
     sign = staticmethod(np.sign)
 

@@ -224,7 +224,7 @@ def _solve_spectral(path: Path, S: float, G: float, tol: float, max_nodes: int):
     method = f"Chebyshev collocation, up to {max_nodes} nodes, direct and by continuation in eta"
     if state is None:
         return None, np.inf, 0, solver.iterations, method
-    coef, resid, N, _ = state
+    coef, resid, N = state
 
     def sigma(tau: np.ndarray, k: int) -> np.ndarray:
         return cheb.chebval(2.0 * tau - 1.0, coef[k])
@@ -352,7 +352,7 @@ class _Collocation:
                 coef = self._coefficients(ops, u, c2, c3)
                 resid, tail = self._residual(G2, coef, N)
                 if resid <= self.tol and tail <= 1e-12:
-                    return coef, resid, N, None
+                    return coef, resid, N
                 guess = (coef,)
             if 2 * N > max_nodes:
                 return None
@@ -384,13 +384,12 @@ class _Collocation:
             except np.linalg.LinAlgError:
                 return None
             norm = np.abs(R[:n]).max() / (1.0 + np.abs(F).max()) + np.abs(R[n:]).max()
-            step = 1.0
             if norm > 10 * scale_prev:  # diverging
                 return None
             scale_prev = min(scale_prev, norm)
-            u = u + step * dz[:n]
-            c2 += step * dz[n]
-            c3 += step * dz[n + 1]
+            u = u + dz[:n]
+            c2 += dz[n]
+            c3 += dz[n + 1]
             if np.abs(dz[:n]).max() <= 1e-14 * (1.0 + np.abs(u).max()) * n:
                 return u, c2, c3
         # accept if the last residual is tiny even without a clean step criterion

@@ -74,7 +74,7 @@ def run(scenario: Scenario, out: str, *, force: bool = False, quiet: bool = Fals
             scenario.law("uniform")))
         validation = stage("validation (power balance, forward re-simulation)",
                            lambda: _validation(an))
-        state["summary"] = summary = _summary(an, validation, prog.timings)
+        state["summary"] = summary = _summary(an, validation)
         stage("trajectory.csv", lambda: od.write_text("trajectory.csv", csv_text(
             _run_columns(an))))
         figs = stage("figures", lambda: _figures(an, uniform, od))
@@ -115,8 +115,7 @@ def _stats(tau: np.ndarray) -> dict[str, list[float]]:
             "rms": [float(v) for v in np.sqrt(np.mean(tau**2, axis=0))]}
 
 
-def _summary(an: Analysis, validation: dict[str, Any], timings: dict[str, float]
-             ) -> dict[str, Any]:
+def _summary(an: Analysis, validation: dict[str, Any]) -> dict[str, Any]:
     sc, law, tr = an.scenario, an.law, an.trajectory
     ine = sc.inertia
     kin, inert = law.cost_parts(sc.path, ine.point_mass, sc.law_spec["eta"])
