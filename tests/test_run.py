@@ -15,10 +15,17 @@ from dextar.cli import main
 from dextar.dynamics import Model, inverse_dynamics, paper_inertia
 from dextar.geometry import DEXTAR_MM
 from dextar.laws import solve_optimal_law
-from dextar.output.run import RUN_COLUMNS
 from dextar.paths import Arc
 
 FIGS = [f"fig{k}" for k in range(3, 10)]
+#: The run's CSV columns in paper units (names carry the unit, see dextar.output.tables).
+RUN_COLUMNS = ["t_T", "p", "dp_per_T", "ddp_per_T2", "x_L", "y_L", "dx_L_T", "dy_L_T",
+               "ddx_L_T2", "ddy_L_T2", "phi_rad", "psi_rad", "dphi_rad_T", "dpsi_rad_T",
+               "ddphi_rad_T2", "ddpsi_rad_T2", "tau1_mL2_T2", "tau2_mL2_T2",
+               "tau1_paper_mL2_T2", "tau2_paper_mL2_T2", "power1_mL2_T3", "power2_mL2_T3",
+               "kinetic_energy_mL2_T2", "force_B_mL_T2", "force_C_mL_T2", "force_P1_mL_T2",
+               "force_P2_mL_T2", "effector_energy_mL2_T2", "effector_energy_fd_mL2_T2",
+               "effector_energy_beta0_mL2_T2"]
 
 
 @pytest.fixture(scope="module")
@@ -52,14 +59,18 @@ def test_every_file_well_formed(run_dir):
     assert (run_dir / "workspace.png").read_bytes()[:4] == b"\x89PNG"
     assert (run_dir / "animation.gif").read_bytes()[:6] in (b"GIF89a", b"GIF87a")
     head, data = read_csv(run_dir / "trajectory.csv")
-    assert head == list(RUN_COLUMNS)
+    assert head == RUN_COLUMNS
     assert data.shape == (1001, len(RUN_COLUMNS)) and np.isfinite(data).all()
     t = data[:, 0]
     assert t[0] == 0.0 and t[-1] == 1.0 and np.allclose(np.diff(t), 1e-3)
     s = json.loads((run_dir / "summary.json").read_text())
     for key in ("units", "robot", "path", "law", "inertia", "cost", "torques", "paper_model",
-                "beta_range_deg", "validation", "claims", "assumptions"):
+                "beta_range_deg", "validation", "claims", "assumptions", "output"):
         assert key in s
+    law = s["law"]
+    assert law["type"] == "optimal" and law["duration"] == 1.0 and law["duration_s"] == 1.0
+    assert law["status"] == 0 and law["success"] and "converged" in law["message"]
+    assert "samples" not in law and s["output"]["samples"] == 1001
     assert s["units"]["system"] == "paper" and s["units"]["length_unit_in_mm"] == 87.0
     assert s["cost"]["total"] == pytest.approx(s["cost"]["kinetic"] + s["cost"]["inertial"])
     assert s["validation"]["power_balance_relative"] < 1e-8
@@ -68,7 +79,8 @@ def test_every_file_well_formed(run_dir):
     p = _Html()
     p.feed((run_dir / "report.html").read_text())
     assert "table" in p.tags
-    assert len(p.imgs) >= 8 and all(src.startswith("data:image/png;base64,") for src in p.imgs)
+    assert len(p.imgs) >= 9 and all(src.startswith("data:image/png;base64,") for src in p.imgs[:-1])
+    assert p.imgs[-1].startswith("data:image/gif;base64,")  # the animation is in the report
     assert not [f for f in run_dir.iterdir() if f.name.startswith(".")]
 
 
@@ -76,14 +88,14 @@ def test_csv_agrees_with_direct_calls(run_dir):
     head, data = read_csv(run_dir / "trajectory.csv")
     c = dict(zip(head, data.T, strict=True))
     robot = DEXTAR_MM.scaled(1 / 87)
-    q = np.stack([c["phi"], c["psi"]], -1)
-    dq = np.stack([c["dphi"], c["dpsi"]], -1)
-    ddq = np.stack([c["ddphi"], c["ddpsi"]], -1)
+    q = np.stack([c["phi_rad"], c["psi_rad"]], -1)
+    dq = np.stack([c["dphi_rad_T"], c["dpsi_rad_T"]], -1)
+    ddq = np.stack([c["ddphi_rad_T2"], c["ddpsi_rad_T2"]], -1)
     tau = inverse_dynamics(Model(robot, paper_inertia(robot)), q, dq, ddq)
-    np.testing.assert_allclose(np.stack([c["tau1"], c["tau2"]], -1), tau, rtol=0,
+    np.testing.assert_allclose(np.stack([c["tau1_mL2_T2"], c["tau2_mL2_T2"]], -1), tau, rtol=0,
                                atol=1e-12 * np.abs(tau).max())
     law = solve_optimal_law(Arc(120 / 87, 0, np.pi), eta=0.1, mass=1.0)
-    s = law.evaluate(c["t"])[0]
+    s = law.evaluate(c["t_T"])[0]
     np.testing.assert_allclose(c["p"], s / (120 / 87), atol=1e-12)
 
 
@@ -140,5 +152,8 @@ def test_run_general_robot_without_paper_model(tmp_path, capsys):
     assert "not symmetric" in s["paper_model"]["not_applicable"]
     assert "claims" not in s and (out / "fig9.png").exists() and not (out / "fig6.png").exists()
     head, data = read_csv(out / "trajectory.csv")
-    assert "tau1" in head and "tau1_paper" not in head and np.isfinite(data).all()
-    assert "not applicable" in (out / "report.html").read_text()
+    assert "tau1_Nm" in head and "x_m" in head and np.isfinite(data).all()
+    assert not [h for h in head if "paper" in h or "effector_energy" in h]
+    report = (out / "report.html").read_text()
+    assert "not applicable" in report and "paper's claims" not in report
+    assert "Five-bar l1 = 70, l2 = 75, L1 = 90, L2 = 85, d = 50 mm" in report

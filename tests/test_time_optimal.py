@@ -65,5 +65,6 @@ def test_speed_limit():
 def test_gravity_beyond_limits_is_an_error():
     heavy = Model(ROBOT, paper_inertia(ROBOT).with_(gravity=(0.0, -100.0)))
     line = Line((-0.4, 1.2), (0.4, 1.3))
-    with pytest.raises(dx.ParameterError, match="torque limits"):
+    with pytest.raises(dx.InfeasibleError, match=r"motor at D needs 93\.1.* to hold the robot "
+                       r"still against gravity at arc length s = 0 .*above its limit 1"):
         solve_time_optimal_law(heavy, line, torque_limit=(1.0, 1.0))

@@ -8,7 +8,7 @@ from dextar.scenario import scenario_from_dict
 
 BASE = {
     "path": {"type": "line", "start": [-60.0, 90.0], "end": [60.0, 115.0]},
-    "law": {"type": "optimal", "duration": 0.4, "eta": 0.003, "samples": 201},
+    "law": {"type": "optimal", "duration": 0.4, "eta": 0.003},
     "inertia": {"effector_mass": 0.05, "payload": 0.02, "proximal_mass": [0.03, 0.035],
                 "distal_mass": 0.02, "distal_com": 40.0, "distal_inertia": 12.0,
                 "rotor_inertia": 5.0},
@@ -18,7 +18,7 @@ BASE = {
 
 
 def run(units):
-    doc = {**BASE, "output": {"units": units}}
+    doc = {**BASE, "output": {"units": units, "samples": 201}}
     sc = scenario_from_dict(doc)
     return sc, analyze(sc)
 

@@ -68,17 +68,10 @@ class Analysis:
                 "force_P1": np.linalg.norm(r.P1, axis=-1),
                 "force_P2": np.linalg.norm(r.P2, axis=-1)}
 
-    def columns(self) -> dict[str, np.ndarray]:
-        """The torques columns: plan columns, exact and paper torques, powers, energy and the
-        passive-joint force magnitudes."""
-        cols = dict(self.trajectory.columns())
-        cols["tau1"], cols["tau2"] = self.tau[:, 0], self.tau[:, 1]
-        if self.paper is not None:
-            cols["tau1_paper"], cols["tau2_paper"] = self.paper.tau[:, 0], self.paper.tau[:, 1]
-        cols["power1"], cols["power2"] = self.power[:, 0], self.power[:, 1]
-        cols["kinetic_energy"] = self.energy
-        cols.update(self.reaction_magnitudes())
-        return cols
+    @property
+    def units(self) -> Any:
+        """The run's unit system."""
+        return self.scenario.units
 
 
 def analyze(scenario: Scenario, law: Law | None = None) -> Analysis:
@@ -106,8 +99,7 @@ def _paper(sc: Scenario, law: Law, tr: Trajectory, model: Model, tau: np.ndarray
     ine = sc.inertia
     if any(ine.gravity) or ine.has_friction:
         # the paper's model is inertial only: compare with the exact inertial torques
-        inertial = Model(sc.robot, ine.with_(gravity=(0.0, 0.0), viscous=(0.0, 0.0),
-                                             coulomb=(0.0, 0.0)), tr.assembly)
+        inertial = Model(sc.robot, ine.frictionless(), tr.assembly)
         tau = inverse_dynamics(inertial, tr.q, tr.dq, tr.ddq, t=tr.t)
     m = sc.inertia.point_mass
     T_exact = 0.5 * m * np.sum(tr.dP**2, axis=-1)
@@ -122,16 +114,30 @@ def _paper(sc: Scenario, law: Law, tr: Trajectory, model: Model, tau: np.ndarray
                            {"distal_mass": mL, "JL": JL, "lambda": lam})
 
 
-def power_balance_residual(an: Analysis, *, interior: int = 201) -> float:
-    """``max |tau . qdot - dT/dt| / max |tau . qdot|`` on ``interior`` times, with ``dT/dt``
-    from an 8th-order central difference of the exact energy along the law (needs no
-    gravity and no friction; returns NaN-free 0-based residual only then)."""
-    sc, law = an.scenario, an.law
+def power_balance_times(law: Law, interior: int = 201) -> tuple[np.ndarray, float]:
+    """Times for the power balance and the finite-difference step ``h``: ``interior`` times
+    (at most), each at least ``5 h`` from the ends and from every breakpoint of the law (where
+    its acceleration jumps and the energy is not smooth)."""
     T = law.duration
-    h = 1e-3 * T
-    t = np.linspace(5 * h, T - 5 * h, interior)
-    model = Model(sc.robot, sc.inertia.with_(gravity=(0.0, 0.0), viscous=(0.0, 0.0),
-                                             coulomb=(0.0, 0.0)), an.trajectory.assembly)
+    cuts = np.concatenate([[0.0], law.breakpoints(), [T]])
+    gap = float(np.diff(cuts).min())
+    h = min(1e-3 * T, 0.05 * gap)
+    if len(cuts) - 1 > interior:  # one time in the middle of each of the longest pieces
+        keep = np.sort(np.argsort(-np.diff(cuts))[:interior])
+        return 0.5 * (cuts[keep] + cuts[keep + 1]), h
+    per = max(1, interior // (len(cuts) - 1))
+    t = [np.linspace(a + 5 * h, b - 5 * h, per) for a, b in zip(cuts[:-1], cuts[1:], strict=True)]
+    return np.concatenate(t), h
+
+
+def power_balance_residual(an: Analysis, *, interior: int = 201) -> float:
+    """``max |tau . qdot - dT/dt| / max |tau . qdot|`` (dimensionless) on up to ``interior``
+    times, with ``dT/dt`` from an 8th-order central difference of the exact energy along the
+    law and the torques of the inertial model (gravity and friction off: they are not part of
+    ``dT/dt``). Times keep clear of the law's breakpoints, where the energy is not smooth."""
+    sc, law = an.scenario, an.law
+    t, h = power_balance_times(law, interior)
+    model = Model(sc.robot, sc.inertia.frictionless(), an.trajectory.assembly)
     rate = np.zeros_like(t)
     for k, c in enumerate(_FD8):
         if c:
@@ -141,6 +147,15 @@ def power_balance_residual(an: Analysis, *, interior: int = 201) -> float:
     tr = sample_trajectory(sc.robot, sc.path, law, mode=sc.mode, times=t)
     power = np.sum(inverse_dynamics(model, tr.q, tr.dq, tr.ddq) * tr.dq, axis=-1)
     return float(np.abs(power - rate).max() / np.abs(power).max())
+
+
+def torque_limit_ratio(an: Analysis) -> float | None:
+    """Largest ``|tau_i| / limit_i`` over the written samples for a law planned under torque
+    limits (None for other laws)."""
+    limit = getattr(an.law, "torque_limit", None)
+    if limit is None:
+        return None
+    return float((np.abs(an.tau) / np.asarray(limit)).max())
 
 
 def forward_error(an: Analysis) -> dict[str, Any]:

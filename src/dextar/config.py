@@ -13,9 +13,13 @@ from pathlib import Path
 from typing import Any
 
 from .errors import ConfigError, DextarError
-from .geometry import FiveBar, parse_assembly_mode, parse_working_mode, preset
+from .geometry import FiveBar, canonical_working_mode, parse_assembly_mode, preset
 
 NUMBER = (int, float)
+
+#: Keys that have one home elsewhere: ``[law].samples`` was a second name for the number of
+#: written samples, which is ``[output].samples``.
+MOVED = {("law", "samples"): "[output].samples (the number of samples written)"}
 
 #: Every table a config file may hold (each command reads the ones it needs).
 TABLES = {"robot", "path", "law", "inertia", "friction", "gravity", "control", "paper",
@@ -52,6 +56,9 @@ def take(table: dict[str, Any], name: str, spec: dict[str, Any],
     Numbers must be finite; ``bool`` is never taken for a number.
     """
     for key, value in table.items():
+        if (name, key) in MOVED:
+            raise ConfigError(f"config key [{name}].{key} is not known: use "
+                              f"{MOVED[name, key]}")
         if key not in spec:
             raise ConfigError(f"config key [{name}].{key} is not known; known keys: "
                               f"{', '.join(spec)}")
@@ -100,8 +107,7 @@ def robot_from_table(table: dict[str, Any] | None) -> RobotConfig:
             geom = FiveBar(**lengths)
         else:
             geom = preset("dextar")
-        wm = t.get("working_mode", "+-")
-        parse_working_mode(wm)
+        wm = canonical_working_mode(t.get("working_mode", "+-"))
         am = t.get("assembly_mode", "up")
         parse_assembly_mode(am)
     except ConfigError:

@@ -34,6 +34,13 @@ class ControlResult:
     task_error : ndarray, shape (n,)
         ``|P_d - P|`` (run length unit).
     saturated : ndarray of bool, shape (n,)
+        Samples where a motor torque was clipped at the limit.
+    torque_limit : float or None
+        The saturation limit (run torque unit).
+    status : int
+        The integrator's status (0: reached the end; a failure raises instead).
+    message : str
+        The integrator's message.
     """
 
     t: np.ndarray
@@ -44,8 +51,17 @@ class ControlResult:
     joint_error: np.ndarray
     task_error: np.ndarray
     saturated: np.ndarray
+    torque_limit: float | None = None
+    status: int = 0
+    message: str = ""
+
+    @property
+    def success(self) -> bool:
+        """True when the integration reached the end of the trajectory."""
+        return self.status == 0
 
     def summary(self) -> dict[str, float]:
+        """Tracking figures: task errors (run length unit), joint error (rad), saturation."""
         return {
             "max_task_error": float(self.task_error.max()),
             "rms_task_error": float(np.sqrt(np.mean(self.task_error**2))),
@@ -119,4 +135,5 @@ def simulate_computed_torque(trajectory: Trajectory, controller: Model, plant: M
                     strict=True)
     P = direct_kinematics(plant.robot, q, plant.assembly)
     return ControlResult(sol.t, q, dq, np.array(taus), P, tr.q - q,
-                         np.linalg.norm(tr.P - P, axis=-1), np.array(sat))
+                         np.linalg.norm(tr.P - P, axis=-1), np.array(sat), torque_limit,
+                         int(sol.status), str(sol.message))

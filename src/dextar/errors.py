@@ -37,3 +37,7 @@ class ConvergenceError(DextarError, RuntimeError):
 
 class ConfigError(DextarError, ValueError):
     """A configuration file or command-line value that is malformed; names the key."""
+
+
+class InfeasibleError(DextarError, ValueError):
+    """No motion exists within the given limits (names the point, the motor and the torque)."""

@@ -112,19 +112,34 @@ def preset(name: str) -> FiveBar:
         raise GeometryError(f"unknown robot preset {name!r}; known: {', '.join(PRESETS)}") from None
 
 
+#: Aliases of the working modes, for shells where ``--`` is awkward (p = plus, m = minus).
+MODE_ALIASES: dict[str, str] = {"pp": "++", "pm": "+-", "mp": "-+", "mm": "--"}
+
+
 def parse_working_mode(mode: str | tuple[int, int]) -> tuple[int, int]:
-    """``"+-"`` -> ``(1, -1)``; a tuple of two signs is checked and returned."""
+    """``"+-"`` (or its alias ``"pm"``) -> ``(1, -1)``; a tuple of two signs is checked.
+
+    The one parser of working modes: the command line and the config files both use it.
+    """
     if isinstance(mode, str):
-        if mode not in WORKING_MODES:
-            raise ParameterError(f"working mode {mode!r} is not one of {', '.join(WORKING_MODES)}")
-        return (1 if mode[0] == "+" else -1, 1 if mode[1] == "+" else -1)
+        name = MODE_ALIASES.get(mode.lower(), mode)
+        if name not in WORKING_MODES:
+            raise ParameterError(f"working mode {mode!r} is not one of {', '.join(WORKING_MODES)} "
+                                 f"(aliases {', '.join(MODE_ALIASES)})")
+        return (1 if name[0] == "+" else -1, 1 if name[1] == "+" else -1)
     s1, s2 = mode
     if s1 not in (1, -1) or s2 not in (1, -1):
         raise ParameterError(f"working mode {mode!r} must be two signs +1/-1")
     return int(s1), int(s2)
 
 
+def canonical_working_mode(mode: str | tuple[int, int]) -> str:
+    """The canonical name (``"+-"``) of a working mode given by name, alias or signs."""
+    return working_mode_name(parse_working_mode(mode))
+
+
 def working_mode_name(signs: tuple[int, int]) -> str:
+    """``(1, -1)`` -> ``"+-"``."""
     return ("+" if signs[0] > 0 else "-") + ("+" if signs[1] > 0 else "-")
 
 
@@ -141,4 +156,5 @@ def parse_assembly_mode(mode: str | int) -> int:
 
 
 def assembly_mode_name(sign: int) -> str:
+    """+1 -> ``"up"``, -1 -> ``"down"``."""
     return "up" if sign > 0 else "down"

@@ -16,8 +16,6 @@ import math
 from dataclasses import dataclass, replace
 from typing import Any
 
-import numpy as np
-
 from .config import (
     NUMBER,
     TABLES,
@@ -28,63 +26,16 @@ from .config import (
     take,
 )
 from .dynamics import Inertia, Model, Rod
+from .dynamics.friction import DEFAULT_COULOMB_SPEED_DEG_S
 from .errors import DextarError
 from .geometry import FiveBar
 from .laws import Law, MinimumJerkLaw, TrapezoidalLaw, UniformLaw, solve_optimal_law
 from .paths import Arc, ExpressionPath, Line, Path, Spline
 from .trajectory import Trajectory, sample_trajectory
+from .units import Units
 
 FIGURES = ("fig3", "fig4", "fig5", "fig6", "fig7", "fig8", "fig9", "workspace", "animation")
 PAIR = (int, float, list)
-
-
-@dataclass(frozen=True)
-class Units:
-    """The run's unit system: how many mm, kg and s one run unit is."""
-
-    system: str
-    length_mm: float
-    mass_kg: float
-    time_s: float
-
-    @property
-    def names(self) -> dict[str, str]:
-        if self.system == "si":
-            return {"length": "m", "mass": "kg", "time": "s", "energy": "J", "torque": "N m",
-                    "angle": "rad"}
-        return {"length": "L", "mass": "m", "time": "T", "energy": "m L^2/T^2",
-                "torque": "m L^2/T^2", "angle": "rad"}
-
-    def describe(self) -> dict[str, Any]:
-        return {"system": self.system, **{f"{k}_unit": v for k, v in self.names.items()},
-                "length_unit_in_mm": self.length_mm, "mass_unit_in_kg": self.mass_kg,
-                "time_unit_in_s": self.time_s}
-
-    # conversions from config units to run units
-    def length(self, mm: float) -> float:
-        return mm / self.length_mm
-
-    def mass(self, kg: float) -> float:
-        return kg / self.mass_kg
-
-    def time(self, s: float) -> float:
-        return s / self.time_s
-
-    def inertia(self, kg_mm2: float) -> float:
-        return kg_mm2 / (self.mass_kg * self.length_mm**2)
-
-    def torque(self, n_m: float) -> float:
-        return n_m * 1e6 / (self.mass_kg * self.length_mm**2 / self.time_s**2)
-
-    def acceleration(self, mm_s2: float) -> float:
-        return mm_s2 / (self.length_mm / self.time_s**2)
-
-    def speed(self, mm_s: float) -> float:
-        return mm_s / (self.length_mm / self.time_s)
-
-    def torque_in_nm(self, run: np.ndarray | float) -> np.ndarray | float:
-        """Run torque units to N m."""
-        return run * (self.mass_kg * self.length_mm**2 / self.time_s**2) / 1e6
 
 
 @dataclass(frozen=True)
@@ -124,7 +75,7 @@ class Scenario:
             return solve_time_optimal_law(self.model(), self.path,
                                           torque_limit=spec["torque_limit"],
                                           speed_limit=spec.get("speed_limit"), mode=self.mode,
-                                          grid=spec["grid"])
+                                          grid=spec["grid"], units=self.units)
         if kind == "trapezoid":
             if "vmax" not in spec or "amax" not in spec:
                 raise ConfigError("config keys [law].vmax and [law].amax are required for a "
@@ -135,7 +86,7 @@ class Scenario:
 
     def trajectory(self, law: Law | None = None, samples: int | None = None) -> Trajectory:
         return sample_trajectory(self.robot, self.path, law or self.law(), mode=self.mode,
-                                 samples=samples or self.law_spec["samples"])
+                                 samples=samples or self.output["samples"])
 
     def model(self, assembly: str | None = None) -> Model:
         return Model(self.robot, self.inertia, assembly or self.assembly)
@@ -185,7 +136,7 @@ def scenario_from_dict(doc: dict[str, Any]) -> Scenario:
             raise ConfigError(f"config key [output].figures: unknown figure {f!r}; known: "
                               f"{', '.join(FIGURES)}")
     law_t = take(doc.get("law", {}), "law", {
-        "type": str, "duration": NUMBER, "eta": NUMBER, "samples": int, "vmax": NUMBER,
+        "type": str, "duration": NUMBER, "eta": NUMBER, "vmax": NUMBER,
         "amax": NUMBER, "torque_limit": PAIR, "speed_limit_deg_s": PAIR, "grid": int})
     inert_t = take(doc.get("inertia", {}), "inertia", {
         "effector_mass": NUMBER, "payload": NUMBER, "proximal_mass": PAIR, "distal_mass": PAIR,
@@ -203,10 +154,10 @@ def scenario_from_dict(doc: dict[str, Any]) -> Scenario:
              else Units("paper", g_mm.L1, effector_kg, duration_s))
     robot = g_mm.scaled(1.0 / units.length_mm)
     path, path_spec = _path(doc.get("path", {}), units)
-    samples = int(out.get("samples", law_t.get("samples", 1001)))
+    samples = int(out.get("samples", 1001))
     if samples < 2:
         raise ConfigError(f"config key [output].samples must be at least 2, got {samples}")
-    law_spec = _law(law_t, units, samples)
+    law_spec = _law(law_t, units)
     inertia = _inertia(inert_t, doc, units, g_mm, effector_kg)
     control = _control(doc.get("control", {}), units, effector_kg)
     paper = take(doc.get("paper", {}), "paper", {
@@ -256,7 +207,7 @@ def _path(t: dict[str, Any], units: Units) -> tuple[Path, dict[str, Any]]:
     return path, spec
 
 
-def _law(t: dict[str, Any], units: Units, samples: int) -> dict[str, Any]:
+def _law(t: dict[str, Any], units: Units) -> dict[str, Any]:
     kind = t.get("type", "optimal")
     if kind not in ("uniform", "min-jerk", "trapezoid", "optimal", "time-optimal"):
         raise ConfigError(f"config key [law].type must be uniform, min-jerk, trapezoid, "
@@ -267,8 +218,7 @@ def _law(t: dict[str, Any], units: Units, samples: int) -> dict[str, Any]:
     spec: dict[str, Any] = {
         "type": kind, "duration": units.time(float(t.get("duration", 1.0))),
         "duration_s": float(t.get("duration", 1.0)),
-        "eta": eta_si * units.mass_kg / units.time_s**2, "eta_s2_per_kg": eta_si,
-        "samples": samples}
+        "eta": eta_si * units.mass_kg / units.time_s**2, "eta_s2_per_kg": eta_si}
     for key, conv in (("vmax", units.speed), ("amax", units.acceleration)):
         if key in t:
             if not t[key] > 0:
@@ -309,7 +259,12 @@ def _inertia(t: dict[str, Any], doc: dict[str, Any], units: Units, g: FiveBar,
             out.append(Rod(units.mass(m), units.length(c), units.inertia(i)))
         return out[0], out[1]
 
-    fr = take(doc.get("friction", {}), "friction", {"viscous": PAIR, "coulomb": PAIR})
+    fr = take(doc.get("friction", {}), "friction", {"viscous": PAIR, "coulomb": PAIR,
+                                                    "coulomb_speed_deg_s": NUMBER})
+    speed = float(fr.get("coulomb_speed_deg_s", DEFAULT_COULOMB_SPEED_DEG_S))
+    if not speed > 0:
+        raise ConfigError(f"config key [friction].coulomb_speed_deg_s must be positive, got "
+                          f"{speed!r}")
     gr = take(doc.get("gravity", {}), "gravity", {"vector": list})
     gvec = _point(gr, "gravity", "vector") if "vector" in gr else (0.0, 0.0)
     rotor = _pair(t, "inertia", "rotor_inertia", 0.0)
@@ -324,7 +279,8 @@ def _inertia(t: dict[str, Any], doc: dict[str, Any], units: Units, g: FiveBar,
             rotor=tuple(units.inertia(v) for v in rotor),  # type: ignore[arg-type]
             viscous=tuple(units.torque(v) / units.time_s for v in visc),  # type: ignore[arg-type]
             coulomb=tuple(units.torque(v) for v in coul),  # type: ignore[arg-type]
-            gravity=tuple(units.acceleration(v) for v in gvec))  # type: ignore[arg-type]
+            gravity=tuple(units.acceleration(v) for v in gvec),  # type: ignore[arg-type]
+            coulomb_speed=math.radians(speed) * units.time_s)
     except DextarError as exc:
         raise ConfigError(f"config table [inertia]: {exc}") from None
 

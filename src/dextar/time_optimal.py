@@ -2,34 +2,52 @@
 
 Along the path (arc length ``s``) the joint motion is ``qdot = q' sdot`` and
 ``qddot = q' sddot + q'' sdot^2``, so with ``x = sdot^2`` and ``u = sddot`` the exact inverse
-dynamics become affine:
+dynamics are affine in ``(x, u)`` up to friction:
 
-    tau(s) = a(s) u + b(s) x + c(s),
-    a = M q',  b = M q'' + c(q, q'),  c = g(q) + coulomb * sign(q'),
+    tau(s) = a(s) u + b(s) x + g(s) + f(s, sdot),
+    a = M q',  b = M q'' + c(q, q'),  g = gravity,  f = friction (viscous + Coulomb).
 
-(velocity-product torques are quadratic in the rates). Torque limits ``|tau_i| <= tau_max_i``
-and speed limits ``|q'_i| sqrt(x) <= w_max_i`` are then linear in ``(x, u)`` at each point of a
-grid in ``s``, and ``x_{k+1} = x_k + 2 ds u_k`` links neighbouring points. The solver follows
-the reachability-analysis method (TOPP-RA, Pham & Pham 2018): a backward pass computes, at each
-grid point, the interval of ``x`` from which rest at the end remains reachable (a
-two-variable linear programme, solved exactly by enumerating vertices), then a forward pass
-takes the largest admissible acceleration from rest at the start. Between grid points the
-acceleration is constant, so the limits hold exactly at the grid points and up to the
-discretisation error in between (reported). Viscous friction is not part of the limits.
+Friction is bounded, not linearised: the regularised Coulomb torque (see
+:mod:`dextar.dynamics.friction`) always lies between 0 and ``coulomb * sign(q')``, and the
+viscous torque ``viscous q' sqrt(x)`` between 0 and its tangent upper bound at the previous
+iterate's speed, so the limits are enforced for every friction value in that interval (both
+ends of the interval are rows of the linear programme). Where a joint reverses along the path
+the interval is ``[-coulomb, coulomb]``; at the two rest points friction is zero.
+
+The solver is reachability analysis (TOPP-RA, Pham & Pham 2018) with the *interpolation*
+discretisation: on each segment ``[s_k, s_{k+1}]`` the acceleration ``u_k`` is constant and
+the limits are imposed at both ends, at ``(x_k, u_k)`` and at ``(x_k + 2 ds u_k, u_k)``, so
+they hold on both sides of every knot, and in between up to the curvature of the dynamics
+(second order in the grid step). A backward pass computes the controllable interval of ``x``
+at each grid point (a two-variable linear programme solved exactly by Fourier-Motzkin
+elimination of ``u``, the static rows precomputed for all points at once), then a forward pass
+takes the largest admissible acceleration from rest.
+
+Output check and margin: the law is then sampled densely (both ends and three interior points
+of every segment) through the exact model with friction; if a torque exceeds its limit by
+more than ``tol`` (default 1e-3) or a speed its limit, the limits are tightened by the excess
+and the problem solved again (a few iterations at most). The law reports ``status`` (0: the
+limits hold within ``tol`` on the check samples; 1: they do not after the iterations, with
+the excess in ``message``) and ``max_torque_ratio``. When no motion within the limits exists
+at all, :class:`~dextar.errors.InfeasibleError` names the point, the motor and the torque.
 """
 
 from __future__ import annotations
 
-import itertools
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from .dynamics import Model, gravity_torques, inverse_dynamics, mass_matrix
-from .errors import ConvergenceError, ParameterError
+from .errors import InfeasibleError, ParameterError
 from .laws import Law, UniformLaw
 from .paths import Path
-from .trajectory import sample_trajectory
+from .trajectory import Trajectory, sample_trajectory
+from .units import Units
+
+#: Greatest number of solves (friction tangent updates and limit margins).
+MAX_SOLVES = 8
 
 
 @dataclass(frozen=True)
@@ -41,7 +59,15 @@ class TimeOptimalLaw(Law):
     knots_t, knots_s, knots_v : ndarray, shape (N + 1,)
         Time, arc length and speed at the grid points; ``accel`` (N,) on each segment.
     torque_limit, speed_limit : tuple
-        The limits used (speed limit ``inf`` when none).
+        The limits of the motors at A and D (speed limit ``inf`` when none).
+    max_torque_ratio, max_speed_ratio : float
+        Largest ``|tau_i| / limit_i`` and ``|qdot_i| / limit_i`` on the check samples.
+    status : int
+        0 when the limits hold within the tolerance on the check samples, 1 otherwise.
+    message : str
+        What the solver did, in words.
+    solves : int
+        Number of reachability solves (margin and friction iterations).
     """
 
     distance: float
@@ -53,7 +79,15 @@ class TimeOptimalLaw(Law):
     torque_limit: tuple[float, float] = (np.inf, np.inf)
     speed_limit: tuple[float, float] = (np.inf, np.inf)
     max_torque_ratio: float = 0.0
+    max_speed_ratio: float = 0.0
+    status: int = 0
+    message: str = ""
+    solves: int = 1
     name: str = field(default="time-optimal", init=False)
+
+    def breakpoints(self) -> np.ndarray:
+        """The grid points, where the acceleration jumps."""
+        return self.knots_t[1:-1]
 
     def _evaluate(self, t: np.ndarray) -> np.ndarray:
         k = np.clip(np.searchsorted(self.knots_t, t, side="right") - 1, 0, self.accel.size - 1)
@@ -64,132 +98,305 @@ class TimeOptimalLaw(Law):
         return np.stack([s, v + u * tau, u, np.zeros_like(t)])
 
 
-def _x_range(G: np.ndarray, h: np.ndarray) -> tuple[float, float] | None:
-    """Range of ``x`` over the polygon ``G @ (x, u) <= h`` (vertex enumeration), or None."""
-    best_lo, best_hi = np.inf, -np.inf
-    scale = np.maximum(np.abs(h), 1.0)
-    for i, j in itertools.combinations(range(len(h)), 2):
-        A = G[[i, j]]
-        det = A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]
-        if abs(det) < 1e-14 * (np.abs(A).max() ** 2 + 1e-300):
-            continue
-        x = (h[i] * A[1, 1] - A[0, 1] * h[j]) / det
-        u = (A[0, 0] * h[j] - h[i] * A[1, 0]) / det
-        if np.all(G @ np.array([x, u]) <= h + 1e-9 * scale):
-            best_lo, best_hi = min(best_lo, x), max(best_hi, x)
-    if best_lo > best_hi:
-        return None
-    return best_lo, best_hi
+@dataclass(frozen=True)
+class _Coefficients:
+    """The path dynamics on the grid: ``tau = a u + b x + g + f``; arrays (N + 1, 2)."""
+
+    s: np.ndarray
+    P: np.ndarray
+    a: np.ndarray
+    b: np.ndarray
+    g: np.ndarray
+    dq_ds: np.ndarray
+    coulomb: np.ndarray  # (2,)
+    viscous: np.ndarray  # (2,)
 
 
 def solve_time_optimal_law(model: Model, path: Path, *, torque_limit: tuple[float, float],
                            speed_limit: tuple[float, float] | None = None, mode: str = "+-",
-                           grid: int = 400) -> TimeOptimalLaw:
+                           grid: int = 400, tol: float = 1e-3,
+                           units: Units | None = None) -> TimeOptimalLaw:
     """The fastest rest-to-rest law along ``path`` within motor torque and speed limits.
 
     Parameters
     ----------
     model : Model
-        Robot and inertia (gravity and Coulomb friction are included in the limits).
+        Robot and inertia; gravity and friction (viscous and Coulomb) are part of the limits.
+    path : Path
+        The path, in the model's length unit.
     torque_limit : (float, float)
-        ``tau_max`` of the motors at A and D (run units).
+        ``tau_max`` of the motors at A and D (run torque unit).
     speed_limit : (float, float), optional
         ``|qdot|`` limits of the motors (rad per run time unit).
+    mode : str
+        Working mode along the path.
     grid : int
         Number of segments in arc length.
+    tol : float
+        Allowed relative excess of a torque or speed over its limit on the check samples.
+    units : Units, optional
+        Only for the words of an error (points in mm, torques in N m).
+
+    Returns
+    -------
+    TimeOptimalLaw
+        With ``status`` and ``message``.
 
     Raises
     ------
-    ParameterError
-        If the limits cannot even hold the robot still somewhere on the path.
+    InfeasibleError
+        No motion within the limits exists: names the point (mm), the arc length, the motor
+        and the torque needed against the limit.
     """
-    tmax = np.array([float(v) for v in torque_limit])
-    if tmax.shape != (2,) or not np.all(tmax > 0):
+    tmax = np.array([float(v) for v in np.broadcast_to(np.asarray(torque_limit, float), (2,))])
+    if not np.all(np.isfinite(tmax) & (tmax > 0)):
         raise ParameterError(f"torque limits {torque_limit!r} must be two positive numbers")
     wmax = np.full(2, np.inf) if speed_limit is None else np.array(
-        [float(v) for v in speed_limit])
-    if wmax.shape != (2,) or not np.all(wmax > 0):
+        [float(v) for v in np.broadcast_to(np.asarray(speed_limit, float), (2,))])
+    if not np.all(wmax > 0):
         raise ParameterError(f"speed limits {speed_limit!r} must be two positive numbers")
     if int(grid) < 10:
         raise ParameterError(f"grid = {grid} must be at least 10")
-    S = path.length
+    if not (0 < tol < 1):
+        raise ParameterError(f"tolerance {tol!r} must be in (0, 1)")
     n = int(grid)
-    # joint path and its derivatives in s: a unit-speed law makes t = s, qdot = q', qddot = q''
+    co, jp = _coefficients(model, path, mode, n)
+    _check_holding(co, tmax, units)
+    ds = path.length / n
+    x0: np.ndarray | None = None  # tangent points of the viscous bound
+    scale_t, scale_w = 1.0, 1.0
+    law: TimeOptimalLaw | None = None
+    has_viscous = bool(np.any(co.viscous > 0))
+    for solve in range(1, MAX_SOLVES + 1):
+        x = _reachability(co, ds, tmax * scale_t, wmax * scale_w, x0, units)
+        law = _law(path.length, co.s, x, tmax, wmax, solve)
+        tr, tr_ratio, sp_ratio = _check(model, path, mode, law, tmax, wmax)
+        law = _with(law, tr_ratio, sp_ratio, 0, "")
+        tangent_moved = has_viscous and (x0 is None or np.abs(np.sqrt(x) - np.sqrt(x0)).max()
+                                         > 1e-6 * np.sqrt(x).max())
+        within = tr_ratio <= 1 + tol and sp_ratio <= 1 + tol
+        if within and not tangent_moved:
+            break
+        bounded = x0 is not None or not has_viscous  # friction bound in place
+        if not within and bounded:  # discretisation excess: tighten by it
+            scale_t *= min(1.0, (1 + 0.25 * tol) / max(tr_ratio, 1e-300))
+            scale_w *= min(1.0, (1 + 0.25 * tol) / max(sp_ratio, 1e-300))
+        if has_viscous:
+            x0 = x
+    assert law is not None
+    ok = law.max_torque_ratio <= 1 + tol and law.max_speed_ratio <= 1 + tol
+    where = f"{n} segments of {ds:.4g}"
+    margin = "" if scale_t == 1.0 and scale_w == 1.0 else (
+        f"; limits tightened by {1 - scale_t:.2%} (torque) and {1 - scale_w:.2%} (speed) so "
+        "that they hold between the grid points")
+    if ok:
+        msg = (f"time-optimal within the limits: torque ratio {law.max_torque_ratio:.5f}, speed "
+               f"ratio {law.max_speed_ratio:.5f} on the check samples ({where}, "
+               f"{law.solves} solve(s)){margin}")
+        return _with(law, law.max_torque_ratio, law.max_speed_ratio, 0, msg)
+    msg = (f"limits exceeded on the check samples after {law.solves} solves: torque ratio "
+           f"{law.max_torque_ratio:.5f}, speed ratio {law.max_speed_ratio:.5f} (tolerance "
+           f"{1 + tol:g}); refine the grid")
+    return _with(law, law.max_torque_ratio, law.max_speed_ratio, 1, msg)
+
+
+def _with(law: TimeOptimalLaw, tr: float, sp: float, status: int, message: str
+          ) -> TimeOptimalLaw:
+    return TimeOptimalLaw(law.distance, law.duration, law.knots_t, law.knots_s, law.knots_v,
+                          law.accel, law.torque_limit, law.speed_limit, tr, sp, status, message,
+                          law.solves)
+
+
+def _coefficients(model: Model, path: Path, mode: str, n: int) -> tuple[_Coefficients,
+                                                                         Trajectory]:
+    """``a, b, g`` on the grid from the joint path ``q(s)`` and its derivatives."""
+    S = path.length
+    # a unit-speed law makes t = s, qdot = q', qddot = q''
     jp = sample_trajectory(model.robot, path, UniformLaw(S, S), mode=mode, samples=n + 1)
-    s, q, q1, q2 = jp.t, jp.q, jp.dq, jp.ddq
-    quiet = Model(model.robot, model.inertia.with_(gravity=(0.0, 0.0), viscous=(0.0, 0.0),
-                                                    coulomb=(0.0, 0.0)), jp.assembly)
-    a = np.einsum("nij,nj->ni", mass_matrix(quiet, q), q1)
-    b = inverse_dynamics(quiet, q, q1, q2)
-    c = gravity_torques(Model(model.robot, model.inertia, jp.assembly), q) + np.array(
-        model.inertia.coulomb) * np.sign(q1)
+    quiet = Model(model.robot, model.inertia.frictionless(), jp.assembly)
+    a = np.einsum("nij,nj->ni", mass_matrix(quiet, jp.q), jp.dq)
+    b = inverse_dynamics(quiet, jp.q, jp.dq, jp.ddq)
+    g = gravity_torques(Model(model.robot, model.inertia, jp.assembly), jp.q)
+    ine = model.inertia
+    return _Coefficients(jp.t, jp.P, a, b, g, jp.dq, np.array(ine.coulomb, float),
+                         np.array(ine.viscous, float)), jp
+
+
+def _describe(co: _Coefficients, k: int, units: Units | None) -> str:
+    if units is None:
+        return f"arc length s = {co.s[k]:.6g} (P = ({co.P[k, 0]:.6g}, {co.P[k, 1]:.6g}))"
+    return (f"P = {units.point_text(co.P[k])} (arc length s = {units.mm(co.s[k]):.6g} mm)")
+
+
+def _torque(units: Units | None, value: float) -> str:
+    return f"{value:.6g}" if units is None else units.torque_text(value)
+
+
+def _check_holding(co: _Coefficients, tmax: np.ndarray, units: Units | None) -> None:
+    """Gravity alone must be within the limits everywhere on the path."""
+    ratio = np.abs(co.g) / tmax
+    if ratio.max() > 1.0:
+        k, i = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
+        motor = "A" if i == 0 else "D"
+        raise InfeasibleError(
+            f"no motion within the limits: the motor at {motor} needs "
+            f"{_torque(units, abs(co.g[k, i]))} to hold the robot still against gravity at "
+            f"{_describe(co, int(k), units)}, above its limit {_torque(units, tmax[i])}")
+
+
+def _friction_bounds(co: _Coefficients, x0: np.ndarray | None
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Friction ``f`` in ``[phi_lo + psi_lo x, phi_hi + psi_hi x]`` at each grid point,
+    arrays (N + 1, 2)."""
+    sg = np.sign(co.dq_ds)
+    steady = (sg == np.roll(sg, 1, axis=0)) & (sg == np.roll(sg, -1, axis=0)) & (sg != 0)
+    steady[[0, -1]] = (sg[[0, -1]] == sg[[1, -2]]) & (sg[[0, -1]] != 0)
+    c = np.broadcast_to(co.coulomb, sg.shape)
+    if x0 is None:
+        phi_v = psi_v = np.zeros_like(sg)
+    else:  # viscous |f| <= w sqrt(x) <= w (x + x0) / (2 sqrt(x0)), tangent at x0
+        r = np.sqrt(np.maximum(x0, 1e-9 * max(float(x0.max()), 1e-300)))[:, None]
+        w = co.viscous * np.abs(co.dq_ds)
+        phi_v, psi_v = 0.5 * w * r, 0.5 * w / r
+    far_phi, far_psi = c + phi_v, psi_v
+    pos = steady & (sg > 0)
+    neg = steady & (sg < 0)
+    both = ~steady
+    phi_hi = np.where(pos | both, far_phi, 0.0)
+    psi_hi = np.where(pos | both, far_psi, 0.0)
+    phi_lo = np.where(neg | both, -far_phi, 0.0)
+    psi_lo = np.where(neg | both, -far_psi, 0.0)
+    for arr in (phi_hi, psi_hi, phi_lo, psi_lo):  # at rest friction is exactly zero
+        arr[[0, -1]] = 0.0
+    return phi_lo, psi_lo, phi_hi, psi_hi
+
+
+def _rows(co: _Coefficients, ds: float, tmax: np.ndarray, wmax: np.ndarray,
+          x0: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Static rows ``Gu u + Gx x <= h`` of every stage, arrays (N, m)."""
+    phi_lo, psi_lo, phi_hi, psi_hi = _friction_bounds(co, x0)
     with np.errstate(divide="ignore"):
-        xmax = np.min(np.where(np.abs(q1) > 0, (wmax / np.abs(q1)) ** 2, np.inf), axis=1)
-    ds = S / n
+        xmax = np.min(np.where(co.dq_ds != 0, (wmax / np.abs(co.dq_ds)) ** 2, np.inf), axis=1)
+    # rows at each point over (u, X), X the squared speed at that point
+    pu = np.concatenate([co.a, -co.a, np.zeros((len(xmax), 2))], axis=1)
+    px = np.concatenate([co.b + psi_hi, -(co.b + psi_lo), np.ones((len(xmax), 1)),
+                         -np.ones((len(xmax), 1))], axis=1)
+    ph = np.concatenate([tmax - co.g - phi_hi, tmax + co.g + phi_lo, xmax[:, None],
+                         np.zeros((len(xmax), 1))], axis=1)
+    # stage k: rows at point k with X = x, rows at point k + 1 with X = x + 2 ds u
+    Gu = np.concatenate([pu[:-1], pu[1:] + 2 * ds * px[1:]], axis=1)
+    Gx = np.concatenate([px[:-1], px[1:]], axis=1)
+    h = np.concatenate([ph[:-1], ph[1:]], axis=1)
+    return Gu, Gx, h
 
-    def constraints(k: int) -> tuple[np.ndarray, np.ndarray]:
-        # rows over (x, u): a u + b x + c <= tmax, -(a u + b x + c) <= tmax, 0 <= x <= xmax
-        G = [[b[k, i], a[k, i]] for i in range(2)] + [[-b[k, i], -a[k, i]] for i in range(2)]
-        h = [tmax[i] - c[k, i] for i in range(2)] + [tmax[i] + c[k, i] for i in range(2)]
-        G += [[-1.0, 0.0]]
-        h += [0.0]
-        if np.isfinite(xmax[k]):
-            G += [[1.0, 0.0]]
-            h += [xmax[k]]
-        return np.array(G), np.array(h)
 
-    # backward pass: controllable intervals K_k
-    K = np.zeros((n + 1, 2))
+def _reachability(co: _Coefficients, ds: float, tmax: np.ndarray, wmax: np.ndarray,
+                  x0: np.ndarray | None, units: Units | None) -> np.ndarray:
+    """Squared speeds ``x`` at the grid points of the fastest admissible motion."""
+    Gu, Gx, h = _rows(co, ds, tmax, wmax, x0)
+    n = Gu.shape[0]
+    tiny = 1e-12 * (np.abs(Gu) + 2 * ds * np.abs(Gx))
+    up, lo_, xonly = Gu > tiny, Gu < -tiny, np.abs(Gu) <= tiny
+    with np.errstate(divide="ignore", invalid="ignore"):
+        alpha = np.where(xonly, 0.0, -Gx / Gu)
+        beta = np.where(xonly, 0.0, h / Gu)
+        # u <= alpha x + beta (uppers), u >= alpha x + beta (lowers); padding never binds
+        au, bu = np.where(up, alpha, 0.0), np.where(up, beta, np.inf)
+        al, bl = np.where(lo_, alpha, 0.0), np.where(lo_, beta, -np.inf)
+        # static x-interval: every lower below every upper, and the x-only rows
+        c = al[:, None, :] - au[:, :, None]
+        d = bu[:, :, None] - bl[:, None, :]
+        hi_pairs = np.where(c > 0, d / c, np.inf)
+        lo_pairs = np.where(c < 0, d / c, -np.inf)
+        x_hi = np.minimum(hi_pairs.min(axis=(1, 2)),
+                          np.where(xonly & (Gx > 0), h / Gx, np.inf).min(axis=1))
+        x_lo = np.maximum(lo_pairs.max(axis=(1, 2)),
+                          np.where(xonly & (Gx < 0), h / Gx, -np.inf).max(axis=1))
+        empty = ((c == 0) & (d < 0)).any(axis=(1, 2)) | (xonly & (Gx == 0) & (h < 0)).any(axis=1)
+    x_lo = np.where(empty, np.inf, np.maximum(x_lo, 0.0))
+    inv2 = 1.0 / (2 * ds)
+    AU, BU, AL, BL = au.tolist(), bu.tolist(), al.tolist(), bl.tolist()
+    XL, XH = x_lo.tolist(), x_hi.tolist()
+    K_lo, K_hi = [0.0] * (n + 1), [0.0] * (n + 1)
     for k in range(n - 1, -1, -1):
-        G, h = constraints(k)
-        lo, hi = K[k + 1]
-        G = np.vstack([G, [[1.0, 2 * ds], [-1.0, -2 * ds]]])
-        h = np.concatenate([h, [hi, -lo]])
-        rng = _x_range(G, h)
-        if rng is None:
-            raise ParameterError(
-                f"the torque limits {tuple(tmax)} cannot bring the robot to rest at the end of "
-                f"the path from s = {s[k]:.6g} (P = ({jp.P[k, 0]:.6g}, {jp.P[k, 1]:.6g})); "
-                "gravity or the required decelerations exceed them")
-        K[k] = max(rng[0], 0.0), rng[1]
-    if K[0, 0] > 1e-12:
-        raise ParameterError("rest at the start of the path is not controllable within the "
-                             f"limits {tuple(tmax)}")
-    # forward pass: greedy largest acceleration that stays controllable
-    x = np.zeros(n + 1)
-    u = np.zeros(n)
+        lo, hi = K_lo[k + 1], K_hi[k + 1]
+        xl, xh = XL[k], XH[k]
+        for a_, b_ in zip(AL[k], BL[k], strict=True):  # lower row vs u <= (hi - x) / (2 ds)
+            cc, dd = a_ + inv2, hi * inv2 - b_
+            if cc > 0:
+                xh = min(xh, dd / cc)
+            elif cc < 0:
+                xl = max(xl, dd / cc)
+            elif dd < 0:
+                xl = math.inf
+        for a_, b_ in zip(AU[k], BU[k], strict=True):  # u >= (lo - x) / (2 ds) vs upper row
+            cc, dd = -inv2 - a_, b_ - lo * inv2
+            if cc > 0:
+                xh = min(xh, dd / cc)
+            elif cc < 0:
+                xl = max(xl, dd / cc)
+            elif dd < 0:
+                xl = math.inf
+        if xl > xh + 1e-12 * (1.0 + abs(xh)):
+            raise _unreachable(co, k, tmax, units)
+        K_lo[k], K_hi[k] = max(0.0, min(xl, xh)), max(0.0, xh)
+    if K_lo[0] > 1e-12 * (1.0 + K_hi[0]):
+        raise _unreachable(co, 0, tmax, units)
+    x = [0.0] * (n + 1)
     for k in range(n):
-        lo_u, hi_u = (K[k + 1, 0] - x[k]) / (2 * ds), (K[k + 1, 1] - x[k]) / (2 * ds)
-        for i in range(2):
-            lim_a = (tmax[i] - b[k, i] * x[k] - c[k, i], -tmax[i] - b[k, i] * x[k] - c[k, i])
-            if abs(a[k, i]) > 1e-14:
-                v1, v2 = lim_a[0] / a[k, i], lim_a[1] / a[k, i]
-                lo_u, hi_u = max(lo_u, min(v1, v2)), min(hi_u, max(v1, v2))
-        if lo_u > hi_u + 1e-9 * (1 + abs(hi_u)):
-            hi_u = lo_u  # numerically empty: stay controllable
-        u[k] = hi_u
-        x[k + 1] = max(x[k] + 2 * ds * u[k], 0.0)
-    x[-1] = 0.0
-    u[-1] = (x[-1] - x[-2]) / (2 * ds)
-    v = np.sqrt(x)
-    dts = 2 * ds / (v[:-1] + v[1:])
-    if not np.all(np.isfinite(dts)):
-        raise ConvergenceError("time-optimal law: the path cannot be traversed (zero speed "
-                               "inside the path)")
+        xk = x[k]
+        u_hi = (K_hi[k + 1] - xk) * inv2
+        u_lo = (K_lo[k + 1] - xk) * inv2
+        for a_, b_ in zip(AU[k], BU[k], strict=True):
+            u_hi = min(u_hi, a_ * xk + b_)
+        for a_, b_ in zip(AL[k], BL[k], strict=True):
+            u_lo = max(u_lo, a_ * xk + b_)
+        if u_lo > u_hi + 1e-9 * (1.0 + abs(u_hi)):
+            raise _unreachable(co, k, tmax, units)
+        x[k + 1] = min(max(xk + 2 * ds * u_hi, K_lo[k + 1]), K_hi[k + 1])
+    x[n] = 0.0
+    return np.array(x)
+
+
+def _unreachable(co: _Coefficients, k: int, tmax: np.ndarray, units: Units | None
+                 ) -> InfeasibleError:
+    need = np.abs(co.g[k]) + co.coulomb
+    i = int(np.argmax(need / tmax))
+    motor = "A" if i == 0 else "D"
+    return InfeasibleError(
+        f"no motion within the limits passes {_describe(co, k, units)}: the motor at {motor} "
+        f"needs up to {_torque(units, need[i])} for gravity and Coulomb friction alone there "
+        f"and the rest of its limit {_torque(units, tmax[i])} cannot brake the robot to rest "
+        "before the end of the path")
+
+
+def _law(S: float, s: np.ndarray, x: np.ndarray, tmax: np.ndarray, wmax: np.ndarray,
+         solves: int) -> TimeOptimalLaw:
+    v = np.sqrt(np.maximum(x, 0.0))
+    den = v[:-1] + v[1:]
+    if np.any(den <= 0):
+        k = int(np.flatnonzero(den <= 0)[0])
+        raise InfeasibleError(f"no motion within the limits: the speed must stay zero at arc "
+                              f"length s = {s[k]:.6g} (the limits leave no acceleration)")
+    dts = 2 * (s[1:] - s[:-1]) / den
     knots_t = np.concatenate([[0.0], np.cumsum(dts)])
-    # constant acceleration on each segment, consistent with the knots
-    accel = (v[1:] - v[:-1]) / dts
-    law = TimeOptimalLaw(distance=S, duration=float(knots_t[-1]), knots_t=knots_t,
-                         knots_s=s, knots_v=v, accel=accel,
-                         torque_limit=(float(tmax[0]), float(tmax[1])),
-                         speed_limit=(float(wmax[0]), float(wmax[1])))
-    # the limits hold at the grid points; measure the discretisation excess in between
-    # (each segment just after its start, at its middle and just before its end: the
-    # acceleration jumps at the knots)
-    frac = np.array([1e-9, 0.25, 0.5, 0.75, 1.0 - 1e-9])
-    times = (knots_t[:-1, None] + dts[:, None] * frac[None, :]).reshape(-1)
-    chk = sample_trajectory(model.robot, path, law, mode=mode, times=times)
-    ratio = np.abs(inverse_dynamics(Model(model.robot, model.inertia.with_(
-        viscous=(0.0, 0.0)), jp.assembly), chk.q, chk.dq, chk.ddq)) / tmax
-    object.__setattr__(law, "max_torque_ratio", float(ratio.max()))
-    return law
+    accel = (v[1:] - v[:-1]) / dts  # constant acceleration on each segment
+    return TimeOptimalLaw(distance=S, duration=float(knots_t[-1]), knots_t=knots_t, knots_s=s,
+                          knots_v=v, accel=accel, torque_limit=(float(tmax[0]), float(tmax[1])),
+                          speed_limit=(float(wmax[0]), float(wmax[1])), solves=solves)
+
+
+#: Where the output check samples each segment (fractions of its duration): both ends
+#: (the acceleration jumps at the knots) and three interior points.
+CHECK_FRACTIONS = np.array([1e-9, 0.25, 0.5, 0.75, 1.0 - 1e-9])
+
+
+def _check(model: Model, path: Path, mode: str, law: TimeOptimalLaw, tmax: np.ndarray,
+           wmax: np.ndarray) -> tuple[Trajectory, float, float]:
+    """Largest torque and speed ratios of the law on the check samples (exact model with
+    gravity and friction)."""
+    dts = np.diff(law.knots_t)
+    times = (law.knots_t[:-1, None] + dts[:, None] * CHECK_FRACTIONS[None, :]).reshape(-1)
+    tr = sample_trajectory(model.robot, path, law, mode=mode, times=times, tol=0.0)
+    tau = inverse_dynamics(Model(model.robot, model.inertia, tr.assembly), tr.q, tr.dq, tr.ddq)
+    return tr, float((np.abs(tau) / tmax).max()), float((np.abs(tr.dq) / wmax).max())

@@ -8,8 +8,9 @@ import pytest
 
 from dextar.cli import main
 
-PLAN_COLUMNS = ["t", "p", "dp", "ddp", "x", "y", "dx", "dy", "ddx", "ddy", "phi", "psi",
-                "dphi", "dpsi", "ddphi", "ddpsi"]
+PLAN_COLUMNS = ["t_T", "p", "dp_per_T", "ddp_per_T2", "x_L", "y_L", "dx_L_T", "dy_L_T",
+                "ddx_L_T2", "ddy_L_T2", "phi_rad", "psi_rad", "dphi_rad_T", "dpsi_rad_T",
+                "ddphi_rad_T2", "ddpsi_rad_T2"]
 
 
 def read_csv(path):
@@ -57,11 +58,13 @@ def test_torques_columns(tmp_path, capsys):
     out = tmp_path / "t.csv"
     assert main(["torques", "--out", str(out)]) == 0
     head, data = read_csv(out)
-    for c in ("tau1", "tau2", "tau1_paper", "tau2_paper", "power1", "power2", "kinetic_energy",
-              "force_B", "force_C", "force_P1", "force_P2"):
+    for c in ("tau1_mL2_T2", "tau2_mL2_T2", "tau1_paper_mL2_T2", "tau2_paper_mL2_T2",
+              "power1_mL2_T3", "power2_mL2_T3", "kinetic_energy_mL2_T2", "force_B_mL_T2",
+              "force_C_mL_T2", "force_P1_mL_T2", "force_P2_mL_T2"):
         assert c in head
+    assert head[:16] == PLAN_COLUMNS  # the same names as plan for the same quantities
     cols = dict(zip(head, data.T, strict=True))
-    np.testing.assert_allclose(cols["power1"], cols["tau1"] * cols["dphi"])
+    np.testing.assert_allclose(cols["power1_mL2_T3"], cols["tau1_mL2_T2"] * cols["dphi_rad_T"])
     assert "paper model (42) error" in capsys.readouterr().out
 
 

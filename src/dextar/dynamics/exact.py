@@ -33,6 +33,7 @@ from .._arrays import as_points, blocks, cos_sin
 from ..errors import AssemblyError, ParameterError, SingularityError
 from ..geometry import FiveBar, parse_assembly_mode
 from ..kinematics import DEFAULT_SINGULARITY_TOL
+from .friction import friction_torque
 from .inertia import Inertia
 
 
@@ -59,7 +60,6 @@ class _Np:
 
     cos_sin = staticmethod(cos_sin)
     sqrt = staticmethod(np.sqrt)
-    sign = staticmethod(np.sign)
 
     @staticmethod
     def clip0(x: Any) -> Any:
@@ -74,10 +74,6 @@ class _Py:
         return math.cos(a), math.sin(a)
 
     sqrt = staticmethod(math.sqrt)
-
-    @staticmethod
-    def sign(x: float) -> float:
-        return (x > 0) - (x < 0)
 
     @staticmethod
     def clip0(x: float) -> float:
@@ -156,8 +152,8 @@ def _kernel(model: Model, q1: Any, q2: Any, w1: Any, w2: Any, a1: Any, a2: Any, 
     tau2 = (l2 * (c2 * FCy - s2 * FCx) + b2 * (ux * FPy - uy * FPx) * idet + J2 * a2
             - rod2.mass * rod2.com * (c2 * gy - s2 * gx))
     if friction:
-        tau1 = tau1 + ine.viscous[0] * w1 + ine.coulomb[0] * xp.sign(w1)
-        tau2 = tau2 + ine.viscous[1] * w2 + ine.coulomb[1] * xp.sign(w2)
+        tau1 = tau1 + friction_torque(w1, ine.viscous[0], ine.coulomb[0], ine.coulomb_speed)
+        tau2 = tau2 + friction_torque(w2, ine.viscous[1], ine.coulomb[1], ine.coulomb_speed)
     out = {"tau1": tau1, "tau2": tau2, "det": det, "wsq": wsq, "del2": del2}
     if extra:
         out.update(locals())

@@ -27,7 +27,10 @@ class ForwardResult:
         The torques applied.
     nfev : int
         Right-hand-side evaluations.
+    status : int
+        The integrator's status (0: reached the end; a failure raises instead).
     message : str
+        The integrator's message.
     """
 
     t: np.ndarray
@@ -37,6 +40,12 @@ class ForwardResult:
     tau: np.ndarray
     nfev: int
     message: str
+    status: int = 0
+
+    @property
+    def success(self) -> bool:
+        """True when the integration reached the last time."""
+        return self.status == 0
 
 
 def torques_from_samples(t: np.ndarray, tau: np.ndarray) -> TorqueFunction:
@@ -101,4 +110,4 @@ def forward_dynamics(model: Model, torque: TorqueFunction, q0: object, dq0: obje
     tau = np.array([torque(ti, qi, dqi) for ti, qi, dqi in zip(sol.t, q, dq, strict=True)])
     h = inverse_dynamics(model, q, dq, np.zeros_like(q), t=sol.t)
     ddq = np.linalg.solve(mass_matrix(model, q), (tau - h)[..., None])[..., 0]
-    return ForwardResult(sol.t, q, dq, ddq, tau, nfev, str(sol.message))
+    return ForwardResult(sol.t, q, dq, ddq, tau, nfev, str(sol.message), int(sol.status))

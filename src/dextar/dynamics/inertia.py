@@ -11,8 +11,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, replace
 
+import numpy as np
+
 from ..errors import ParameterError
 from ..geometry import FiveBar
+from .friction import friction_torque
 
 
 def _check(name: str, value: float, *, positive: bool = False) -> float:
@@ -72,7 +75,10 @@ class Inertia:
     rotor : (float, float)
         Rotor inertia of the motors at A and D (as seen at the joint).
     viscous, coulomb : (float, float)
-        Motor friction: ``tau_f = viscous * qdot + coulomb * sign(qdot)``.
+        Motor friction, ``tau_f = viscous * qdot + coulomb * tanh(qdot / coulomb_speed)``
+        (see :mod:`dextar.dynamics.friction`).
+    coulomb_speed : float
+        Regularisation speed of the Coulomb friction (rad per time unit, > 0).
     gravity : (float, float)
         In-plane gravity vector (zero when the robot lies horizontally).
     """
@@ -85,6 +91,7 @@ class Inertia:
     viscous: tuple[float, float] = (0.0, 0.0)
     coulomb: tuple[float, float] = (0.0, 0.0)
     gravity: tuple[float, float] = field(default=(0.0, 0.0))
+    coulomb_speed: float = 1e-3
 
     def __post_init__(self) -> None:
         names = (("proximal rod AB", "proximal rod DC"), ("distal rod BP", "distal rod CP"))
@@ -106,6 +113,8 @@ class Inertia:
         if len(g) != 2 or not all(math.isfinite(v) for v in g):
             raise ParameterError(f"gravity {self.gravity!r} must be a finite 2-vector")
         object.__setattr__(self, "gravity", g)
+        object.__setattr__(self, "coulomb_speed", _check("Coulomb regularisation speed",
+                                                         self.coulomb_speed, positive=True))
 
     @property
     def point_mass(self) -> float:
@@ -126,7 +135,18 @@ class Inertia:
             effector_mass=effector_mass, **kwargs)  # type: ignore[arg-type]
 
     def with_(self, **changes: object) -> Inertia:
+        """A copy with some fields changed."""
         return replace(self, **changes)  # type: ignore[arg-type]
+
+    def frictionless(self) -> Inertia:
+        """The same inertia without gravity or friction (the inertial part of the dynamics)."""
+        return replace(self, gravity=(0.0, 0.0), viscous=(0.0, 0.0), coulomb=(0.0, 0.0))
+
+    def friction_torques(self, dq: object) -> np.ndarray:
+        """Friction torques of both motors at joint rates ``dq`` (..., 2), same shape."""
+        dq = np.asarray(dq, dtype=float)
+        return np.stack([friction_torque(dq[..., k], self.viscous[k], self.coulomb[k],
+                                         self.coulomb_speed) for k in range(2)], axis=-1)
 
     def scaled_masses(self, factor: float) -> Inertia:
         """Every mass and inertia (rods, effector, payload, rotors) times ``factor``."""

@@ -5,7 +5,16 @@ the loop is closed by an equality ``connect`` between sites at the two distal ti
 mass at P (end-effector plus payload) is lumped into the distal rod BP at its tip (a point mass
 has no rotary inertia, so riding on either rod is the same). Motors at A and D drive the joints
 ``phi`` and ``psi`` with unit gear; rotor inertia becomes joint ``armature``, viscous friction
-joint ``damping``. Units are those of the robot and inertia given (the run's units).
+joint ``damping`` and Coulomb friction joint ``frictionloss`` (MuJoCo's dry friction, a stiff
+soft constraint: its regularisation differs from dextar's ``tanh`` only below the
+regularisation speed). Units are those of the robot and inertia given (the run's units).
+
+With a start state the model holds a keyframe ``start``: the motion's first sample with the
+loop closed and the motion's velocities. Load it with::
+
+    m = mujoco.MjModel.from_xml_path("dextar.xml")
+    d = mujoco.MjData(m)
+    mujoco.mj_resetDataKeyframe(m, d, m.key("start").id)
 
 Joint order in ``qpos``: ``phi, theta1, psi, theta2``, where ``theta1`` and ``theta2`` are the
 distal rods' angles relative to their proximal rods.
@@ -22,6 +31,8 @@ from ..output.files import write_text
 #: Constraint softness: as stiff as MuJoCo allows (impedance 0.9999).
 SOLREF = "0.0005 1"
 SOLIMP = "0.9999 0.9999 0.001 0.5 2"
+#: Softness of the joints' dry friction (``frictionloss``): stiff, like the closure.
+SOLREF_FRICTION = "0.0005 1"
 
 
 def _fmt(*values: float) -> str:
@@ -37,9 +48,11 @@ def _inertial(mass: float, com: float, izz: float) -> str:
             f'diaginertia="{_fmt(1e-3 * i, i, i)}"/>')
 
 
-def to_mjcf(model: Model, *, name: str = "dextar") -> str:
-    """The MJCF text of ``model`` (geometry, inertia, gravity, rotor inertia, viscous
-    friction)."""
+def to_mjcf(model: Model, *, name: str = "dextar",
+            start: tuple[np.ndarray, np.ndarray] | None = None) -> str:
+    """The MJCF text of ``model``: geometry, inertia, gravity, rotor inertia, viscous and
+    Coulomb friction, and, given ``start = (q0, dq0)`` (each (2,)), a keyframe ``start`` with
+    the loop closed at that state."""
     r, ine = model.robot, model.inertia
     p1, p2 = ine.proximal
     d1, d2 = ine.distal
@@ -56,7 +69,7 @@ def to_mjcf(model: Model, *, name: str = "dextar") -> str:
             (r.D, p2, r.l2, r.L2, d2.mass, d2.com, d2.inertia)), start=1):
         joint = "phi" if k == 1 else "psi"
         leg.append(f"""    <body name="proximal{k}" pos="{_fmt(pivot[0], pivot[1], 0)}">
-      <joint name="{joint}" type="hinge" axis="0 0 1" armature="{ine.rotor[k - 1]:.17g}" damping="{ine.viscous[k - 1]:.17g}"/>
+      <joint name="{joint}" type="hinge" axis="0 0 1" armature="{ine.rotor[k - 1]:.17g}" damping="{ine.viscous[k - 1]:.17g}" frictionloss="{ine.coulomb[k - 1]:.17g}" solreffriction="{SOLREF_FRICTION}"/>
       {_inertial(prox.mass, prox.com, prox.inertia)}
       <geom type="capsule" fromto="0 0 0 {l:.17g} 0 0" size="{rad:.6g}" mass="0" contype="0" conaffinity="0"/>
       <body name="distal{k}" pos="{l:.17g} 0 0">
@@ -67,6 +80,12 @@ def to_mjcf(model: Model, *, name: str = "dextar") -> str:
       </body>
     </body>""")
     legs = "\n".join(leg)
+    key = ""
+    if start is not None:
+        qpos, qvel = mujoco_state(model, np.asarray(start[0], float)[None],
+                                  np.asarray(start[1], float)[None])
+        key = (f'  <keyframe>\n    <key name="start" qpos="{_fmt(*qpos[0])}" '
+               f'qvel="{_fmt(*qvel[0])}"/>\n  </keyframe>\n')
     return f"""<mujoco model="{name}">
   <!-- five-bar exported by dextar; units are the run's units -->
   <compiler angle="radian"/>
@@ -83,13 +102,14 @@ def to_mjcf(model: Model, *, name: str = "dextar") -> str:
     <motor name="motor_A" joint="phi" gear="1"/>
     <motor name="motor_D" joint="psi" gear="1"/>
   </actuator>
-</mujoco>
+{key}</mujoco>
 """
 
 
-def write_mjcf(model: Model, path: str) -> None:
+def write_mjcf(model: Model, path: str, *,
+               start: tuple[np.ndarray, np.ndarray] | None = None) -> None:
     """Write :func:`to_mjcf` atomically to ``path``."""
-    write_text(path, to_mjcf(model))
+    write_text(path, to_mjcf(model, start=start))
 
 
 def mujoco_state(model: Model, q: np.ndarray, dq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

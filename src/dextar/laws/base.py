@@ -29,6 +29,19 @@ class Law(ABC):
     distance: float
     duration: float
     name: str = "law"
+    #: Solver outcome, as in ``scipy.optimize.OptimizeResult``: 0 is success. Closed-form
+    #: laws always succeed; solved laws (optimal, time-optimal) set their own.
+    status: int = 0
+    message: str = "closed form"
+
+    @property
+    def success(self) -> bool:
+        """True when the law was found as asked (``status == 0``)."""
+        return self.status == 0
+
+    def breakpoints(self) -> np.ndarray:
+        """Times inside ``(0, duration)`` where the acceleration jumps (none by default)."""
+        return np.empty(0)
 
     @abstractmethod
     def _evaluate(self, t: np.ndarray) -> np.ndarray:
@@ -132,6 +145,11 @@ class TrapezoidalLaw(Law):
                                      f"above vmax {vmax:.6g}")
         object.__setattr__(self, "duration", T)
         object.__setattr__(self, "cruise", v)
+
+    def breakpoints(self) -> np.ndarray:
+        """The ends of the acceleration and deceleration phases."""
+        ta = self.cruise / self.amax
+        return np.unique([ta, self.duration - ta])
 
     def _evaluate(self, t: np.ndarray) -> np.ndarray:
         a, v, T = self.amax, self.cruise, self.duration

@@ -128,6 +128,7 @@ class OptimalLaw(Law):
     nodes: int = 0
     iterations: int = 0
     message: str = ""
+    status: int = 0
     name: str = field(default="optimal", init=False)
 
     @property

@@ -50,7 +50,7 @@ def fig3(an: Analysis, uniform: Trajectory) -> Any:
 
 
 def fig5(an: Analysis) -> Any:
-    return _angles(an.trajectory, "Fig. 5: leading angles, optimal law", an)
+    return _angles(an.trajectory, f"Fig. 5: leading angles, {an.law.name} law", an)
 
 
 def fig4(an: Analysis) -> Any:
@@ -70,7 +70,7 @@ def fig4(an: Analysis) -> Any:
     u = _labels(an)["len"]
     ax.set_xlabel(f"x [{u}]")
     ax.set_ylabel(f"y [{u}]")
-    ax.set_title("Fig. 4: robot every T/8, optimal law")
+    ax.set_title(f"Fig. 4: robot every eighth of the motion, {an.law.name} law")
     ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5))
     fig.tight_layout()
     return fig
@@ -98,7 +98,7 @@ def fig7(an: Analysis) -> Any:
 
 def fig8(an: Analysis) -> Any:
     tr = an.trajectory
-    return _time_plot(an, "Fig. 8: angular velocities of the rods, optimal law",
+    return _time_plot(an, f"Fig. 8: angular velocities of the rods, {an.law.name} law",
                       _labels(an)["w"], [(tr.t, tr.dq[:, 0], "-", r"$\dot\varphi(t)$"),
                                          (tr.t, tr.dq[:, 1], "-", r"$\dot\psi(t)$")])
 
@@ -138,7 +138,7 @@ def animation_gif(an: Analysis, frames: int = 41) -> bytes:
     ax.set_xlim(pts[:, 0].min() - pad, pts[:, 0].max() + pad)
     ax.set_ylim(pts[:, 1].min() - pad, pts[:, 1].max() + pad)
     ax.set_aspect("equal")
-    ax.set_title("DexTAR following the path (optimal law)", fontsize=9)
+    ax.set_title(f"The robot following the path ({an.law.name} law)", fontsize=9)
     fig.tight_layout()
     images = []
     for i in np.linspace(0, len(tr.t) - 1, frames).round().astype(int):
@@ -165,3 +165,34 @@ def svg_bytes(fig: Any) -> bytes:
     buf = io.BytesIO()
     fig.savefig(buf, format="svg")
     return buf.getvalue()
+
+
+def tracking_figure(res: Any, units: Any, mass_error: float, payload_kg: float) -> Any:
+    """Computed-torque tracking: task and joint errors, and the applied torques against the
+    saturation limit (dashed) with the saturated samples marked."""
+    fig, axes = plt.subplots(3, 1, figsize=(6.4, 8), sharex=True)
+    mm = units.length_mm
+    axes[0].plot(res.t, res.task_error * mm)
+    axes[0].set_ylabel("task-space error [mm]")
+    axes[1].plot(res.t, np.degrees(res.joint_error))
+    axes[1].set_ylabel("joint error [deg]")
+    axes[1].legend([r"$\varphi$", r"$\psi$"], fontsize=8)
+    axes[2].plot(res.t, res.tau[:, 0], label="motor A")
+    axes[2].plot(res.t, res.tau[:, 1], label="motor D")
+    if res.torque_limit is not None:
+        for sign in (1, -1):
+            axes[2].axhline(sign * res.torque_limit, color="k", ls="--", lw=1,
+                            label="torque limit" if sign > 0 else None)
+        if res.saturated.any():
+            sat = res.saturated
+            axes[2].plot(res.t[sat], np.abs(res.tau[sat]).max(axis=1)
+                         * np.sign(res.tau[sat][np.arange(sat.sum()),
+                                                np.abs(res.tau[sat]).argmax(axis=1)]),
+                         "r.", ms=3, label=f"saturated ({res.saturated.mean():.1%})")
+    axes[2].set_ylabel(f"torque [{units.names['torque']}]")
+    axes[2].legend(fontsize=8)
+    axes[2].set_xlabel(f"time [{units.names['time']}]")
+    axes[0].set_title(f"Computed-torque tracking: masses {mass_error:+.0%}, unmodelled "
+                      f"payload {payload_kg:g} kg", fontsize=10)
+    fig.tight_layout()
+    return fig

@@ -16,16 +16,20 @@ from typing import Any
 import numpy as np
 
 from .. import __version__
-from ..analysis import Analysis, analyze, forward_error, power_balance_residual
+from ..analysis import (
+    Analysis,
+    analyze,
+    forward_error,
+    power_balance_residual,
+    torque_limit_ratio,
+)
 from ..dynamics.paper import paper_model_limits
 from ..errors import DextarError
-from ..laws import OptimalLaw
+from ..geometry import DEXTAR_MM
+from ..laws import Law, OptimalLaw, TrapezoidalLaw
 from ..scenario import Scenario
 from .outdir import OutputDir
-from .tables import csv_text
-
-RUN_COLUMNS = ("t", "p", "dp", "ddp", "x", "y", "phi", "psi", "dphi", "dpsi", "ddphi", "ddpsi",
-               "tau1", "tau2", "tau1_paper", "tau2_paper", "T_exact", "T_fd", "T_approx")
+from .tables import csv_text, run_columns
 
 
 class Progress:
@@ -69,23 +73,27 @@ def run(scenario: Scenario, out: str, *, force: bool = False, quiet: bool = Fals
             prog.done(name)
             return result
 
-        an = stage("optimal law, trajectory and torques", lambda: analyze(scenario))
+        an = stage(f"{scenario.law_spec['type']} law, trajectory and torques",
+                   lambda: analyze(scenario))
         uniform = stage("uniform law (Fig. 3)", lambda: scenario.trajectory(
             scenario.law("uniform")))
         validation = stage("validation (power balance, forward re-simulation)",
                            lambda: _validation(an))
         state["summary"] = summary = _summary(an, validation)
         stage("trajectory.csv", lambda: od.write_text("trajectory.csv", csv_text(
-            _run_columns(an))))
+            run_columns(an))))
         figs = stage("figures", lambda: _figures(an, uniform, od))
+        gif = None
         if "animation" in scenario.output["figures"]:
             from .figures import animation_gif
 
-            stage("animation.gif", lambda: od.write_bytes("animation.gif", animation_gif(
-                an, scenario.output["animation_frames"])))
+            gif = stage("animation.gif", lambda: animation_gif(
+                an, scenario.output["animation_frames"]))
+            od.write_bytes("animation.gif", gif)
         summary["timing_s"] = prog.timings
         summary["files"] = sorted(set(od.written) | {"summary.json", "report.html"})
-        stage("report.html", lambda: od.write_text("report.html", _report(an, summary, figs)))
+        stage("report.html", lambda: od.write_text("report.html", _report(an, summary, figs,
+                                                                           gif)))
         od.write_text("summary.json", json.dumps(summary, indent=2, allow_nan=False) + "\n")
     return summary
 
@@ -93,21 +101,42 @@ def run(scenario: Scenario, out: str, *, force: bool = False, quiet: bool = Fals
 def _validation(an: Analysis) -> dict[str, Any]:
     out: dict[str, Any] = {"forward_resimulation": forward_error(an)}
     out["power_balance_relative"] = power_balance_residual(an)
-    out["power_balance_note"] = ("max |tau.qdot - dT/dt| / max |tau.qdot| on 201 interior "
-                                 "times, dT/dt by 8th-order differences of the exact energy, "
-                                 "gravity and friction off")
+    out["power_balance_note"] = (
+        "max |tau.qdot - dT/dt| / max |tau.qdot| (dimensionless) on interior times clear of "
+        "the law's breakpoints, dT/dt by 8th-order differences of the exact kinetic energy, "
+        "gravity and friction off; it checks the torques against the energy")
     return out
 
 
-def _run_columns(an: Analysis) -> dict[str, np.ndarray]:
-    tr = an.trajectory
-    cols = {k: v for k, v in tr.columns().items() if k in RUN_COLUMNS}
-    cols["tau1"], cols["tau2"] = an.tau[:, 0], an.tau[:, 1]
-    if an.paper is not None:
-        cols["tau1_paper"], cols["tau2_paper"] = an.paper.tau[:, 0], an.paper.tau[:, 1]
-        cols["T_exact"], cols["T_fd"], cols["T_approx"] = (an.paper.T_exact, an.paper.T_fd,
-                                                           an.paper.T_approx)
-    return {k: cols[k] for k in RUN_COLUMNS if k in cols}
+def is_paper_example(sc: Scenario) -> bool:
+    """The paper's numerical example: the DexTAR, the semicircle R = 120 mm about O from 0 to
+    180 deg, the optimal law, in working mode "+-" (the claims table is about it)."""
+    return (sc.robot_mm == DEXTAR_MM and sc.mode == "+-" and sc.law_spec["type"] == "optimal"
+            and sc.path_spec == {"type": "arc", "radius_mm": 120.0, "center_mm": [0.0, 0.0],
+                                 "start_deg": 0.0, "end_deg": 180.0})
+
+
+def law_summary(sc: Scenario, law: Law, an: Analysis | None = None) -> dict[str, Any]:
+    """The law actually used: its type, its one duration (run time unit and seconds), the
+    solver's status and message, and its own parameters."""
+    spec = sc.law_spec
+    out: dict[str, Any] = {"type": law.name, "duration": law.duration,
+                           "duration_s": law.duration * sc.units.time_s,
+                           "status": int(law.status), "success": bool(law.success),
+                           "message": law.message}
+    if isinstance(law, OptimalLaw):
+        out.update(eta=spec["eta"], eta_s2_per_kg=spec["eta_s2_per_kg"],
+                   ode_residual=law.residual, nodes=law.nodes)
+    if isinstance(law, TrapezoidalLaw):
+        out.update(vmax=law.vmax, amax=law.amax, cruise_speed=law.cruise)
+    if law.name == "time-optimal":
+        out.update(torque_limit_Nm=spec["torque_limit_nm"], grid=spec["grid"],
+                   max_torque_ratio_check_samples=getattr(law, "max_torque_ratio", None))
+        if "speed_limit_deg_s" in spec:
+            out["speed_limit_deg_s"] = spec["speed_limit_deg_s"]
+        if an is not None:
+            out["max_torque_ratio"] = torque_limit_ratio(an)
+    return out
 
 
 def _stats(tau: np.ndarray) -> dict[str, list[float]]:
@@ -118,9 +147,6 @@ def _stats(tau: np.ndarray) -> dict[str, list[float]]:
 def _summary(an: Analysis, validation: dict[str, Any]) -> dict[str, Any]:
     sc, law, tr = an.scenario, an.law, an.trajectory
     ine = sc.inertia
-    kin, inert = law.cost_parts(sc.path, ine.point_mass, sc.law_spec["eta"])
-    solver = ({"residual": law.residual, "nodes": law.nodes, "message": law.message}
-              if isinstance(law, OptimalLaw) else None)
     s: dict[str, Any] = {
         "dextar_version": __version__,
         "config": sc.source,
@@ -128,20 +154,15 @@ def _summary(an: Analysis, validation: dict[str, Any]) -> dict[str, Any]:
         "robot": {"geometry_mm": sc.robot_mm.as_dict(), "geometry": sc.robot.as_dict(),
                   "working_mode": tr.mode, "assembly_mode": tr.assembly},
         "path": {**sc.path_spec, "length": sc.path.length},
-        "law": {**sc.law_spec, "name": law.name, "duration": law.duration,
-                **({"max_torque_ratio": law.max_torque_ratio}
-                   if hasattr(law, "max_torque_ratio") else {})},
+        "law": law_summary(sc, law, an),
         "inertia": {
             "effector_mass": ine.effector_mass, "payload": ine.payload,
             "proximal": [vars(r) for r in ine.proximal], "distal": [vars(r) for r in ine.distal],
             "rotor": list(ine.rotor), "viscous": list(ine.viscous), "coulomb": list(ine.coulomb),
-            "gravity": list(ine.gravity),
+            "gravity": list(ine.gravity), "coulomb_speed": ine.coulomb_speed,
             "note": "rods: mass, com (distance from the proximal joint), inertia about the com",
         },
-        "cost": {"total": kin + inert, "kinetic": kin, "inertial": inert,
-                 "definition": "Phi = (m/2) Int |rdot|^2 dt + (eta m^2/2) Int |rddot|^2 dt"},
-        "optimal_law_solver": solver,
-        "samples": int(tr.t.size),
+        "output": {"samples": int(tr.t.size), "figures": sc.output["figures"]},
         "torques": {"exact": _stats(an.tau)},
         "peak_power": [float(v) for v in np.abs(an.power).max(axis=0)],
         "peak_joint_forces": {k: float(v.max()) for k, v in an.reaction_magnitudes().items()},
@@ -154,10 +175,14 @@ def _summary(an: Analysis, validation: dict[str, Any]) -> dict[str, Any]:
             "the paper's (23) and (30) are used with d/l in the bracket; the sign of the "
             "beta-dot term in (30) follows (28)",
             "T_fd uses second-order central differences of the sampled angles",
+            "Coulomb friction is regularised, coulomb * tanh(qdot / coulomb_speed): zero at "
+            "rest",
         ],
     }
-    if solver is None:
-        s.pop("optimal_law_solver")
+    if isinstance(law, OptimalLaw):  # the paper's functional belongs to the paper's law
+        s["cost"] = {"total": law.cost, "kinetic": law.kinetic, "inertial": law.inertial,
+                     "unit": f"{sc.units.names['energy']} x {sc.units.names['time']}",
+                     "definition": "Phi = (m/2) Int |rdot|^2 dt + (eta m^2/2) Int |rddot|^2 dt"}
     if an.paper is None:
         s["paper_model"] = {"not_applicable": paper_model_limits(sc.robot, sc.inertia)}
     else:
@@ -176,7 +201,8 @@ def _summary(an: Analysis, validation: dict[str, Any]) -> dict[str, Any]:
                      "peak_T_r": float(p.T_r.max()),
                      "ratio": float(p.T_r.max() / (p.T_exact + p.T_S).max())},
         }
-        s["claims"] = _claims(an, s)
+        if is_paper_example(sc):
+            s["claims"] = _claims(an, s)
     return s
 
 
@@ -242,7 +268,8 @@ def _figures(an: Analysis, uniform: Any, od: OutputDir) -> dict[str, bytes]:
     return pngs
 
 
-def _report(an: Analysis, summary: dict[str, Any], pngs: dict[str, bytes]) -> str:
+def _report(an: Analysis, summary: dict[str, Any], pngs: dict[str, bytes],
+            gif: bytes | None) -> str:
     from .report import render_report
 
-    return render_report(an, summary, pngs)
+    return render_report(an, summary, pngs, gif)

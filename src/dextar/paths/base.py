@@ -137,7 +137,8 @@ class Arc(Path):
         object.__setattr__(self, "center", tuple(float(c) for c in self.center))
 
     @property
-    def constant_curvature(self) -> float:  # type: ignore[override]
+    def constant_curvature(self) -> float:  # type: ignore[override]  # a property, not a field
+        """``1 / radius``."""
         return 1.0 / self.radius
 
     def derivatives(self, p: object) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -203,6 +204,7 @@ class Spline(Path):
     """Quintic (C4) interpolating spline through waypoints, parametrised by chord length.
 
     The end conditions set the third and fourth derivatives to zero ("natural" quintic).
+    Through two waypoints the spline is the straight segment between them.
     """
 
     waypoints: tuple[tuple[float, float], ...]
@@ -222,13 +224,23 @@ class Spline(Path):
         object.__setattr__(self, "waypoints", tuple(map(tuple, w.tolist())))
         knots = np.concatenate([[0.0], np.cumsum(chord)])
         object.__setattr__(self, "p1", float(knots[-1]))
-        bc = [(3, np.zeros(2)), (4, np.zeros(2))]
-        object.__setattr__(self, "_spl", make_interp_spline(knots, w, k=5, bc_type=(bc, bc)))
+        if len(w) == 2:  # the straight segment (a quintic would overshoot it)
+            spl = make_interp_spline(knots, w, k=1)
+        else:
+            bc = [(3, np.zeros(2)), (4, np.zeros(2))]
+            spl = make_interp_spline(knots, w, k=5, bc_type=(bc, bc))
+        object.__setattr__(self, "_spl", spl)
+
+    @property
+    def constant_curvature(self) -> float | None:  # type: ignore[override]  # a property here
+        """0 for the straight two-waypoint spline, else None (varying curvature)."""
+        return 0.0 if len(self.waypoints) == 2 else None
 
     def derivatives(self, p: object) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         p = self._check_parameter(p)
         spl = self._spl  # type: ignore[attr-defined]
-        return tuple(spl(p, nu=k) for k in range(4))  # type: ignore[return-value]
+        vals = [spl(p, nu=k) if k <= spl.k else np.zeros(p.shape + (2,)) for k in range(4)]
+        return vals[0], vals[1], vals[2], vals[3]
 
 
 @dataclass(frozen=True)
