@@ -10,6 +10,7 @@ import argparse
 import json
 import os
 import sys
+import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, NoReturn
@@ -150,7 +151,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(_protect_negatives(argv))
     _terminate_as_interrupt()
     try:
-        return int(args.func(args))
+        with warnings.catch_warnings():  # numerical warnings of a failing solve: the error
+            warnings.simplefilter("ignore", RuntimeWarning)  # that follows says it in words
+            return int(args.func(args))
     except DextarError as exc:
         sys.stderr.write(f"dextar {args.command}: error: {exc}\n")
         return 2

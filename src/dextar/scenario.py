@@ -31,7 +31,7 @@ from .errors import DextarError
 from .geometry import FiveBar
 from .laws import Law, MinimumJerkLaw, TrapezoidalLaw, UniformLaw, solve_optimal_law
 from .paths import Arc, ExpressionPath, Line, Path, Spline
-from .trajectory import Trajectory, sample_trajectory
+from .trajectory import Trajectory, check_path, sample_trajectory
 from .units import Units
 
 FIGURES = ("fig3", "fig4", "fig5", "fig6", "fig7", "fig8", "fig9", "workspace", "animation")
@@ -64,6 +64,7 @@ class Scenario:
         """The configured law (or another ``kind`` with the same duration)."""
         spec = self.law_spec
         kind = kind or spec["type"]
+        check_path(self.robot, self.path, mode=self.mode, units=self.units)
         S, T = self.path.length, spec["duration"]
         if kind == "uniform":
             return UniformLaw(S, T)
@@ -86,7 +87,7 @@ class Scenario:
 
     def trajectory(self, law: Law | None = None, samples: int | None = None) -> Trajectory:
         return sample_trajectory(self.robot, self.path, law or self.law(), mode=self.mode,
-                                 samples=samples or self.output["samples"])
+                                 samples=samples or self.output["samples"], units=self.units)
 
     def model(self, assembly: str | None = None) -> Model:
         return Model(self.robot, self.inertia, assembly or self.assembly)
@@ -196,9 +197,8 @@ def _path(t: dict[str, Any], units: Units) -> tuple[Path, dict[str, Any]]:
     elif kind == "expression":
         t = take(t, "path", {**common, "x": str, "y": str, "p0": NUMBER, "p1": NUMBER},
                  ("x", "y"))
-        k = 1.0 / units.length_mm
-        path = ExpressionPath(f"({t['x']})*{k!r}", f"({t['y']})*{k!r}",
-                              float(t.get("p0", 0.0)), float(t.get("p1", 1.0)))
+        path = ExpressionPath(t["x"], t["y"], float(t.get("p0", 0.0)), float(t.get("p1", 1.0)),
+                              scale=1.0 / units.length_mm)
         spec = {"type": "expression", "x_mm": t["x"], "y_mm": t["y"],
                 "p0": float(t.get("p0", 0.0)), "p1": float(t.get("p1", 1.0))}
     else:

@@ -160,7 +160,7 @@ def solve_time_optimal_law(model: Model, path: Path, *, torque_limit: tuple[floa
     if not (0 < tol < 1):
         raise ParameterError(f"tolerance {tol!r} must be in (0, 1)")
     n = int(grid)
-    co, jp = _coefficients(model, path, mode, n)
+    co, jp = _coefficients(model, path, mode, n, units)
     _check_holding(co, tmax, units)
     ds = path.length / n
     x0: np.ndarray | None = None  # tangent points of the viscous bound
@@ -207,12 +207,13 @@ def _with(law: TimeOptimalLaw, tr: float, sp: float, status: int, message: str
                           law.solves)
 
 
-def _coefficients(model: Model, path: Path, mode: str, n: int) -> tuple[_Coefficients,
-                                                                         Trajectory]:
+def _coefficients(model: Model, path: Path, mode: str, n: int, units: Units | None
+                  ) -> tuple[_Coefficients, Trajectory]:
     """``a, b, g`` on the grid from the joint path ``q(s)`` and its derivatives."""
     S = path.length
     # a unit-speed law makes t = s, qdot = q', qddot = q''
-    jp = sample_trajectory(model.robot, path, UniformLaw(S, S), mode=mode, samples=n + 1)
+    jp = sample_trajectory(model.robot, path, UniformLaw(S, S), mode=mode, samples=n + 1,
+                           units=units)
     quiet = Model(model.robot, model.inertia.frictionless(), jp.assembly)
     a = np.einsum("nij,nj->ni", mass_matrix(quiet, jp.q), jp.dq)
     b = inverse_dynamics(quiet, jp.q, jp.dq, jp.ddq)

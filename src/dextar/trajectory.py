@@ -23,6 +23,7 @@ from .kinematics import (
 )
 from .laws import Law
 from .paths import Path
+from .units import Units
 
 
 @dataclass(frozen=True)
@@ -96,7 +97,8 @@ def path_motion(path: Path, law: Law, t: np.ndarray) -> tuple[np.ndarray, ...]:
 
 def sample_trajectory(robot: FiveBar, path: Path, law: Law, *, mode: str = "+-",
                       samples: int = 1001, times: np.ndarray | None = None,
-                      tol: float = DEFAULT_SINGULARITY_TOL) -> Trajectory:
+                      tol: float = DEFAULT_SINGULARITY_TOL,
+                      units: Units | None = None) -> Trajectory:
     """Sample ``law`` along ``path`` and map it to joint space in working mode ``mode``.
 
     Parameters
@@ -107,6 +109,8 @@ def sample_trajectory(robot: FiveBar, path: Path, law: Law, *, mode: str = "+-",
         Explicit sample times (overrides ``samples``).
     tol : float
         Smallest normalised distance to a singularity accepted on the way.
+    units : Units, optional
+        The run's units, only to state points in mm and times in seconds in an error.
 
     Raises
     ------
@@ -121,7 +125,7 @@ def sample_trajectory(robot: FiveBar, path: Path, law: Law, *, mode: str = "+-",
                              f"{path.length:.9g} long")
     t = law.times(samples) if times is None else np.asarray(times, dtype=float)
     s, ds, dds, p, dp, ddp, P, dP, ddP = path_motion(path, law, t)
-    _check_reach(robot, t, P)
+    _check_reach(robot, t, P, units)
     q = inverse_kinematics(robot, P, mode, unwrap=True)
     d1, d2 = singularity_distances(robot, q, P)
     det = parallel_indicator(robot, q, P)
@@ -134,8 +138,8 @@ def sample_trajectory(robot: FiveBar, path: Path, law: Law, *, mode: str = "+-",
             i = int(np.flatnonzero(bad)[0])
             what = "serial (type 1)" if kind == 1 else "parallel (type 2)"
             raise SingularityError(
-                f"the path meets a {what} singularity in working mode {mode} at t = {t[i]:.6g} "
-                f"(sample {i}): P = ({P[i, 0]:.6g}, {P[i, 1]:.6g}), q = "
+                f"the path meets a {what} singularity in working mode {mode} at "
+                f"{_when(t[i], units)} (sample {i}): P = {_point(P[i], units)}, q = "
                 f"({np.degrees(q[i, 0]):.6g}, {np.degrees(q[i, 1]):.6g}) deg, normalised "
                 f"distance {dist[i]:.3g}" + (f" below {tol:g}" if dist[i] < tol else
                                              ", crossed since the previous sample"))
@@ -146,7 +150,59 @@ def sample_trajectory(robot: FiveBar, path: Path, law: Law, *, mode: str = "+-",
                       p, dp, ddp, P, dP, ddP, q, dq, ddq)
 
 
-def _check_reach(robot: FiveBar, t: np.ndarray, P: np.ndarray) -> None:
+def check_path(robot: FiveBar, path: Path, *, mode: str = "+-", samples: int = 2001,
+               tol: float = DEFAULT_SINGULARITY_TOL, units: Units | None = None) -> None:
+    """Check a path before any law is planned on it: every one of ``samples`` points equally
+    spaced in the path parameter within reach, and clear of both singularity types in working
+    mode ``mode``. Errors name the path parameter and the point (in mm with ``units``).
+
+    Raises
+    ------
+    ReachError, SingularityError
+    """
+    mode = working_mode_name(parse_working_mode(mode))
+    p = np.linspace(path.p0, path.p1, samples)
+    P = path.position(p)
+    where = [f"p = {v:.6g}" for v in p]
+    try:
+        _check_reach(robot, p, P, None)
+    except ReachError:
+        for leg, pivot in ((1, robot.A), (2, robot.D)):
+            rin, rout = robot.reach(leg)
+            rho = np.hypot(P[:, 0] - pivot[0], P[:, 1])
+            bad = (rho < rin) | (rho > rout)
+            if bad.any():
+                i = int(np.flatnonzero(bad)[0])
+                out = max(rin - rho[i], rho[i] - rout)
+                by = f"{out:.6g}" if units is None else f"{units.mm(out):.6g} mm"
+                raise ReachError(f"the path leaves the workspace at {where[i]}: point "
+                                 f"{_point(P[i], units)} is out of reach of leg {leg} by "
+                                 f"{by}") from None
+    q = inverse_kinematics(robot, P, mode, unwrap=True)
+    d1, d2 = singularity_distances(robot, q, P)
+    det = parallel_indicator(robot, q, P)
+    crossing = np.concatenate([[False], np.sign(det[1:]) != np.sign(det[:-1])])
+    for kind, dist in ((1, d1), (2, d2)):
+        bad = (dist < tol) | (crossing if kind == 2 else False)
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            what = "serial (type 1)" if kind == 1 else "parallel (type 2)"
+            raise SingularityError(
+                f"the path meets a {what} singularity in working mode {mode} at {where[i]}: "
+                f"P = {_point(P[i], units)}, q = ({np.degrees(q[i, 0]):.6g}, "
+                f"{np.degrees(q[i, 1]):.6g}) deg, normalised distance {dist[i]:.3g}"
+                + (f" below {tol:g}" if dist[i] < tol else ", crossed on the way"))
+
+
+def _when(t: float, units: Units | None) -> str:
+    return f"t = {t:.6g}" if units is None else units.time_text(t)
+
+
+def _point(P: np.ndarray, units: Units | None) -> str:
+    return f"({P[0]:.6g}, {P[1]:.6g})" if units is None else units.point_text(P)
+
+
+def _check_reach(robot: FiveBar, t: np.ndarray, P: np.ndarray, units: Units | None) -> None:
     for leg, pivot in ((1, robot.A), (2, robot.D)):
         rin, rout = robot.reach(leg)
         rho = np.hypot(P[:, 0] - pivot[0], P[:, 1])
@@ -154,6 +210,7 @@ def _check_reach(robot: FiveBar, t: np.ndarray, P: np.ndarray) -> None:
         if bad.any():
             i = int(np.flatnonzero(bad)[0])
             out = max(rin - rho[i], rho[i] - rout)
+            by = f"{out:.6g}" if units is None else f"{units.mm(out):.6g} mm"
             raise ReachError(
-                f"the path leaves the workspace at t = {t[i]:.6g} (sample {i}): point "
-                f"({P[i, 0]:.6g}, {P[i, 1]:.6g}) is out of reach of leg {leg} by {out:.6g}")
+                f"the path leaves the workspace at {_when(t[i], units)} (sample {i}): point "
+                f"{_point(P[i], units)} is out of reach of leg {leg} by {by}")

@@ -247,6 +247,9 @@ class Spline(Path):
 class ExpressionPath(Path):
     """A path given as text, ``x(p)`` and ``y(p)``, differentiated symbolically.
 
+    ``scale`` multiplies the values (a config's expressions give mm; the run may compute in
+    other length units), so that every error quotes the expressions as typed.
+
     >>> path = ExpressionPath("0.3*cos(p)", "1.2 + 0.2*sin(2*p)", 0.0, 3.0)
     """
 
@@ -254,15 +257,19 @@ class ExpressionPath(Path):
     y: str
     p0: float = 0.0
     p1: float = 1.0
+    scale: float = 1.0
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.p0) and math.isfinite(self.p1) and self.p1 > self.p0):
             raise ParameterError(f"expression path needs p0 < p1, got {self.p0!r}, {self.p1!r}")
+        if not (math.isfinite(self.scale) and self.scale > 0):
+            raise ParameterError(f"expression path scale {self.scale!r} must be positive")
         object.__setattr__(self, "_ex", Expression.parse(self.x))
         object.__setattr__(self, "_ey", Expression.parse(self.y))
 
     def derivatives(self, p: object) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         p = self._check_parameter(p)
-        xs = self._ex(p)  # type: ignore[attr-defined]
+        xs = self._ex(p)  # type: ignore[attr-defined]  # set in __post_init__
         ys = self._ey(p)  # type: ignore[attr-defined]
-        return tuple(np.stack([a, b], -1) for a, b in zip(xs, ys, strict=True))  # type: ignore
+        r = [self.scale * np.stack([a, b], -1) for a, b in zip(xs, ys, strict=True)]
+        return r[0], r[1], r[2], r[3]
