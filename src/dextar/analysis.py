@@ -169,4 +169,4 @@ def forward_error(an: Analysis) -> dict[str, Any]:
     return {"final_error_relative_to_range": float((np.abs(res.q[-1] - tr.q[-1]) / span).max()),
             "max_error_relative_to_range": float((np.abs(res.q - tr.q).max(axis=0) / span).max()),
             "max_error_rad": float(np.abs(res.q - tr.q).max()),
-            "rhs_evaluations": int(res.nfev)}
+            "rhs_evaluations": int(res.nfev), "status": res.status, "message": res.message}

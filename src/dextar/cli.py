@@ -148,7 +148,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     # negative numbers are values, not options: "dextar ik -10 120"
     argv = list(sys.argv[1:] if argv is None else argv)
-    args = parser.parse_args(_protect_negatives(argv))
+    try:
+        args = parser.parse_args(_protect_negatives(argv))
+    except SystemExit as exc:  # --help, --version, or a usage error (already printed)
+        return int(exc.code or 0) if not isinstance(exc.code, str) else 2
     _terminate_as_interrupt()
     try:
         with warnings.catch_warnings():  # numerical warnings of a failing solve: the error
