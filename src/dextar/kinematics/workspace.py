@@ -12,6 +12,10 @@ from ..geometry import FiveBar, parse_working_mode, working_mode_name
 from .positions import _leg_solve
 
 
+#: Largest grid side of a workspace map (16 million points).
+MAX_RESOLUTION = 4001
+
+
 @dataclass(frozen=True)
 class WorkspaceMap:
     """A workspace sampled on a regular grid.
@@ -63,8 +67,9 @@ def workspace_map(
         Defaults to the box that holds both legs' reach.
     """
     signs = parse_working_mode(mode)
-    if int(resolution) < 10:
-        raise ParameterError(f"workspace resolution {resolution} must be at least 10")
+    if not 10 <= int(resolution) <= MAX_RESOLUTION:
+        raise ParameterError(f"workspace resolution {resolution} must be between 10 and "
+                             f"{MAX_RESOLUTION} grid points")
     if bounds is None:
         r = max(robot.l1 + robot.L1, robot.l2 + robot.L2)
         h = 0.5 * robot.d

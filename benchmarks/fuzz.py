@@ -1,0 +1,99 @@
+"""The long robustness run: random configs and command lines through the real command line.
+
+Run: python benchmarks/fuzz.py --cases 10000 [--seed 0]
+
+Each case is classified by ``tests/robustness/harness.py``: ``ok`` (exit 0, finite outputs),
+``refused`` (exit 2, one line on stderr) or a defect (traceback, nan, hang, partial,
+bad-exit). Prints the counts, the slowest case and the first few defects; exits 1 if there
+is any defect.
+"""
+
+from __future__ import annotations
+
+import argparse
+import collections
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+from tests.robustness.harness import DEFECTS, run_case, toml_text  # noqa: E402
+from tests.robustness.strategies import COMMANDS, configs, kinematics_argv  # noqa: E402
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--cases", type=int, default=1000)
+    ap.add_argument("--seed", type=int, default=0)
+    args = ap.parse_args()
+    counts: collections.Counter[str] = collections.Counter()
+    defects: list[str] = []
+    slowest = (0.0, "")
+    t_start = time.perf_counter()
+
+    def record(outcome: str, detail: str, label: str, dt: float) -> None:
+        nonlocal slowest
+        counts[outcome] += 1
+        if outcome in DEFECTS and len(defects) < 20:
+            defects.append(f"{outcome}: {detail}\n    {label}")
+        if dt > slowest[0]:
+            slowest = (dt, label)
+        done = sum(counts.values())
+        if done % 500 == 0:
+            print(f"  {done} cases, {dict(counts)}", file=sys.stderr, flush=True)
+
+    n_cfg = int(args.cases * 0.8)
+
+    @settings(max_examples=n_cfg, deadline=None, database=None, derandomize=False,
+              suppress_health_check=list(HealthCheck))
+    @given(doc=configs(), command=COMMANDS)
+    def fuzz_configs(doc: dict, command: str) -> None:
+        with tempfile.TemporaryDirectory() as tmp:
+            work = Path(tmp)
+            cfg = work / "case.toml"
+            text = toml_text(doc)
+            cfg.write_text(text)
+            out = work / ("out.xml" if command == "export" else "out.csv")
+            argv = [command, "mjcf"] if command == "export" else [command]
+            t0 = time.perf_counter()
+            outcome, detail = run_case([*argv, str(cfg), "--out", str(out)], work, out)
+            record(outcome, detail, f"{command} with\n{text}", time.perf_counter() - t0)
+
+    @settings(max_examples=args.cases - n_cfg, deadline=None, database=None,
+              suppress_health_check=list(HealthCheck))
+    @given(argv=kinematics_argv())
+    def fuzz_argv(argv: list[str]) -> None:
+        with tempfile.TemporaryDirectory() as tmp:
+            work = Path(tmp)
+            out = None
+            if argv[0] == "workspace":
+                out = work / "ws.png"
+                argv = [*argv, "--out", str(out)]
+            t0 = time.perf_counter()
+            outcome, detail = run_case(argv, work, out)
+            record(outcome, detail, " ".join(argv), time.perf_counter() - t0)
+
+    import random
+
+    random.seed(args.seed)
+    st.random_module()
+    fuzz_configs()
+    fuzz_argv()
+    total = sum(counts.values())
+    print(f"{total} cases in {time.perf_counter() - t_start:.0f} s: " + ", ".join(
+        f"{k} {counts.get(k, 0)}" for k in ("ok", "refused", *DEFECTS)))
+    print(f"tracebacks {counts.get('traceback', 0)}, NaN outputs {counts.get('nan', 0)}, "
+          f"hangs {counts.get('hang', 0)}, partial files {counts.get('partial', 0)}")
+    print(f"slowest case {slowest[0]:.2f} s: {slowest[1][:300]}")
+    for d in defects:
+        print(d)
+    return 1 if any(counts.get(k, 0) for k in DEFECTS) else 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

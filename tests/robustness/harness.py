@@ -1,0 +1,123 @@
+"""The robustness harness, shared by the test suite and ``benchmarks/fuzz.py``.
+
+A case is a config (a dict of TOML tables, written to a file) and a command line. It is run
+in-process through :func:`dextar.cli.main` under a time bound, and classified:
+
+* ``"ok"``: exit 0, the output file complete and every number in it finite;
+* ``"refused"``: exit 2 with exactly one line on stderr, no output file left behind;
+* anything else is a defect: ``"traceback"`` (an internal error or an exception escaping),
+  ``"nan"`` (a non-finite number in an output), ``"hang"`` (past the time bound),
+  ``"partial"`` (a half-written or leftover staging file), ``"bad-exit"`` (another exit
+  status or a refusal without its one line).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import math
+import re
+import signal
+from pathlib import Path
+from typing import Any
+
+from dextar.cli import main
+
+#: Seconds a single case may take (each command is bounded well below this).
+TIME_BOUND = 60.0
+DEFECTS = ("traceback", "nan", "hang", "partial", "bad-exit")
+
+
+class Hang(BaseException):
+    """Raised by the alarm when a case runs past its bound (not an Exception: the CLI's
+    catch-all must not swallow it)."""
+
+
+def toml_value(v: Any) -> str:
+    """A Python value as TOML (nan and inf included)."""
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        if math.isnan(v):
+            return "nan"
+        if math.isinf(v):
+            return "inf" if v > 0 else "-inf"
+        return repr(v)
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n") + '"'
+    if isinstance(v, list):
+        return "[" + ", ".join(toml_value(x) for x in v) + "]"
+    if isinstance(v, dict):
+        return "{" + ", ".join(f'"{k}" = {toml_value(x)}' for k, x in v.items()) + "}"
+    raise TypeError(type(v))
+
+
+def toml_text(doc: dict[str, Any]) -> str:
+    """A config dict as TOML text: top-level non-table values first, then one table each."""
+    lines = [f'"{k}" = {toml_value(v)}' for k, v in doc.items() if not isinstance(v, dict)]
+    for name, table in doc.items():
+        if isinstance(table, dict):
+            lines.append(f'["{name}"]')
+            lines += [f'"{k}" = {toml_value(v)}' for k, v in table.items()]
+    return "\n".join(lines) + "\n"
+
+
+def _finite_csv(text: str) -> bool:
+    body = text.splitlines()[1:]
+    if not body:
+        return False
+    for row in body:
+        for cell in row.split(","):
+            if not math.isfinite(float(cell)):
+                return False
+    return True
+
+
+def run_case(argv: list[str], workdir: Path, out: Path | None,
+             bound: float = TIME_BOUND) -> tuple[str, str]:
+    """Run one command line; returns ``(outcome, detail)`` (see the module doc)."""
+    err, std = io.StringIO(), io.StringIO()
+
+    def alarm(signum: int, frame: object) -> None:
+        raise Hang
+
+    old = signal.signal(signal.SIGALRM, alarm)
+    signal.setitimer(signal.ITIMER_REAL, bound)
+    try:
+        with contextlib.redirect_stderr(err), contextlib.redirect_stdout(std):
+            code = main(argv)
+    except Hang:
+        return "hang", " ".join(argv)
+    except BaseException as exc:  # noqa: BLE001 - anything escaping main is a defect
+        return "traceback", f"{type(exc).__name__}: {exc}"
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+    msg = err.getvalue()
+    leftovers = [p.name for p in workdir.rglob("*") if p.name.startswith(".")]
+    if leftovers:
+        return "partial", f"leftover files {leftovers}"
+    if "Traceback" in msg or "internal error" in msg:
+        return "traceback", msg.strip()
+    if code == 2:
+        if msg.count("\n") != 1 or not msg.startswith("dextar"):
+            return "bad-exit", f"refusal without one line on stderr: {msg!r}"
+        if out is not None and out.exists():
+            return "partial", f"output written on a refusal: {msg.strip()}"
+        return "refused", msg.strip()
+    if code != 0:
+        return "bad-exit", f"exit {code}: {msg.strip()}"
+    if out is not None:
+        if not out.exists():
+            return "bad-exit", "exit 0 without the output file"
+        if out.suffix == ".csv" and not _finite_csv(out.read_text()):
+            return "nan", f"non-finite value in {out.name}"
+        if out.suffix == ".xml" and not out.read_text().rstrip().endswith("</mujoco>"):
+            return "partial", "incomplete XML"
+        if out.suffix == ".xml" and ("nan" in out.read_text() or "inf" in out.read_text()):
+            return "nan", "non-finite value in the MJCF"
+    if re.search(r"\b(nan|inf|infinity)\b", std.getvalue(), re.IGNORECASE):
+        return "nan", f"non-finite number printed: {std.getvalue()[:200]}"
+    return "ok", ""

@@ -1,0 +1,172 @@
+"""Hypothesis strategies over configs (every table and key, with wrong types, huge and tiny
+values, points outside the workspace, degenerate geometry, expressions with poles) and over
+command-line arguments."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from hypothesis import strategies as st
+
+FIN = st.floats(allow_nan=False, allow_infinity=False)
+EXTREME = st.sampled_from([0.0, -0.0, -1.0, 1e-300, 1e-12, 1e12, 1e300, -1e300,
+                           float("nan"), float("inf"), float("-inf")])
+WRONG = st.one_of(st.text(max_size=6), st.booleans(), st.lists(st.integers(-3, 3), max_size=3),
+                  st.dictionaries(st.sampled_from(["a", "x"]), st.integers(), max_size=1))
+
+
+def number(lo: float, hi: float, clean: bool = False) -> st.SearchStrategy[Any]:
+    """A sensible number in [lo, hi]; unless ``clean``, sometimes an extreme or a wrong
+    type instead."""
+    sensible = st.one_of(st.floats(lo, hi), st.integers(int(max(lo, -1e6)), int(min(hi, 1e6)))
+                         ) if hi - lo >= 1 else st.floats(lo, hi)
+    if clean:
+        return sensible
+    return st.one_of(*([sensible] * 8), EXTREME, WRONG)
+
+
+def pair(lo: float, hi: float, clean: bool = False) -> st.SearchStrategy[Any]:
+    """A number or a pair of numbers (unless ``clean``, sometimes of the wrong length)."""
+    good = st.one_of(number(lo, hi, clean),
+                     st.lists(number(lo, hi, clean), min_size=2, max_size=2))
+    return good if clean else st.one_of(good, good, good, st.lists(FIN, max_size=3))
+
+
+def point(lo: float = -250.0, hi: float = 250.0, clean: bool = False) -> st.SearchStrategy[Any]:
+    """A point in mm, often inside the DexTAR's workspace, sometimes far outside."""
+    inside = st.tuples(st.floats(-90, 90), st.floats(60, 150)).map(list)
+    anywhere = st.lists(number(lo, hi, clean), min_size=2, max_size=2)
+    if clean:
+        return st.one_of(inside, inside, inside, anywhere)
+    return st.one_of(inside, inside, inside, anywhere, st.lists(FIN, max_size=3), WRONG)
+
+
+INTEGER = st.one_of(st.integers(-5, 5000), st.sampled_from([10**9, -(10**9)]), WRONG, FIN)
+EXPRESSIONS = st.sampled_from([
+    "40*cos(p)", "100 + 20*sin(p)", "30*p", "110 + 10/(p - 0.5)", "100 + log(p - 2)",
+    "sqrt(-p)", "1e300*p*p", "p**p", "asin(2*p)", "tan(p*3.14159)", "", "p +", "__import__",
+    "exp(1000*p)", "0*p", "100", "120 - 30*p**2", "abs(p)",
+])
+
+
+def _table(keys: dict[str, st.SearchStrategy[Any]], *, always: tuple[str, ...] = ()
+           ) -> st.SearchStrategy[dict[str, Any]]:
+    """A table with the keys ``always`` and a random subset of the others, and sometimes an
+    unknown key."""
+    names = sorted(k for k in keys if k not in always)
+
+    @st.composite
+    def build(draw: st.DrawFn) -> dict[str, Any]:
+        chosen = draw(st.lists(st.sampled_from(names), unique=True, max_size=len(names))
+                      ) if names else []
+        d = {k: draw(keys[k]) for k in (*always, *sorted(chosen))}
+        if draw(st.integers(0, 40)) == 17:  # (hypothesis favours 0: use another value)
+            d["unknown_key"] = 1
+        return d
+
+    return build()
+
+
+def tables(clean: bool) -> dict[str, st.SearchStrategy[dict[str, Any]]]:
+    """A strategy per config table (``clean``: sensible values of the right types only)."""
+    def pick(good: list[Any], bad: list[Any]) -> st.SearchStrategy[Any]:
+        return st.sampled_from(good if clean else good + bad)
+
+    integer = st.integers(10, 2000) if clean else INTEGER
+    near = st.floats(0.8, 1.25)
+    robot = st.fixed_dictionaries({"preset": st.just("dextar")}, optional={
+        "l1": near.map(lambda f: 72 * f), "L1": near.map(lambda f: 87 * f),
+        "d": near.map(lambda f: 60 * f), "working_mode": st.sampled_from(["+-", "pm", "--"]),
+        "assembly_mode": st.just("up")}) if clean else _table({
+                    "preset": pick(["dextar", "DexTAR"], ["unknown"]),
+                    "l1": number(1, 200, clean), "l2": number(1, 200, clean), "L1": number(1, 200, clean),
+                    "L2": number(1, 200, clean), "d": number(0.1, 300, clean),
+                    "working_mode": pick(["++", "+-", "-+", "--", "pm", "mp", "mm", "pp", "+-",
+                                          "+-"], ["x", ""]),
+                    "assembly_mode": pick(["up", "down", "up"], ["sideways"])})
+    paths = st.one_of(
+        _table({"type": st.just("arc"), "radius": number(0.1, 200, clean), "center": point(clean=clean),
+                "start_deg": number(-360, 360, clean), "end_deg": number(-360, 360, clean)}, always=("type",)),
+        _table({"type": st.just("line"), "start": point(clean=clean), "end": point(clean=clean)},
+               always=("type", "start", "end") if clean else ("type",)),
+        _table({"type": st.just("spline"),
+                "waypoints": st.lists(point(clean=clean), min_size=0, max_size=5)},
+               always=("type", "waypoints") if clean else ("type",)),
+        _table({"type": st.just("expression"), "x": EXPRESSIONS, "y": EXPRESSIONS,
+                "p0": number(-2, 2, clean), "p1": number(-2, 3, clean)},
+               always=("type", "x", "y") if clean else ("type",)),
+        st.fixed_dictionaries({"type": pick(["arc"], ["circle", 3])}),
+    )
+    law = _table({"type": pick(["uniform", "min-jerk", "trapezoid", "optimal", "time-optimal"],
+                               ["fast"]),
+                  "duration": number(1e-3, 100, clean), "eta": number(1e-6, 1e6, clean),
+                  "vmax": number(1, 1e5, clean), "amax": number(1, 1e6, clean),
+                  "torque_limit": pair(1e-3, 100, clean), "speed_limit_deg_s": pair(1, 1e5, clean),
+                  "grid": integer, **({} if clean else {"samples": INTEGER})})
+    inertia = _table({"effector_mass": number(1e-3, 10, clean), "payload": number(0, 5, clean),
+                      "proximal_mass": pair(0, 2, clean), "distal_mass": pair(0, 2, clean),
+                      "proximal_com": pair(-10, 200, clean), "distal_com": pair(-10, 200, clean),
+                      "proximal_inertia": pair(0, 1e4, clean), "distal_inertia": pair(0, 1e4, clean),
+                      "rotor_inertia": pair(0, 1e4, clean)})
+    friction = _table({"viscous": pair(0, 1, clean), "coulomb": pair(0, 1, clean),
+                       "coulomb_speed_deg_s": number(1e-4, 100, clean)})
+    gravity = _table({"vector": point(-2e4, 2e4, clean=clean)})
+    control = _table({"natural_frequency_hz": number(0.1, 100, clean), "damping": number(0.05, 5, clean),
+                      "mass_error": number(-0.5, 1, clean), "payload": number(0, 2, clean),
+                      "torque_limit": number(1e-3, 10, clean),
+                      "initial_error_deg": st.lists(number(-10, 10, clean), min_size=2,
+                                                    max_size=2 if clean else 3)})
+    paper = _table({"beta0_time": number(0, 1, clean), "fig7_distal_mass_ratio": number(0, 2, clean),
+                    "fig7_lambda": number(0, 1, clean)})
+    output = _table({"units": pick(["paper", "si"], ["imperial"]),
+                     "samples": st.integers(2, 3000) if clean else st.one_of(
+                         st.integers(2, 3000), INTEGER),
+                     "figures": st.lists(pick(["fig3", "fig9", "workspace"], ["fig99"]),
+                                         max_size=2),
+                     "animation_frames": integer})
+
+    return {"robot": robot, "path": paths, "law": law, "inertia": inertia,
+            "friction": friction, "gravity": gravity, "control": control, "paper": paper,
+            "output": output}
+
+
+TABLES = {True: tables(True), False: tables(False)}
+
+
+@st.composite
+def configs(draw: st.DrawFn) -> dict[str, Any]:
+    """A config: a random subset of the tables, each a random subset of its keys, and
+    sometimes an unknown table or a value where a table belongs."""
+    clean = draw(st.booleans())
+    strategies = TABLES[clean]
+    names = draw(st.sets(st.sampled_from(sorted(strategies)), max_size=len(strategies)))
+    doc: dict[str, Any] = {n: draw(strategies[n]) for n in sorted(names)}
+    extra = draw(st.integers(0, 60))
+    if extra == 17 and not clean:
+        doc["unknown_table"] = {"a": 1}
+    elif extra == 23 and not clean:
+        doc["law"] = 3
+    return doc
+
+
+COMMANDS = st.sampled_from(["plan", "torques", "plan", "torques", "export"])
+
+
+@st.composite
+def kinematics_argv(draw: st.DrawFn) -> list[str]:
+    """Command lines of ik, fk and workspace with odd numbers and options."""
+    num = st.one_of(st.floats(-300, 300).map(lambda v: f"{v:g}"),
+                    st.sampled_from(["nan", "inf", "-inf", "1e308", "x", "", "--", "-0"]))
+    cmd = draw(st.sampled_from(["ik", "fk", "workspace"]))
+    if cmd == "workspace":
+        argv = ["workspace", "--resolution", draw(st.sampled_from(["2", "10", "40", "-3",
+                                                                   "abc", "100000000"]))]
+    else:
+        argv = [cmd, draw(num), draw(num)]
+    if cmd in ("ik", "workspace") and draw(st.booleans()):
+        argv += ["--mode", draw(st.sampled_from(["+-", "--", "pm", "bad", "-+"]))]
+    if cmd == "fk" and draw(st.booleans()):
+        argv += ["--assembly", draw(st.sampled_from(["up", "down", "left"]))]
+    if draw(st.booleans()):
+        argv.append("--json")
+    return argv

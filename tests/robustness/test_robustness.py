@@ -1,0 +1,61 @@
+"""Robustness: random configs and command lines end in exit 0 with finite outputs or in
+exit 2 with one line on stderr naming the key or the place; never a traceback, a NaN in a
+file, a hang past a bound or a half-written file. ``benchmarks/fuzz.py --cases 10000`` runs
+the long version."""
+
+from __future__ import annotations
+
+import re
+import tempfile
+from pathlib import Path
+
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from .harness import DEFECTS, run_case, toml_text
+from .strategies import COMMANDS, configs, kinematics_argv
+
+SETTINGS = settings(max_examples=150, deadline=None, derandomize=True,
+                    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+
+
+@SETTINGS
+@given(doc=configs(), command=COMMANDS)
+def test_random_configs_never_crash(doc, command):
+    with tempfile.TemporaryDirectory() as tmp:
+        work = Path(tmp)
+        cfg = work / "case.toml"
+        cfg.write_text(toml_text(doc))
+        out = work / ("out.xml" if command == "export" else "out.csv")
+        argv = [command, "mjcf"] if command == "export" else [command]
+        outcome, detail = run_case([*argv, str(cfg), "--out", str(out)], work, out)
+    assert outcome not in DEFECTS, f"{outcome}: {detail}\nconfig:\n{toml_text(doc)}"
+    if outcome == "refused":
+        # the one line names a config key, a table, a point, a time, a leg or the solver
+        assert re.search(r"\[\w+\]|point|leg|t = |p = |motor|law|path|expression|"
+                         r"singularity|config|geometry|mode|--out", detail), detail
+
+
+@SETTINGS
+@given(argv=kinematics_argv())
+def test_random_command_lines_never_crash(argv):
+    with tempfile.TemporaryDirectory() as tmp:
+        work = Path(tmp)
+        out = None
+        if argv[0] == "workspace":
+            out = work / "ws.png"
+            argv = [*argv, "--out", str(out)]
+        outcome, detail = run_case(argv, work, out)
+    assert outcome not in DEFECTS, f"{outcome}: {detail}\nargv: {argv}"
+
+
+@settings(max_examples=25, deadline=None, derandomize=True)
+@given(text=st.text(max_size=60))
+def test_arbitrary_bytes_as_config(text):
+    with tempfile.TemporaryDirectory() as tmp:
+        work = Path(tmp)
+        cfg = work / "case.toml"
+        cfg.write_text(text)
+        out = work / "out.csv"
+        outcome, detail = run_case(["plan", str(cfg), "--out", str(out)], work, out)
+    assert outcome not in DEFECTS, f"{outcome}: {detail}\ntext: {text!r}"
