@@ -11,7 +11,6 @@ from ..errors import ParameterError
 from ..geometry import FiveBar, parse_working_mode, working_mode_name
 from .positions import _leg_solve
 
-
 #: Largest grid side of a workspace map (16 million points).
 MAX_RESOLUTION = 4001
 
