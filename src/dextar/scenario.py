@@ -239,6 +239,7 @@ def _law(t: dict[str, Any], units: Units) -> dict[str, Any]:
             if min(w) <= 0:
                 raise ConfigError("config key [law].speed_limit_deg_s must be positive")
             spec["speed_limit"] = tuple(math.radians(v) * units.time_s for v in w)
+            spec["speed_limit_deg_s"] = list(w)
         spec["grid"] = int(t.get("grid", 400))
         if spec["grid"] < 10:
             raise ConfigError("config key [law].grid must be at least 10")
