@@ -39,8 +39,10 @@ def main() -> int:
     def record(outcome: str, detail: str, label: str, dt: float) -> None:
         nonlocal slowest
         counts[outcome] += 1
-        if outcome in DEFECTS and len(defects) < 20:
-            defects.append(f"{outcome}: {detail}\n    {label}")
+        if outcome in DEFECTS:
+            print(f"DEFECT {outcome}: {detail}\n    {label}", file=sys.stderr, flush=True)
+            if len(defects) < 20:
+                defects.append(f"{outcome}: {detail}\n    {label}")
         if dt > slowest[0]:
             slowest = (dt, label)
         done = sum(counts.values())

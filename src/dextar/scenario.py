@@ -36,6 +36,10 @@ from .units import Units
 
 FIGURES = ("fig3", "fig4", "fig5", "fig6", "fig7", "fig8", "fig9", "workspace", "animation")
 PAIR = (int, float, list)
+#: Most samples a run writes (a 200 s motion at 1 kHz).
+MAX_SAMPLES = 200_000
+#: Finest time-optimal grid.
+MAX_GRID = 100_000
 
 
 @dataclass(frozen=True)
@@ -156,8 +160,9 @@ def scenario_from_dict(doc: dict[str, Any]) -> Scenario:
     robot = g_mm.scaled(1.0 / units.length_mm)
     path, path_spec = _path(doc.get("path", {}), units)
     samples = int(out.get("samples", 1001))
-    if samples < 2:
-        raise ConfigError(f"config key [output].samples must be at least 2, got {samples}")
+    if not 2 <= samples <= MAX_SAMPLES:
+        raise ConfigError(f"config key [output].samples must be between 2 and {MAX_SAMPLES}, "
+                          f"got {samples}")
     law_spec = _law(law_t, units)
     inertia = _inertia(inert_t, doc, units, g_mm, effector_kg)
     control = _control(doc.get("control", {}), units, effector_kg)
@@ -165,8 +170,12 @@ def scenario_from_dict(doc: dict[str, Any]) -> Scenario:
         "beta0_time": NUMBER, "fig7_distal_mass_ratio": NUMBER, "fig7_lambda": NUMBER,
         "fig9_proximal_mass_ratio": NUMBER, "fig9_distal_mass_ratio": NUMBER})
     paper = {"beta0_time": 0.5, "fig7_distal_mass_ratio": 0.5, "fig7_lambda": 0.5, **paper}
+    frames = int(out.get("animation_frames", 41))
+    if not 2 <= frames <= 1000:
+        raise ConfigError(f"config key [output].animation_frames must be between 2 and 1000, "
+                          f"got {frames}")
     output = {"units": system, "samples": samples, "figures": list(figures),
-              "animation_frames": int(out.get("animation_frames", 41))}
+              "animation_frames": frames}
     return Scenario(units, g_mm, robot, rc.working_mode, rc.assembly_mode, path, path_spec,
                     law_spec, inertia, control, paper, output)
 
@@ -241,8 +250,9 @@ def _law(t: dict[str, Any], units: Units) -> dict[str, Any]:
             spec["speed_limit"] = tuple(math.radians(v) * units.time_s for v in w)
             spec["speed_limit_deg_s"] = list(w)
         spec["grid"] = int(t.get("grid", 400))
-        if spec["grid"] < 10:
-            raise ConfigError("config key [law].grid must be at least 10")
+        if not 10 <= spec["grid"] <= MAX_GRID:
+            raise ConfigError(f"config key [law].grid must be between 10 and {MAX_GRID}, got "
+                              f"{spec['grid']}")
     return spec
 
 

@@ -95,6 +95,8 @@ def run_case(argv: list[str], workdir: Path, out: Path | None,
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, old)
+    if code == 130:  # interrupted (Ctrl-C or SIGTERM): stop the whole run
+        raise KeyboardInterrupt
     msg = err.getvalue()
     leftovers = [p.name for p in workdir.rglob("*") if p.name.startswith(".")]
     if leftovers:

@@ -186,8 +186,9 @@ def effector_energy_fd(robot: FiveBar, mass: float, t: np.ndarray, q: np.ndarray
     q = as_points(q, "q")
     t = np.asarray(t, dtype=float)
     beta = base_angle(robot, q)
-    dq = np.gradient(q, t, axis=0, edge_order=2)
-    dbeta = np.gradient(beta, t, edge_order=2)
+    order = 2 if len(t) >= 3 else 1  # second-order differences need three samples
+    dq = np.gradient(q, t, axis=0, edge_order=order)
+    dbeta = np.gradient(beta, t, edge_order=order)
     vx, vy = _effector_velocity_23(robot, q, dq, beta, dbeta)
     return 0.5 * mass * (vx * vx + vy * vy)
 
