@@ -84,7 +84,8 @@ def cmd_fk(args: argparse.Namespace) -> int:
 
 
 def cmd_workspace(args: argparse.Namespace) -> int:
-    from .kinematics import plot_workspace, workspace_map
+    from .kinematics import workspace_map
+    from .output.figures import plot_workspace
     from .output.files import save_figure
 
     rc = _robot(args.robot)

@@ -116,7 +116,7 @@ def test_workspace_map():
 
 
 def test_workspace_plot(tmp_path):
-    from dextar.kinematics import plot_workspace
+    from dextar.output.figures import plot_workspace
     from dextar.output.files import save_figure
 
     ws = dx.workspace_map(ROBOT, "+-", resolution=60)

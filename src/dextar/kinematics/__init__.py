@@ -13,7 +13,7 @@ from .velocity import (
     task_velocity,
     velocity_matrices,
 )
-from .workspace import WorkspaceMap, plot_workspace, workspace_map
+from .workspace import WorkspaceMap, workspace_map
 
 __all__ = [
     "DEFAULT_SINGULARITY_TOL",
@@ -27,7 +27,6 @@ __all__ = [
     "joint_acceleration",
     "joint_velocity",
     "parallel_indicator",
-    "plot_workspace",
     "singularity_distances",
     "task_acceleration",
     "task_velocity",

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
@@ -106,66 +105,3 @@ def workspace_map(
         dex = np.sqrt(np.where(smax2 > 0, smin2 / smax2, 0.0))
     dex = np.where(reachable, dex, 0.0)
     return WorkspaceMap(robot, x, y, reachable, type2, dex, working_mode_name(signs))
-
-
-def plot_workspace(
-    ws: WorkspaceMap,
-    *,
-    path: np.ndarray | None = None,
-    pose: tuple[np.ndarray, np.ndarray] | None = None,
-    unit: str = "mm",
-    ax: Any = None,
-) -> Any:
-    """Draw a :class:`WorkspaceMap`: dexterity colour map, type-1 circles (dashed blue),
-    type-2 curves (red), pivots, and optionally a path (n, 2) and a pose ``(q, P)``.
-
-    Returns the matplotlib figure.
-    """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    if ax is None:
-        fig, ax = plt.subplots(figsize=(7, 5.6))
-    else:
-        fig = ax.figure
-    r = ws.robot
-    dex = np.ma.masked_where(~ws.reachable, ws.dexterity)
-    im = ax.pcolormesh(ws.x, ws.y, dex, shading="auto", cmap="viridis", vmin=0, vmax=1)
-    fig.colorbar(im, ax=ax, label="dexterity (inverse condition number of J)")
-    t2 = np.ma.masked_where(~ws.reachable, ws.type2)
-    if np.any(t2 > 0) and np.any(t2 < 0):
-        ax.contour(ws.x, ws.y, t2, levels=[0.0], colors="red", linewidths=1.5)
-    theta = np.linspace(0, 2 * np.pi, 361)
-    for centre, l, L in ((r.A, r.l1, r.L1), (r.D, r.l2, r.L2)):
-        for rad in {abs(l - L), l + L}:
-            if rad > 0:
-                ax.plot(
-                    centre[0] + rad * np.cos(theta), centre[1] + rad * np.sin(theta), "b--", lw=0.8
-                )
-    ax.plot([r.A[0], r.D[0]], [0, 0], "ks", ms=6)
-    ax.plot([], [], "r-", label="type-2 (parallel) singularity")
-    ax.plot([], [], "b--", label="type-1 (serial) singularity")
-    if path is not None:
-        path = np.asarray(path)
-        ax.plot(path[:, 0], path[:, 1], "w-", lw=2.5)
-        ax.plot(path[:, 0], path[:, 1], "k-", lw=1.2, label="path")
-    if pose is not None:
-        from .positions import elbows
-
-        q, P = pose
-        B, C = elbows(r, q)
-        ax.plot(
-            [r.A[0], B[0], P[0], C[0], r.D[0]],
-            [r.A[1], B[1], P[1], C[1], r.D[1]],
-            "o-",
-            color="orange",
-            lw=2,
-        )
-    ax.set_aspect("equal")
-    ax.set_xlabel(f"x [{unit}]")
-    ax.set_ylabel(f"y [{unit}]")
-    ax.set_title(f'Workspace, working mode "{ws.mode}"')
-    ax.legend(loc="lower right", fontsize=8)
-    return fig

@@ -6,14 +6,16 @@ import io
 from typing import Any
 
 import matplotlib
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+from ..analysis import Analysis
+from ..kinematics import WorkspaceMap, elbows, workspace_map
+from ..trajectory import Trajectory
 
-from ..analysis import Analysis  # noqa: E402
-from ..kinematics import elbows, plot_workspace, workspace_map  # noqa: E402
-from ..trajectory import Trajectory  # noqa: E402
+# Figures are matplotlib.figure.Figure objects drawn without pyplot: no global backend or
+# figure registry is touched, as the Matplotlib docs advise for non-interactive output.
 
 
 def _labels(an: Analysis) -> dict[str, str]:
@@ -27,7 +29,8 @@ def _time_plot(an: Analysis, title: str, ylabel: str,
                curves: list[tuple[np.ndarray, np.ndarray, str, str]], *,
                title_size: float = 12) -> Any:
     """One figure of curves ``(t, y, style, label)`` against time."""
-    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    fig = Figure(figsize=(6.4, 4.2))
+    ax = fig.subplots()
     for t, y, style, label in curves:
         ax.plot(t, y, style, label=label, lw=2.0 if "-" == style[-1:] else 1.5)
     ax.set_xlabel(_labels(an)["t"])
@@ -55,11 +58,12 @@ def fig5(an: Analysis) -> Any:
 
 def fig4(an: Analysis) -> Any:
     tr, r = an.trajectory, an.scenario.robot
-    fig, ax = plt.subplots(figsize=(7.6, 5.0))
+    fig = Figure(figsize=(7.6, 5.0))
+    ax = fig.subplots()
     ax.plot(tr.P[:, 0], tr.P[:, 1], "k-", lw=1, label="path")
     times = np.linspace(0, an.law.duration, 9)
     idx = [int(np.argmin(np.abs(tr.t - t))) for t in times]
-    colors = plt.cm.viridis(np.linspace(0, 1, len(idx)))
+    colors = matplotlib.colormaps["viridis"](np.linspace(0, 1, len(idx)))
     for i, c in zip(idx, colors, strict=True):
         B, C = elbows(r, tr.q[i])
         P = tr.P[i]
@@ -127,7 +131,9 @@ def animation_gif(an: Analysis, frames: int = 41) -> bytes:
     from PIL import Image
 
     tr, r = an.trajectory, an.scenario.robot
-    fig, ax = plt.subplots(figsize=(4.8, 3.6), dpi=80)
+    fig = Figure(figsize=(4.8, 3.6), dpi=80)
+    canvas = FigureCanvasAgg(fig)
+    ax = fig.subplots()
     ax.plot(tr.P[:, 0], tr.P[:, 1], "k-", lw=0.8)
     ax.plot([r.A[0], r.D[0]], [0, 0], "ks", ms=6)
     (arm,) = ax.plot([], [], "o-", color="tab:orange", lw=2.5, ms=4)
@@ -145,10 +151,9 @@ def animation_gif(an: Analysis, frames: int = 41) -> bytes:
         arm.set_data([r.A[0], B[i, 0], tr.P[i, 0], C[i, 0], r.D[0]],
                      [r.A[1], B[i, 1], tr.P[i, 1], C[i, 1], r.D[1]])
         label.set_text(f"t = {tr.t[i]:.3f} {an.scenario.units.names['time']}")
-        fig.canvas.draw()
-        rgba = np.asarray(fig.canvas.buffer_rgba())  # type: ignore[attr-defined]
+        canvas.draw()
+        rgba = np.asarray(canvas.buffer_rgba())
         images.append(Image.fromarray(rgba[..., :3]).convert("P", palette=Image.Palette.ADAPTIVE))
-    plt.close(fig)
     buf = io.BytesIO()
     images[0].save(buf, format="GIF", save_all=True, append_images=images[1:], duration=80,
                    loop=0)
@@ -170,7 +175,8 @@ def svg_bytes(fig: Any) -> bytes:
 def tracking_figure(res: Any, units: Any, mass_error: float, payload_kg: float) -> Any:
     """Computed-torque tracking: task and joint errors, and the applied torques against the
     saturation limit (dashed) with the saturated samples marked."""
-    fig, axes = plt.subplots(3, 1, figsize=(6.4, 8), sharex=True)
+    fig = Figure(figsize=(6.4, 8))
+    axes = fig.subplots(3, 1, sharex=True)
     mm = units.length_mm
     axes[0].plot(res.t, res.task_error * mm)
     axes[0].set_ylabel("task-space error [mm]")
@@ -195,4 +201,61 @@ def tracking_figure(res: Any, units: Any, mass_error: float, payload_kg: float) 
     axes[0].set_title(f"Computed-torque tracking: masses {mass_error:+.0%}, unmodelled "
                       f"payload {payload_kg:g} kg", fontsize=10)
     fig.tight_layout()
+    return fig
+
+
+def plot_workspace(
+    ws: WorkspaceMap,
+    *,
+    path: np.ndarray | None = None,
+    pose: tuple[np.ndarray, np.ndarray] | None = None,
+    unit: str = "mm",
+    ax: Any = None,
+) -> Any:
+    """Draw a :class:`WorkspaceMap`: dexterity colour map, type-1 circles (dashed blue),
+    type-2 curves (red), pivots, and optionally a path (n, 2) and a pose ``(q, P)``.
+
+    Returns the matplotlib figure.
+    """
+    if ax is None:
+        fig = Figure(figsize=(7, 5.6))
+        ax = fig.subplots()
+    else:
+        fig = ax.figure
+    r = ws.robot
+    dex = np.ma.masked_where(~ws.reachable, ws.dexterity)
+    im = ax.pcolormesh(ws.x, ws.y, dex, shading="auto", cmap="viridis", vmin=0, vmax=1)
+    fig.colorbar(im, ax=ax, label="dexterity (inverse condition number of J)")
+    t2 = np.ma.masked_where(~ws.reachable, ws.type2)
+    if np.any(t2 > 0) and np.any(t2 < 0):
+        ax.contour(ws.x, ws.y, t2, levels=[0.0], colors="red", linewidths=1.5)
+    theta = np.linspace(0, 2 * np.pi, 361)
+    for centre, l, L in ((r.A, r.l1, r.L1), (r.D, r.l2, r.L2)):
+        for rad in {abs(l - L), l + L}:
+            if rad > 0:
+                ax.plot(
+                    centre[0] + rad * np.cos(theta), centre[1] + rad * np.sin(theta), "b--", lw=0.8
+                )
+    ax.plot([r.A[0], r.D[0]], [0, 0], "ks", ms=6)
+    ax.plot([], [], "r-", label="type-2 (parallel) singularity")
+    ax.plot([], [], "b--", label="type-1 (serial) singularity")
+    if path is not None:
+        path = np.asarray(path)
+        ax.plot(path[:, 0], path[:, 1], "w-", lw=2.5)
+        ax.plot(path[:, 0], path[:, 1], "k-", lw=1.2, label="path")
+    if pose is not None:
+        q, P = pose
+        B, C = elbows(r, q)
+        ax.plot(
+            [r.A[0], B[0], P[0], C[0], r.D[0]],
+            [r.A[1], B[1], P[1], C[1], r.D[1]],
+            "o-",
+            color="orange",
+            lw=2,
+        )
+    ax.set_aspect("equal")
+    ax.set_xlabel(f"x [{unit}]")
+    ax.set_ylabel(f"y [{unit}]")
+    ax.set_title(f'Workspace, working mode "{ws.mode}"')
+    ax.legend(loc="lower right", fontsize=8)
     return fig

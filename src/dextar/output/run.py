@@ -245,8 +245,6 @@ def _claims(an: Analysis, s: dict[str, Any]) -> list[dict[str, Any]]:
 
 
 def _figures(an: Analysis, uniform: Any, od: OutputDir) -> dict[str, bytes]:
-    import matplotlib.pyplot as plt
-
     from . import figures as fg
 
     wanted = an.scenario.output["figures"]
@@ -264,7 +262,6 @@ def _figures(an: Analysis, uniform: Any, od: OutputDir) -> dict[str, bytes]:
         od.write_bytes(f"{name}.png", pngs[name])
         if name != "workspace":
             od.write_bytes(f"{name}.svg", fg.svg_bytes(fig))
-        plt.close(fig)
     return pngs
 
 
