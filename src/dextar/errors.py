@@ -41,3 +41,8 @@ class ConfigError(DextarError, ValueError):
 
 class InfeasibleError(DextarError, ValueError):
     """No motion exists within the given limits (names the point, the motor and the torque)."""
+
+
+class NumericalError(DextarError, ArithmeticError):
+    """A result that is not finite (parameters so large or small that they overflow double
+    precision); names the quantity and the sample."""

@@ -30,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import NumericalError
 from ..units import Units
 
 _TOKENS = {
@@ -68,14 +69,15 @@ def trajectory_columns(tr: Any, units: Units) -> dict[str, np.ndarray]:
 def csv_text(columns: dict[str, np.ndarray]) -> str:
     """CSV with a header row of the column names and one row per sample (17 digits).
 
-    Raises ``ValueError`` naming the column and row of a value that is not finite: no NaN is
-    ever written.
+    Raises :class:`~dextar.errors.NumericalError` naming the column and row of a value that
+    is not finite: no NaN is ever written.
     """
     names = list(columns)
     data = np.column_stack([np.asarray(columns[n], dtype=float) for n in names])
     if not np.isfinite(data).all():
         bad = np.argwhere(~np.isfinite(data))[0]
-        raise ValueError(f"column {names[bad[1]]} is not finite at row {bad[0]}")
+        raise NumericalError(f"column {names[bad[1]]} is not finite at row {bad[0]} (the "
+                             "parameters overflow double precision)")
     buf = io.StringIO()
     buf.write(",".join(names) + "\n")
     np.savetxt(buf, data, delimiter=",", fmt="%.17g")
