@@ -12,9 +12,9 @@ import time
 import numpy as np
 
 from dextar.dynamics import Model, inverse_dynamics, paper_inertia
-from dextar.export.mjcf import mujoco_state, to_mjcf
 from dextar.geometry import DEXTAR_MM
 from dextar.laws import solve_optimal_law
+from dextar.output.mjcf import mujoco_state, to_mjcf
 from dextar.paths import Arc
 from dextar.trajectory import sample_trajectory
 

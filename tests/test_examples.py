@@ -5,7 +5,7 @@ from pathlib import Path
 
 import pytest
 
-from dextar.scenario import load_scenario
+from dextar.config import load_scenario
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
@@ -26,4 +26,4 @@ def test_paper_toml_is_the_default():
     a = load_scenario(str(EXAMPLES / "paper.toml"))
     b = load_scenario(None)
     assert a.robot == b.robot and a.path == b.path and a.inertia == b.inertia
-    assert a.law_spec == b.law_spec and a.units == b.units and a.paper == b.paper
+    assert a.law_table == b.law_table and a.units == b.units and a.paper == b.paper

@@ -5,9 +5,9 @@ import pytest
 
 import dextar as dx
 from dextar.dynamics import Model, inverse_dynamics, paper_inertia
+from dextar.dynamics import time_optimal_law as solve_time_optimal_law
 from dextar.laws import MinimumJerkLaw
 from dextar.paths import Arc, Line
-from dextar.time_optimal import solve_time_optimal_law
 from dextar.trajectory import sample_trajectory
 
 ROBOT = dx.DEXTAR_MM.scaled(1 / 87)
@@ -85,10 +85,10 @@ CIRCLE = {"path": {"type": "arc", "radius": 30.0, "center": [0.0, 120.0], "start
 
 def test_limits_hold_on_the_output_through_velocity_reversals():
     from dextar.analysis import analyze, torque_limit_ratio
-    from dextar.scenario import scenario_from_dict
+    from dextar.config import scenario_from_dict
 
     sc = scenario_from_dict(CIRCLE)
-    an = analyze(sc)
+    an = analyze(sc.inputs(), sc.law())
     law = an.law
     assert law.success and law.status == 0 and "within the limits" in law.message
     # the written samples and a much denser sampling: torques within 1 + 1e-3 of the limits

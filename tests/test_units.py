@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from dextar.analysis import analyze
-from dextar.scenario import scenario_from_dict
+from dextar.config import scenario_from_dict
 
 BASE = {
     "path": {"type": "line", "start": [-60.0, 90.0], "end": [60.0, 115.0]},
@@ -20,7 +20,7 @@ BASE = {
 def run(units):
     doc = {**BASE, "output": {"units": units, "samples": 201}}
     sc = scenario_from_dict(doc)
-    return sc, analyze(sc)
+    return sc, analyze(sc.inputs(), sc.law())
 
 
 def test_paper_and_si_units_agree():

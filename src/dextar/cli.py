@@ -12,14 +12,10 @@ import os
 import sys
 import warnings
 from collections.abc import Callable, Sequence
-from pathlib import Path
 from typing import Any, NoReturn
 
-import numpy as np
-
-from . import __version__
-from .config import TABLES, RobotConfig, check_tables, load_toml, robot_from_table
-from .errors import ConfigError, DextarError
+from . import __version__, jobs
+from .errors import DextarError
 from .geometry import MODE_ALIASES, WORKING_MODES, canonical_working_mode
 
 MODE_HELP = "working mode: ++, +-, -+ or -- (aliases pp, pm, mp, mm)"
@@ -39,70 +35,36 @@ class _Parser(argparse.ArgumentParser):
         raise SystemExit(2)
 
 
-def _robot(path: str | None) -> RobotConfig:
-    if path is None:
-        return robot_from_table(None)
-    doc = load_toml(path)
-    check_tables(doc, TABLES)
-    return robot_from_table(doc.get("robot"))
-
-
 def _emit(args: argparse.Namespace, payload: dict[str, Any], text: str) -> None:
     """Print the JSON payload (``--json``) or the text; to stderr when stdout carries data."""
     stream = sys.stderr if getattr(args, "out", None) == "-" else sys.stdout
     print(json.dumps(payload) if args.json else text, file=stream)
 
 
-def _shown(path: str | Path, name: str | None = None) -> str:
-    """A path as printed: no doubled or trailing separators."""
-    p = Path(path)
-    return str(p / name) if name else str(p)
+def _print(args: argparse.Namespace, res: Any) -> int:
+    """Print a job's result: data to stdout (``--out -``), warnings to stderr, then the
+    payload (``--json``) or the words."""
+    if res.data is not None:
+        sys.stdout.write(res.data)
+        sys.stdout.flush()
+    for w in res.warnings:
+        sys.stderr.write(w + "\n")
+    if not getattr(args, "quiet", False) or args.json:
+        _emit(args, res.payload, res.text)
+    return 0
 
 
 def cmd_ik(args: argparse.Namespace) -> int:
-    from .kinematics import inverse_kinematics
-
-    rc = _robot(args.robot)
-    mode = args.mode or rc.working_mode
-    q = inverse_kinematics(rc.geometry_mm, [args.x, args.y], mode)
-    phi, psi = (float(v) for v in np.degrees(q))
-    _emit(args, {"phi_deg": phi, "psi_deg": psi, "mode": mode},
-          f"phi = {phi:.6f} deg, psi = {psi:.6f} deg (working mode {mode})")
-    return 0
+    return _print(args, jobs.ik(args.x, args.y, mode=args.mode, robot=args.robot))
 
 
 def cmd_fk(args: argparse.Namespace) -> int:
-    from .kinematics import direct_kinematics
-
-    rc = _robot(args.robot)
-    assembly = args.assembly or rc.assembly_mode
-    P = direct_kinematics(rc.geometry_mm, np.radians([args.phi, args.psi]), assembly)
-    x, y = float(P[0]), float(P[1])
-    _emit(args, {"x_mm": x, "y_mm": y, "assembly": assembly},
-          f"x = {x:.6f} mm, y = {y:.6f} mm (assembly mode {assembly})")
-    return 0
+    return _print(args, jobs.fk(args.phi, args.psi, assembly=args.assembly, robot=args.robot))
 
 
 def cmd_workspace(args: argparse.Namespace) -> int:
-    from .kinematics import workspace_map
-    from .output.figures import plot_workspace
-    from .output.files import save_figure
-
-    rc = _robot(args.robot)
-    mode = args.mode or rc.working_mode
-    out = _out_file(args.out, ".png", ".svg")
-    ws = workspace_map(rc.geometry_mm, mode, resolution=args.resolution)
-    save_figure(plot_workspace(ws), out, dpi=150)
-    area = ws.reachable_area
-    reach = ws.dexterity[ws.reachable]
-    payload = {"out": str(out), "mode": mode, "robot_mm": rc.geometry_mm.as_dict(),
-               "resolution": [int(ws.x.size), int(ws.y.size)], "reachable_area_mm2": area,
-               "dexterity_mean": float(reach.mean()) if reach.size else 0.0,
-               "dexterity_max": float(reach.max()) if reach.size else 0.0,
-               "type2_curve_in_workspace": bool((ws.type2[ws.reachable] > 0).any()
-                                                and (ws.type2[ws.reachable] < 0).any())}
-    _emit(args, payload, f"wrote {out} (working mode {mode}, reachable area {area:.0f} mm^2)")
-    return 0
+    return _print(args, jobs.workspace(args.out, mode=args.mode, resolution=args.resolution,
+                                       robot=args.robot))
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -213,208 +175,24 @@ _ALIAS_OF = {v: k for k, v in MODE_ALIASES.items()}
 
 
 # ----------------------------------------------------------------------------- stages
-def _scenario(path: str | None) -> Any:
-    from .scenario import load_scenario
-
-    return load_scenario(path)
-
-
-def _units_note(sc: Any) -> str:
-    u = sc.units
-    n = u.names
-    if u.system == "paper":
-        return (f"paper units: length L = {u.length_mm:g} mm, mass m = {u.mass_kg:g} kg, "
-                f"time T = {u.time_s:g} s; angles in rad")
-    return f"SI units: {n['length']}, {n['mass']}, {n['time']}; torques in N m; angles in rad"
-
-
-def _out_file(out: str, *suffixes: str) -> Path | None:
-    """The ``--out`` file, refused unless it ends in one of ``suffixes``; None for ``-``
-    (stdout)."""
-    if out == "-":
-        return None
-    p = Path(out)
-    if p.suffix.lower() not in suffixes:
-        raise ConfigError(f"--out {out!r} must end in {' or '.join(suffixes)} (or be - for "
-                          "stdout)")
-    if p.is_dir():
-        raise ConfigError(f"--out {out!r} is a directory")
-    return p
-
-
-def _write(out: Path | None, text: str) -> str:
-    """Write ``text`` atomically to ``out`` (stdout for None); the words for the message."""
-    from .output.files import write_text
-
-    if out is None:
-        sys.stdout.write(text)
-        sys.stdout.flush()
-        return "stdout"
-    write_text(out, text)
-    return str(out)
-
-
-def _law_line(sc: Any, law: Any) -> str:
-    """Motion time and the law solver's outcome, in words."""
-    u = sc.units
-    secs = law.duration * u.time_s
-    time = (f"{secs:.6g} s" if u.system == "si"
-            else f"{law.duration:.6g} {u.names['time']} ({secs:.6g} s)")
-    return f"{law.name} law: motion time {time}; status {law.status}: {law.message}"
-
-
-def _law_payload(sc: Any, law: Any) -> dict[str, Any]:
-    return {"law": law.name, "duration": law.duration, "duration_s": law.duration * sc.units.time_s,
-            "status": int(law.status), "success": bool(law.success), "message": law.message}
-
-
-def _warn_law(args: argparse.Namespace, law: Any) -> None:
-    if not law.success:
-        sys.stderr.write(f"dextar {args.command}: warning: {law.name} law status {law.status}: "
-                         f"{law.message}\n")
-
-
 def cmd_plan(args: argparse.Namespace) -> int:
-    from .output.tables import csv_text, trajectory_columns
-
-    out = _out_file(args.out, ".csv")
-    sc = _scenario(args.config)
-    law = sc.law()
-    tr = sc.trajectory(law)
-    where = _write(out, csv_text(trajectory_columns(tr, sc.units)))
-    payload: dict[str, Any] = {"out": where, "samples": int(tr.t.size), **_law_payload(sc, law),
-                               "units": sc.units.describe()}
-    lines = [_law_line(sc, law)]
-    if law.name == "optimal":
-        kin, inert = law.kinetic, law.inertial
-        payload.update(cost=kin + inert, cost_kinetic=kin, cost_inertial=inert)
-        lines.append(f"cost Phi = {kin + inert:.10g} (kinetic {kin:.10g}, inertial "
-                     f"{inert:.10g}) [{sc.units.names['energy']} x {sc.units.names['time']}]")
-    lines.append(f"wrote {where}: {tr.t.size} samples, working mode {tr.mode} "
-                 f"({_units_note(sc)})")
-    _warn_law(args, law)
-    _emit(args, payload, "\n".join(lines))
-    return 0
+    return _print(args, jobs.plan(args.config, args.out))
 
 
 def cmd_torques(args: argparse.Namespace) -> int:
-    from .analysis import analyze
-    from .output.tables import csv_text, torque_columns
-
-    out = _out_file(args.out, ".csv")
-    sc = _scenario(args.config)
-    an = analyze(sc)
-    where = _write(out, csv_text(torque_columns(an)))
-    peak = np.abs(an.tau).max(axis=0)
-    payload: dict[str, Any] = {"out": where, "samples": int(an.trajectory.t.size),
-                               **_law_payload(sc, an.law),
-                               "peak_torque": [float(v) for v in peak],
-                               "units": sc.units.describe()}
-    text = (f"{_law_line(sc, an.law)}\nwrote {where}: {an.trajectory.t.size} samples; peak "
-            f"|tau| = {peak[0]:.6g}, {peak[1]:.6g} [{sc.units.names['torque']}] "
-            f"({_units_note(sc)})")
-    if an.paper is not None:
-        payload["paper_model_error"] = an.paper.error
-        text += (f"\npaper model (42) error: max {an.paper.error['max_relative']:.1%}, RMS "
-                 f"{an.paper.error['rms_relative']:.1%} of the peak exact torque")
-    else:
-        from .dynamics.paper import paper_model_limits
-
-        why = paper_model_limits(sc.robot, sc.inertia)
-        text += f"\nno paper-model columns: the paper's simplified model does not apply ({why})"
-    _warn_law(args, an.law)
-    _emit(args, payload, text)
-    return 0
+    return _print(args, jobs.torques(args.config, args.out))
 
 
 def cmd_simulate(args: argparse.Namespace) -> int:
-    from .control import simulate_computed_torque
-    from .dynamics import Model
-    from .output.figures import png_bytes, tracking_figure
-    from .output.outdir import OutputDir
-    from .output.tables import csv_text, unit_tokens
-
-    sc = _scenario(args.config)
-    tr = sc.trajectory()
-    c = sc.control
-    controller = Model(sc.robot, sc.inertia, tr.assembly)
-    plant_inertia = sc.inertia.scaled_masses(1.0 + c["mass_error"])
-    plant_inertia = plant_inertia.with_(payload=plant_inertia.payload + c["payload"])
-    plant = Model(sc.robot, plant_inertia, tr.assembly)
-    res = simulate_computed_torque(tr, controller, plant, natural_frequency=c["natural_frequency"],
-                                   damping=c["damping"], torque_limit=c["torque_limit"],
-                                   initial_error=c["initial_error"])
-    mm = sc.units.length_mm
-    u = unit_tokens(sc.units)
-    cols = {f"t_{u['time']}": res.t, "phi_des_rad": tr.q[:, 0], "psi_des_rad": tr.q[:, 1],
-            "phi_rad": res.q[:, 0], "psi_rad": res.q[:, 1], "err_phi_rad": res.joint_error[:, 0],
-            "err_psi_rad": res.joint_error[:, 1], "task_error_mm": res.task_error * mm,
-            f"tau1_{u['torque']}": res.tau[:, 0], f"tau2_{u['torque']}": res.tau[:, 1],
-            "saturated": res.saturated.astype(float)}
-    summ = res.summary()
-    report = {"units": sc.units.describe(), "control": {k: v for k, v in c.items()},
-              "status": res.status, "message": res.message,
-              "max_task_error_mm": summ["max_task_error"] * mm,
-              "rms_task_error_mm": summ["rms_task_error"] * mm,
-              "final_task_error_mm": summ["final_task_error"] * mm,
-              "max_joint_error_deg": float(np.degrees(summ["max_joint_error_rad"])),
-              "saturated_fraction": summ["saturated_fraction"]}
-    fig = tracking_figure(res, sc.units, c["mass_error"], c["payload_kg"])
-    with OutputDir(args.out, force=args.force) as od:
-        od.write_text("tracking.csv", csv_text(cols))
-        od.write_bytes("tracking.png", png_bytes(fig))
-        od.write_text("tracking.json", json.dumps(report, indent=2, default=str) + "\n")
-    if summ["saturated_fraction"] > 0:
-        sys.stderr.write(f"dextar simulate: warning: the torque limit "
-                         f"{c['torque_limit_nm']:g} N m saturates a motor during "
-                         f"{summ['saturated_fraction']:.1%} of the motion; tracking is not "
-                         "guaranteed\n")
-    files = ", ".join(_shown(args.out, n) for n in ("tracking.csv", "tracking.png",
-                                                     "tracking.json"))
-    _emit(args, report, f"wrote {files}: max task error {report['max_task_error_mm']:.4g} mm, "
-          f"max joint error {report['max_joint_error_deg']:.4g} deg, torque saturated "
-          f"{report['saturated_fraction']:.1%} of the time")
-    return 0
+    return _print(args, jobs.simulate(args.config, args.out, force=args.force))
 
 
 def cmd_export(args: argparse.Namespace) -> int:
-    from .export.mjcf import to_mjcf
-
-    sc = _scenario(args.config)
-    out = _out_file(args.out, ".xml")
-    tr = sc.trajectory(samples=2)
-    where = _write(out, to_mjcf(sc.model(tr.assembly), start=(tr.q[0], tr.dq[0])))
-    _emit(args, {"out": where, "units": sc.units.describe()},
-          f"wrote {where} (MuJoCo model in {_units_note(sc)}; keyframe 'start' at the "
-          "motion's start)")
-    return 0
+    return _print(args, jobs.export_mjcf(args.config, args.out))
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    from .output.run import run
-
-    sc = _scenario(args.config)
-    s = run(sc, args.out, force=args.force, quiet=args.quiet)
-    if not s["law"]["success"]:
-        sys.stderr.write(f"dextar run: warning: {s['law']['type']} law status "
-                         f"{s['law']['status']}: {s['law']['message']}\n")
-    if args.json:
-        print(json.dumps(s))
-    elif not args.quiet:
-        law = s["law"]
-        secs = law["duration_s"]
-        claims = s.get("claims", [])
-        lines = [f"wrote {len(s['files'])} files to {_shown(args.out)} (open "
-                 f"{_shown(args.out, 'report.html')})",
-                 f"{law['type']} law: motion time {secs:.6g} s; status {law['status']}: "
-                 f"{law['message']}"]
-        if "cost" in s:
-            lines.append(f"cost Phi = {s['cost']['total']:.8g} [{s['cost']['unit']}]")
-        lines.append(f"peak |tau| exact = {max(s['torques']['exact']['peak']):.6g} "
-                     f"{s['units']['torque_unit']}")
-        lines += [f"  {c['verdict']:>11}: {c['claim']} ({c['value']:.3g})" for c in claims]
-        print("\n".join(lines))
-    return 0
+    return _print(args, jobs.run(args.config, args.out, force=args.force, quiet=args.quiet))
 
 
 def _register_stages(sub: Any) -> None:

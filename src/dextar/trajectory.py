@@ -10,17 +10,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import ParameterError, ReachError, SingularityError
+from .errors import ParameterError
 from .geometry import FiveBar, assembly_mode_name, parse_working_mode, working_mode_name
-from .kinematics import (
-    DEFAULT_SINGULARITY_TOL,
-    assembly_mode,
-    inverse_kinematics,
-    joint_acceleration,
-    joint_velocity,
-    parallel_indicator,
-    singularity_distances,
-)
+from .kinematics import assembly_mode, inverse_kinematics, joint_acceleration, joint_velocity
+from .kinematics.checker import DEFAULT_TOLERANCES, Tolerances, check_poses, check_reach
 from .laws import Law
 from .paths import Path
 from .units import Units
@@ -97,20 +90,30 @@ def path_motion(path: Path, law: Law, t: np.ndarray) -> tuple[np.ndarray, ...]:
 
 def sample_trajectory(robot: FiveBar, path: Path, law: Law, *, mode: str = "+-",
                       samples: int = 1001, times: np.ndarray | None = None,
-                      tol: float = DEFAULT_SINGULARITY_TOL,
+                      tolerances: Tolerances = DEFAULT_TOLERANCES,
                       units: Units | None = None) -> Trajectory:
     """Sample ``law`` along ``path`` and map it to joint space in working mode ``mode``.
 
     Parameters
     ----------
+    robot : FiveBar
+    path : Path
+    law : Law
+        Covers the path's length.
+    mode : str
+        Working mode (name or alias).
     samples : int
         Number of samples on a uniform grid including ``t = 0`` and ``t = T``.
     times : ndarray, optional
         Explicit sample times (overrides ``samples``).
-    tol : float
-        Smallest normalised distance to a singularity accepted on the way.
+    tolerances : Tolerances
+        The geometry checker's tolerances on the way.
     units : Units, optional
         The run's units, only to state points in mm and times in seconds in an error.
+
+    Returns
+    -------
+    Trajectory
 
     Raises
     ------
@@ -125,24 +128,15 @@ def sample_trajectory(robot: FiveBar, path: Path, law: Law, *, mode: str = "+-",
                              f"{path.length:.9g} long")
     t = law.times(samples) if times is None else np.asarray(times, dtype=float)
     s, ds, dds, p, dp, ddp, P, dP, ddP = path_motion(path, law, t)
-    _check_reach(robot, t, P, units)
+    words = _Words(units)
+
+    def where(i: int) -> str:
+        return f"at {words.time(t[i])} (sample {i})"
+
+    check_reach(robot, P, lambda i: f"the path leaves the workspace {where(i)}", words.point,
+                words.length)
     q = inverse_kinematics(robot, P, mode, unwrap=True)
-    d1, d2 = singularity_distances(robot, q, P)
-    det = parallel_indicator(robot, q, P)
-    crossing = np.concatenate([[False], np.sign(det[1:]) != np.sign(det[:-1])])
-    for kind, dist in ((1, d1), (2, d2)):
-        bad = dist < tol
-        if kind == 2:
-            bad = bad | crossing
-        if bad.any():
-            i = int(np.flatnonzero(bad)[0])
-            what = "serial (type 1)" if kind == 1 else "parallel (type 2)"
-            raise SingularityError(
-                f"the path meets a {what} singularity in working mode {mode} at "
-                f"{_when(t[i], units)} (sample {i}): P = {_point(P[i], units)}, q = "
-                f"({np.degrees(q[i, 0]):.6g}, {np.degrees(q[i, 1]):.6g}) deg, normalised "
-                f"distance {dist[i]:.3g}" + (f" below {tol:g}" if dist[i] < tol else
-                                             ", crossed since the previous sample"))
+    check_poses(robot, q, P, tolerances=tolerances, where=where, point=words.point, mode=mode)
     dq = joint_velocity(robot, q, P, dP, tol=0.0)
     ddq = joint_acceleration(robot, q, P, dq, dP, ddP, tol=0.0)
     sig = assembly_mode(robot, q, P)
@@ -151,10 +145,11 @@ def sample_trajectory(robot: FiveBar, path: Path, law: Law, *, mode: str = "+-",
 
 
 def check_path(robot: FiveBar, path: Path, *, mode: str = "+-", samples: int = 2001,
-               tol: float = DEFAULT_SINGULARITY_TOL, units: Units | None = None) -> None:
-    """Check a path before any law is planned on it: every one of ``samples`` points equally
-    spaced in the path parameter within reach, and clear of both singularity types in working
-    mode ``mode``. Errors name the path parameter and the point (in mm with ``units``).
+               tolerances: Tolerances = DEFAULT_TOLERANCES, units: Units | None = None) -> None:
+    """Check a path before any law is planned on it: ``samples`` points equally spaced in the
+    path parameter, within reach and clear of both singularity types in working mode ``mode``
+    (the geometry checker). Errors name the path parameter and the point (in mm with
+    ``units``).
 
     Raises
     ------
@@ -163,54 +158,25 @@ def check_path(robot: FiveBar, path: Path, *, mode: str = "+-", samples: int = 2
     mode = working_mode_name(parse_working_mode(mode))
     p = np.linspace(path.p0, path.p1, samples)
     P = path.position(p)
-    where = [f"p = {v:.6g}" for v in p]
-    try:
-        _check_reach(robot, p, P, None)
-    except ReachError:
-        for leg, pivot in ((1, robot.A), (2, robot.D)):
-            rin, rout = robot.reach(leg)
-            rho = np.hypot(P[:, 0] - pivot[0], P[:, 1])
-            bad = (rho < rin) | (rho > rout)
-            if bad.any():
-                i = int(np.flatnonzero(bad)[0])
-                out = max(rin - rho[i], rho[i] - rout)
-                by = f"{out:.6g}" if units is None else f"{units.mm(out):.6g} mm"
-                raise ReachError(f"the path leaves the workspace at {where[i]}: point "
-                                 f"{_point(P[i], units)} is out of reach of leg {leg} by "
-                                 f"{by}") from None
+    words = _Words(units)
+    check_reach(robot, P, lambda i: f"the path leaves the workspace at p = {p[i]:.6g}",
+                words.point, words.length)
     q = inverse_kinematics(robot, P, mode, unwrap=True)
-    d1, d2 = singularity_distances(robot, q, P)
-    det = parallel_indicator(robot, q, P)
-    crossing = np.concatenate([[False], np.sign(det[1:]) != np.sign(det[:-1])])
-    for kind, dist in ((1, d1), (2, d2)):
-        bad = (dist < tol) | (crossing if kind == 2 else False)
-        if bad.any():
-            i = int(np.flatnonzero(bad)[0])
-            what = "serial (type 1)" if kind == 1 else "parallel (type 2)"
-            raise SingularityError(
-                f"the path meets a {what} singularity in working mode {mode} at {where[i]}: "
-                f"P = {_point(P[i], units)}, q = ({np.degrees(q[i, 0]):.6g}, "
-                f"{np.degrees(q[i, 1]):.6g}) deg, normalised distance {dist[i]:.3g}"
-                + (f" below {tol:g}" if dist[i] < tol else ", crossed on the way"))
+    check_poses(robot, q, P, tolerances=tolerances, where=lambda i: f"at p = {p[i]:.6g}",
+                point=words.point, mode=mode)
 
 
-def _when(t: float, units: Units | None) -> str:
-    return f"t = {t:.6g}" if units is None else units.time_text(t)
+@dataclass(frozen=True)
+class _Words:
+    """Times, points and lengths in the user's words (mm and s with units, else run units)."""
 
+    units: Units | None
 
-def _point(P: np.ndarray, units: Units | None) -> str:
-    return f"({P[0]:.6g}, {P[1]:.6g})" if units is None else units.point_text(P)
+    def time(self, t: float) -> str:
+        return f"t = {t:.6g}" if self.units is None else self.units.time_text(t)
 
+    def point(self, P: np.ndarray) -> str:
+        return f"({P[0]:.6g}, {P[1]:.6g})" if self.units is None else self.units.point_text(P)
 
-def _check_reach(robot: FiveBar, t: np.ndarray, P: np.ndarray, units: Units | None) -> None:
-    for leg, pivot in ((1, robot.A), (2, robot.D)):
-        rin, rout = robot.reach(leg)
-        rho = np.hypot(P[:, 0] - pivot[0], P[:, 1])
-        bad = (rho < rin) | (rho > rout)
-        if bad.any():
-            i = int(np.flatnonzero(bad)[0])
-            out = max(rin - rho[i], rho[i] - rout)
-            by = f"{out:.6g}" if units is None else f"{units.mm(out):.6g} mm"
-            raise ReachError(
-                f"the path leaves the workspace at {_when(t[i], units)} (sample {i}): point "
-                f"{_point(P[i], units)} is out of reach of leg {leg} by {by}")
+    def length(self, x: float) -> str:
+        return f"{x:.6g}" if self.units is None else f"{self.units.mm(x):.6g} mm"

@@ -46,7 +46,7 @@ def test_robot_file(tmp_path, capsys):
         ("[robot]\nl1 = 'x'\n", "[robot].l1 must be a number"),
         ("[robot]\nfoo = 1\n", "[robot].foo is not known"),
         ("[robot]\nl1 = 1\n", "[robot].l2 is required"),
-        ("[robot]\npreset = 'dextar'\nd = -3\n", "d = -3"),
+        ("[robot]\npreset = 'dextar'\nd = -3\n", "[robot].d must be positive, got -3"),
         ("[robot]\nworking_mode = '+x'\n", "working mode '+x'"),
         ("[robt]\n", "[robt] is not known"),
         ("[robot\n", "not valid TOML"),

@@ -100,7 +100,7 @@ def test_export_loads_in_mujoco(tmp_path):
     ('[law]\ntype = "time-optimal"\n', "[law].torque_limit is required"),
     ('[path]\ntype = "line"\nstart = [0.0, 100.0]\n', "[path].end is required"),
     ('[path]\nradius = "big"\n', "[path].radius must be a number"),
-    ('[inertia]\ndistal_mass = -0.1\n', "distal rod BP mass"),
+    ('[inertia]\ndistal_mass = -0.1\n', "[inertia].distal_mass must be at least 0"),
     ('[inertia]\nproximal_mass = [0.1, 0.2, 0.3]\n', "[inertia].proximal_mass"),
     ('[output]\nunits = "imperial"\n', "[output].units"),
     ('[output]\nfigures = ["fig99"]\n', "fig99"),

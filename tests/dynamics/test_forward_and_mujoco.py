@@ -3,7 +3,7 @@ import pytest
 
 from dextar.dynamics import Model, inverse_dynamics, paper_inertia
 from dextar.dynamics.forward import forward_dynamics, torques_from_samples
-from dextar.export.mjcf import mujoco_state, to_mjcf
+from dextar.output.mjcf import mujoco_state, to_mjcf
 from dextar.trajectory import sample_trajectory
 
 from .conftest import ROBOT, SEMI
@@ -86,7 +86,7 @@ def test_mujoco_replays_our_torques_open_loop(tmp_path):
     """The exported model (friction, gravity, payload, rotors; keyframe at the start) driven
     open loop by our torques follows the paper's motion within 1e-3 rad."""
     from dextar.cli import main
-    from dextar.scenario import scenario_from_dict
+    from dextar.config import scenario_from_dict
 
     doc = {"inertia": {"effector_mass": 1.0, "payload": 0.1, "proximal_mass": 0.08,
                        "distal_mass": 0.1, "rotor_inertia": 50.0},

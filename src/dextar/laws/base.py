@@ -188,3 +188,28 @@ def _curvature_at_s(path: object, s: np.ndarray) -> np.ndarray:
     if k is not None:
         return np.full_like(s, k)
     return path.curvature(path.parameter_at(s))[0]  # type: ignore[attr-defined]
+
+
+def _register() -> None:
+    from ..params import REQUIRED, Param
+    from .registry import LawType, register_law
+
+    duration = Param("number", "s", 1.0, "motion time", positive=True)
+    register_law(LawType("uniform", {"duration": duration},
+                         lambda r: UniformLaw(r.path.length, r.params["duration"]),
+                         "constant speed; starts and stops at speed (the paper's Fig. 3)"))
+    register_law(LawType("min-jerk", {"duration": duration},
+                         lambda r: MinimumJerkLaw(r.path.length, r.params["duration"]),
+                         "rest-to-rest quintic, minimum jerk"))
+    register_law(LawType(
+        "trapezoid",
+        {"vmax": Param("number", "mm/s", REQUIRED, "cruise speed limit", positive=True),
+         "amax": Param("number", "mm/s^2", REQUIRED, "acceleration", positive=True),
+         "duration": Param("number", "s", None, "motion time (default: the fastest)",
+                           positive=True)},
+        lambda r: TrapezoidalLaw(r.path.length, r.params["vmax"], r.params["amax"],
+                                 r.params.get("duration")),
+        "trapezoidal speed: accelerate, cruise, decelerate"))
+
+
+_register()

@@ -424,3 +424,20 @@ class _Collocation:
         a = coef[4]
         tail = float(np.abs(a[-4:]).max() / max(np.abs(a).max(), 1e-300))
         return resid, tail
+
+
+def _register() -> None:
+    from ..params import Param
+    from .registry import LawType, register_law
+
+    register_law(LawType(
+        "optimal",
+        {"duration": Param("number", "s", 1.0, "motion time", positive=True),
+         "eta": Param("number", "s^2/kg", 0.1, "weight of the mean-square inertia forces",
+                      positive=True)},
+        lambda r: solve_optimal_law(r.path, duration=r.params["duration"], eta=r.params["eta"],
+                                    mass=r.mass),
+        "the paper's optimal law: minimise (m/2) Int |rdot|^2 + (eta m^2/2) Int |rddot|^2"))
+
+
+_register()

@@ -19,7 +19,7 @@ from ..trajectory import Trajectory
 
 
 def _labels(an: Analysis) -> dict[str, str]:
-    n = an.scenario.units.names
+    n = an.inputs.units.names
     return {"t": f"time t [{n['time']}]", "E": f"energy [{n['energy']}]",
             "tau": f"torque [{n['torque']}]", "w": f"angular velocity [rad/{n['time']}]",
             "len": n["length"]}
@@ -57,7 +57,7 @@ def fig5(an: Analysis) -> Any:
 
 
 def fig4(an: Analysis) -> Any:
-    tr, r = an.trajectory, an.scenario.robot
+    tr, r = an.trajectory, an.inputs.robot
     fig = Figure(figsize=(7.6, 5.0))
     ax = fig.subplots()
     ax.plot(tr.P[:, 0], tr.P[:, 1], "k-", lw=1, label="path")
@@ -108,7 +108,7 @@ def fig8(an: Analysis) -> Any:
 
 
 def fig9(an: Analysis) -> Any:
-    tr, ine = an.trajectory, an.scenario.inertia
+    tr, ine = an.trajectory, an.inputs.inertia
     curves = [(tr.t, an.tau[:, 0], "b-", r"$M_1$ exact"), (tr.t, an.tau[:, 1], "g-", r"$M_2$ exact")]
     if an.paper is not None:
         curves += [(tr.t, an.paper.tau[:, 0], "b--", r"$M_1$ paper (42)"),
@@ -119,7 +119,7 @@ def fig9(an: Analysis) -> Any:
 
 
 def workspace_figure(an: Analysis) -> Any:
-    sc = an.scenario
+    sc = an.inputs
     ws = workspace_map(sc.robot, sc.mode, resolution=241)
     mid = len(an.trajectory.t) // 2
     return plot_workspace(ws, path=an.trajectory.P, unit=sc.units.names["length"],
@@ -130,7 +130,7 @@ def animation_gif(an: Analysis, frames: int = 41) -> bytes:
     """A GIF of the robot following the path (``frames`` poses equally spaced in time)."""
     from PIL import Image
 
-    tr, r = an.trajectory, an.scenario.robot
+    tr, r = an.trajectory, an.inputs.robot
     fig = Figure(figsize=(4.8, 3.6), dpi=80)
     canvas = FigureCanvasAgg(fig)
     ax = fig.subplots()
@@ -150,7 +150,7 @@ def animation_gif(an: Analysis, frames: int = 41) -> bytes:
     for i in np.linspace(0, len(tr.t) - 1, frames).round().astype(int):
         arm.set_data([r.A[0], B[i, 0], tr.P[i, 0], C[i, 0], r.D[0]],
                      [r.A[1], B[i, 1], tr.P[i, 1], C[i, 1], r.D[1]])
-        label.set_text(f"t = {tr.t[i]:.3f} {an.scenario.units.names['time']}")
+        label.set_text(f"t = {tr.t[i]:.3f} {an.inputs.units.names['time']}")
         canvas.draw()
         rgba = np.asarray(canvas.buffer_rgba())
         images.append(Image.fromarray(rgba[..., :3]).convert("P", palette=Image.Palette.ADAPTIVE))

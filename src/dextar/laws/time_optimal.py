@@ -1,5 +1,11 @@
 """Time-optimal law of motion along a path under motor torque and speed limits.
 
+The solver needs the robot's dynamics along the path only through the small
+:class:`PathDynamics` interface (implemented for the exact closed-chain model by
+:class:`dextar.dynamics.along_path.RobotAlongPath`), so this module, like every law, sits
+below the trajectory and dynamics stages. ``dextar.dynamics.time_optimal_law(model, path,
+...)`` is the one-call form.
+
 Along the path (arc length ``s``) the joint motion is ``qdot = q' sdot`` and
 ``qddot = q' sddot + q'' sdot^2``, so with ``x = sdot^2`` and ``u = sddot`` the exact inverse
 dynamics are affine in ``(x, u)`` up to friction:
@@ -36,18 +42,19 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Protocol
 
 import numpy as np
 
-from .dynamics import Model, gravity_torques, inverse_dynamics, mass_matrix
-from .errors import InfeasibleError, ParameterError
-from .laws import Law, UniformLaw
-from .paths import Path
-from .trajectory import Trajectory, sample_trajectory
-from .units import Units
+from ..errors import InfeasibleError, ParameterError
+from ..units import Units
+from .base import Law
 
 #: Greatest number of solves (friction tangent updates and limit margins).
 MAX_SOLVES = 8
+#: Where the output check samples each segment (fractions of its duration): both ends
+#: (the acceleration jumps at the knots) and three interior points.
+CHECK_FRACTIONS = np.array([1e-9, 0.25, 0.5, 0.75, 1.0 - 1e-9])
 
 
 @dataclass(frozen=True)
@@ -99,8 +106,22 @@ class TimeOptimalLaw(Law):
 
 
 @dataclass(frozen=True)
-class _Coefficients:
-    """The path dynamics on the grid: ``tau = a u + b x + g + f``; arrays (N + 1, 2)."""
+class PathCoefficients:
+    """The path dynamics on a grid of arc lengths: ``tau = a u + b x + g + f``.
+
+    Attributes
+    ----------
+    s : ndarray, shape (N + 1,)
+        Arc lengths, equally spaced from 0 to the path's length.
+    P : ndarray, shape (N + 1, 2)
+        End-effector positions (for the words of an error).
+    a, b, g : ndarray, shape (N + 1, 2)
+        ``M q'``, ``M q'' + c(q, q')`` and the gravity torques.
+    dq_ds : ndarray, shape (N + 1, 2)
+        ``q'``, the joint rates per unit arc length.
+    coulomb, viscous : ndarray, shape (2,)
+        The motors' friction coefficients.
+    """
 
     s: np.ndarray
     P: np.ndarray
@@ -108,28 +129,37 @@ class _Coefficients:
     b: np.ndarray
     g: np.ndarray
     dq_ds: np.ndarray
-    coulomb: np.ndarray  # (2,)
-    viscous: np.ndarray  # (2,)
+    coulomb: np.ndarray
+    viscous: np.ndarray
 
 
-def solve_time_optimal_law(model: Model, path: Path, *, torque_limit: tuple[float, float],
-                           speed_limit: tuple[float, float] | None = None, mode: str = "+-",
-                           grid: int = 400, tol: float = 1e-3,
-                           units: Units | None = None) -> TimeOptimalLaw:
-    """The fastest rest-to-rest law along ``path`` within motor torque and speed limits.
+class PathDynamics(Protocol):
+    """The robot along a path, as the time-optimal law needs it."""
+
+    def coefficients(self, segments: int) -> PathCoefficients:
+        """The coefficients on ``segments + 1`` equally spaced arc lengths."""
+        ...
+
+    def ratios(self, law: Law, times: np.ndarray, torque_limit: np.ndarray,
+               speed_limit: np.ndarray) -> tuple[float, float]:
+        """Largest ``|tau_i| / torque_limit_i`` and ``|qdot_i| / speed_limit_i`` of ``law``
+        at ``times`` (exact model with gravity and friction)."""
+        ...
+
+
+def solve_time_optimal_law(dynamics: PathDynamics, *, torque_limit: tuple[float, float],
+                           speed_limit: tuple[float, float] | None = None, grid: int = 400,
+                           tol: float = 1e-3, units: Units | None = None) -> TimeOptimalLaw:
+    """The fastest rest-to-rest law along a path within motor torque and speed limits.
 
     Parameters
     ----------
-    model : Model
-        Robot and inertia; gravity and friction (viscous and Coulomb) are part of the limits.
-    path : Path
-        The path, in the model's length unit.
+    dynamics : PathDynamics
+        The robot along the path (gravity and friction included).
     torque_limit : (float, float)
         ``tau_max`` of the motors at A and D (run torque unit).
     speed_limit : (float, float), optional
         ``|qdot|`` limits of the motors (rad per run time unit).
-    mode : str
-        Working mode along the path.
     grid : int
         Number of segments in arc length.
     tol : float
@@ -160,17 +190,20 @@ def solve_time_optimal_law(model: Model, path: Path, *, torque_limit: tuple[floa
     if not (0 < tol < 1):
         raise ParameterError(f"tolerance {tol!r} must be in (0, 1)")
     n = int(grid)
-    co, jp = _coefficients(model, path, mode, n, units)
+    co = dynamics.coefficients(n)
+    length = float(co.s[-1])
     _check_holding(co, tmax, units)
-    ds = path.length / n
+    ds = length / n
     x0: np.ndarray | None = None  # tangent points of the viscous bound
     scale_t, scale_w = 1.0, 1.0
     law: TimeOptimalLaw | None = None
     has_viscous = bool(np.any(co.viscous > 0))
     for solve in range(1, MAX_SOLVES + 1):
         x = _reachability(co, ds, tmax * scale_t, wmax * scale_w, x0, units)
-        law = _law(path.length, co.s, x, tmax, wmax, solve)
-        tr, tr_ratio, sp_ratio = _check(model, path, mode, law, tmax, wmax)
+        law = _law(length, co.s, x, tmax, wmax, solve)
+        dts = np.diff(law.knots_t)
+        times = (law.knots_t[:-1, None] + dts[:, None] * CHECK_FRACTIONS[None, :]).reshape(-1)
+        tr_ratio, sp_ratio = dynamics.ratios(law, times, tmax, wmax)
         law = _with(law, tr_ratio, sp_ratio, 0, "")
         tangent_moved = has_viscous and (x0 is None or np.abs(np.sqrt(x) - np.sqrt(x0)).max()
                                          > 1e-6 * np.sqrt(x).max())
@@ -207,23 +240,7 @@ def _with(law: TimeOptimalLaw, tr: float, sp: float, status: int, message: str
                           law.solves)
 
 
-def _coefficients(model: Model, path: Path, mode: str, n: int, units: Units | None
-                  ) -> tuple[_Coefficients, Trajectory]:
-    """``a, b, g`` on the grid from the joint path ``q(s)`` and its derivatives."""
-    S = path.length
-    # a unit-speed law makes t = s, qdot = q', qddot = q''
-    jp = sample_trajectory(model.robot, path, UniformLaw(S, S), mode=mode, samples=n + 1,
-                           units=units)
-    quiet = Model(model.robot, model.inertia.frictionless(), jp.assembly)
-    a = np.einsum("nij,nj->ni", mass_matrix(quiet, jp.q), jp.dq)
-    b = inverse_dynamics(quiet, jp.q, jp.dq, jp.ddq)
-    g = gravity_torques(Model(model.robot, model.inertia, jp.assembly), jp.q)
-    ine = model.inertia
-    return _Coefficients(jp.t, jp.P, a, b, g, jp.dq, np.array(ine.coulomb, float),
-                         np.array(ine.viscous, float)), jp
-
-
-def _describe(co: _Coefficients, k: int, units: Units | None) -> str:
+def _describe(co: PathCoefficients, k: int, units: Units | None) -> str:
     if units is None:
         return f"arc length s = {co.s[k]:.6g} (P = ({co.P[k, 0]:.6g}, {co.P[k, 1]:.6g}))"
     return (f"P = {units.point_text(co.P[k])} (arc length s = {units.mm(co.s[k]):.6g} mm)")
@@ -233,7 +250,7 @@ def _torque(units: Units | None, value: float) -> str:
     return f"{value:.6g}" if units is None else units.torque_text(value)
 
 
-def _check_holding(co: _Coefficients, tmax: np.ndarray, units: Units | None) -> None:
+def _check_holding(co: PathCoefficients, tmax: np.ndarray, units: Units | None) -> None:
     """Gravity alone must be within the limits everywhere on the path."""
     ratio = np.abs(co.g) / tmax
     if ratio.max() > 1.0:
@@ -245,7 +262,7 @@ def _check_holding(co: _Coefficients, tmax: np.ndarray, units: Units | None) -> 
             f"{_describe(co, int(k), units)}, above its limit {_torque(units, tmax[i])}")
 
 
-def _friction_bounds(co: _Coefficients, x0: np.ndarray | None
+def _friction_bounds(co: PathCoefficients, x0: np.ndarray | None
                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Friction ``f`` in ``[phi_lo + psi_lo x, phi_hi + psi_hi x]`` at each grid point,
     arrays (N + 1, 2)."""
@@ -272,7 +289,7 @@ def _friction_bounds(co: _Coefficients, x0: np.ndarray | None
     return phi_lo, psi_lo, phi_hi, psi_hi
 
 
-def _rows(co: _Coefficients, ds: float, tmax: np.ndarray, wmax: np.ndarray,
+def _rows(co: PathCoefficients, ds: float, tmax: np.ndarray, wmax: np.ndarray,
           x0: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Static rows ``Gu u + Gx x <= h`` of every stage, arrays (N, m)."""
     phi_lo, psi_lo, phi_hi, psi_hi = _friction_bounds(co, x0)
@@ -291,7 +308,7 @@ def _rows(co: _Coefficients, ds: float, tmax: np.ndarray, wmax: np.ndarray,
     return Gu, Gx, h
 
 
-def _reachability(co: _Coefficients, ds: float, tmax: np.ndarray, wmax: np.ndarray,
+def _reachability(co: PathCoefficients, ds: float, tmax: np.ndarray, wmax: np.ndarray,
                   x0: np.ndarray | None, units: Units | None) -> np.ndarray:
     """Squared speeds ``x`` at the grid points of the fastest admissible motion."""
     Gu, Gx, h = _rows(co, ds, tmax, wmax, x0)
@@ -359,7 +376,7 @@ def _reachability(co: _Coefficients, ds: float, tmax: np.ndarray, wmax: np.ndarr
     return np.array(x)
 
 
-def _unreachable(co: _Coefficients, k: int, tmax: np.ndarray, units: Units | None
+def _unreachable(co: PathCoefficients, k: int, tmax: np.ndarray, units: Units | None
                  ) -> InfeasibleError:
     need = np.abs(co.g[k]) + co.coulomb
     i = int(np.argmax(need / tmax))
@@ -387,17 +404,27 @@ def _law(S: float, s: np.ndarray, x: np.ndarray, tmax: np.ndarray, wmax: np.ndar
                           speed_limit=(float(wmax[0]), float(wmax[1])), solves=solves)
 
 
-#: Where the output check samples each segment (fractions of its duration): both ends
-#: (the acceleration jumps at the knots) and three interior points.
-CHECK_FRACTIONS = np.array([1e-9, 0.25, 0.5, 0.75, 1.0 - 1e-9])
 
 
-def _check(model: Model, path: Path, mode: str, law: TimeOptimalLaw, tmax: np.ndarray,
-           wmax: np.ndarray) -> tuple[Trajectory, float, float]:
-    """Largest torque and speed ratios of the law on the check samples (exact model with
-    gravity and friction)."""
-    dts = np.diff(law.knots_t)
-    times = (law.knots_t[:-1, None] + dts[:, None] * CHECK_FRACTIONS[None, :]).reshape(-1)
-    tr = sample_trajectory(model.robot, path, law, mode=mode, times=times, tol=0.0)
-    tau = inverse_dynamics(Model(model.robot, model.inertia, tr.assembly), tr.q, tr.dq, tr.ddq)
-    return tr, float((np.abs(tau) / tmax).max()), float((np.abs(tr.dq) / wmax).max())
+
+
+def _register() -> None:
+    from ..params import REQUIRED, Param
+    from .registry import LawType, register_law
+
+    register_law(LawType(
+        "time-optimal",
+        {"torque_limit": Param("pair", "N m", REQUIRED, "motor torque limits [A, D]",
+                               positive=True),
+         "speed_limit_deg_s": Param("pair", "deg/s", None, "motor speed limits [A, D]",
+                                    positive=True),
+         "grid": Param("integer", "", 400, "segments in arc length", minimum=10,
+                       maximum=100_000)},
+        lambda r: solve_time_optimal_law(r.dynamics, torque_limit=r.params["torque_limit"],
+                                         speed_limit=r.params.get("speed_limit_deg_s"),
+                                         grid=r.params["grid"], units=r.units),
+        "the fastest rest-to-rest motion within the motors' torque and speed limits (TOPP-RA)",
+        needs_dynamics=True))
+
+
+_register()

@@ -14,10 +14,10 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.interpolate import CubicHermiteSpline
 
-from .dynamics.exact import Model, state_dynamics
-from .errors import ConvergenceError, ParameterError, SingularityError
-from .kinematics import direct_kinematics
-from .trajectory import Trajectory
+from ..dynamics.exact import Model, state_dynamics
+from ..errors import ConvergenceError, ParameterError, SingularityError
+from ..kinematics import direct_kinematics
+from ..trajectory import Trajectory
 
 
 @dataclass(frozen=True)

@@ -1,17 +1,17 @@
-"""One stage on top of the others: a scenario's trajectory, exact torques, the paper's model
-beside them, the energy comparisons of the paper's Figs. 6 and 7, and the validation residuals
-(power balance and forward re-simulation)."""
+"""A run's analysis: the trajectory, exact torques, the paper's model beside them, the energy
+comparisons of the paper's Figs. 6 and 7, and the validation residuals (power balance and
+forward re-simulation). It takes explicit :class:`RunInputs`, never a config."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from .dynamics import Model, Reactions, inverse_dynamics, joint_reactions, kinetic_energy
-from .dynamics.forward import forward_dynamics, torques_from_samples
-from .dynamics.paper import (
+from ..dynamics import Inertia, Model, Reactions, inverse_dynamics, joint_reactions, kinetic_energy
+from ..dynamics.forward import forward_dynamics, torques_from_samples
+from ..dynamics.paper import (
     PaperModel,
     base_angle,
     effector_energy_const_beta,
@@ -21,9 +21,62 @@ from .dynamics.paper import (
     torque_error,
     triangle_energies,
 )
-from .laws import Law
-from .scenario import Scenario
-from .trajectory import Trajectory, sample_trajectory
+from ..errors import NumericalError
+from ..geometry import FiveBar
+from ..kinematics.checker import DEFAULT_TOLERANCES, Tolerances
+from ..laws import Law
+from ..paths import Path
+from ..trajectory import Trajectory, sample_trajectory
+from ..units import Units
+
+
+@dataclass(frozen=True)
+class RunInputs:
+    """What a run's analysis is computed from (built by the config layer).
+
+    Attributes
+    ----------
+    robot, robot_mm : FiveBar
+        The geometry in run units and in mm.
+    path : Path
+        The path in run units; ``path_spec`` describes it as configured (mm, degrees).
+    mode, assembly : str
+        Working and assembly modes.
+    inertia : Inertia
+        Masses, friction and gravity in run units.
+    units : Units
+        The run's unit system.
+    samples : int
+        Samples written.
+    law_type : str
+        The configured law's name; ``law_values`` its config keys (config units).
+    beta0_time, fig7_distal_mass_ratio, fig7_lambda : float
+        The paper's model settings (``[paper]``).
+    """
+
+    robot: FiveBar
+    robot_mm: FiveBar
+    path: Path
+    path_spec: dict[str, Any]
+    mode: str
+    assembly: str
+    inertia: Inertia
+    units: Units
+    samples: int = 1001
+    law_type: str = "optimal"
+    law_values: dict[str, Any] = field(default_factory=dict)
+    tolerances: Tolerances = DEFAULT_TOLERANCES
+    beta0_time: float = 0.5
+    fig7_distal_mass_ratio: float = 0.5
+    fig7_lambda: float = 0.5
+    source: str = ""
+
+    def trajectory(self, law: Law, *, samples: int | None = None,
+                   times: np.ndarray | None = None) -> Trajectory:
+        """``law`` sampled along the path (``samples`` or the run's samples, or ``times``)."""
+        return sample_trajectory(self.robot, self.path, law, mode=self.mode,
+                                 samples=samples or self.samples, times=times,
+                                 tolerances=self.tolerances, units=self.units)
 
 # central differences of order 8 on 9 points, for dT/dt in the power balance
 _FD8 = np.array([1 / 280, -4 / 105, 1 / 5, -4 / 5, 0.0, 4 / 5, -1 / 5, 4 / 105, -1 / 280])
@@ -50,7 +103,10 @@ class PaperComparison:
 
 @dataclass(frozen=True)
 class Analysis:
-    scenario: Scenario
+    """A law's trajectory with its exact torques, powers, energy, joint forces and, where it
+    applies, the paper's model beside them."""
+
+    inputs: RunInputs
     law: Law
     trajectory: Trajectory
     model: Model
@@ -69,29 +125,37 @@ class Analysis:
                 "force_P2": np.linalg.norm(r.P2, axis=-1)}
 
     @property
-    def units(self) -> Any:
+    def units(self) -> Units:
         """The run's unit system."""
-        return self.scenario.units
+        return self.inputs.units
 
 
-def analyze(scenario: Scenario, law: Law | None = None) -> Analysis:
-    """Trajectory and torques of ``scenario`` (with the paper comparison when the robot is
-    symmetric)."""
-    law = law or scenario.law()
-    tr = scenario.trajectory(law)
-    model = Model(scenario.robot, scenario.inertia, tr.assembly)
+def analyze(inputs: RunInputs, law: Law) -> Analysis:
+    """Trajectory and exact torques of ``law`` (with the paper comparison when its model
+    applies).
+
+    Raises
+    ------
+    NumericalError
+        When a torque is not finite (parameters that overflow), naming the time.
+    """
+    tr = inputs.trajectory(law)
+    model = Model(inputs.robot, inputs.inertia, tr.assembly, tol=inputs.tolerances.type2)
     tau = inverse_dynamics(model, tr.q, tr.dq, tr.ddq, t=tr.t)
+    if not np.isfinite(tau).all():
+        i = int(np.flatnonzero(~np.isfinite(tau).all(axis=1))[0])
+        raise NumericalError(f"the torque is not finite at {inputs.units.time_text(tr.t[i])}: "
+                             "the parameters overflow double precision")
     power = tau * tr.dq
     energy = kinetic_energy(model, tr.q, tr.dq)
     reactions = joint_reactions(model, tr.q, tr.dq, tr.ddq)
-    applies = paper_model_limits(scenario.robot, scenario.inertia) is None
-    paper = _paper(scenario, law, tr, model, tau) if applies else None
-    return Analysis(scenario, law, tr, model, tau, power, energy, reactions, paper)
+    applies = paper_model_limits(inputs.robot, inputs.inertia) is None
+    paper = _paper(inputs, law, tr, tau) if applies else None
+    return Analysis(inputs, law, tr, model, tau, power, energy, reactions, paper)
 
 
-def _paper(sc: Scenario, law: Law, tr: Trajectory, model: Model, tau: np.ndarray
-           ) -> PaperComparison:
-    t0 = sc.paper["beta0_time"] * law.duration
+def _paper(sc: RunInputs, law: Law, tr: Trajectory, tau: np.ndarray) -> PaperComparison:
+    t0 = sc.beta0_time * law.duration
     mid = sample_trajectory(sc.robot, sc.path, law, mode=sc.mode, times=np.array([t0]))
     beta0 = float(base_angle(sc.robot, mid.q)[0])
     pm = paper_model(sc.robot, sc.inertia, beta0)
@@ -105,7 +169,7 @@ def _paper(sc: Scenario, law: Law, tr: Trajectory, model: Model, tau: np.ndarray
     T_exact = 0.5 * m * np.sum(tr.dP**2, axis=-1)
     T_fd = effector_energy_fd(sc.robot, m, tr.t, tr.q)
     T_approx = effector_energy_const_beta(sc.robot, m, beta0, tr.q, tr.dq)
-    ratio, lam = sc.paper["fig7_distal_mass_ratio"], sc.paper["fig7_lambda"]
+    ratio, lam = sc.fig7_distal_mass_ratio, sc.fig7_lambda
     mL = ratio * m
     JL = mL * sc.robot.L1**2 / 2
     T_S, T_r = triangle_energies(sc.robot, mL, JL, lam, tr.q, tr.dq, tr.dP)
@@ -135,7 +199,7 @@ def power_balance_residual(an: Analysis, *, interior: int = 201) -> float:
     times, with ``dT/dt`` from an 8th-order central difference of the exact energy along the
     law and the torques of the inertial model (gravity and friction off: they are not part of
     ``dT/dt``). Times keep clear of the law's breakpoints, where the energy is not smooth."""
-    sc, law = an.scenario, an.law
+    sc, law = an.inputs, an.law
     t, h = power_balance_times(law, interior)
     model = Model(sc.robot, sc.inertia.frictionless(), an.trajectory.assembly)
     rate = np.zeros_like(t)

@@ -26,7 +26,7 @@ import numpy as np
 
 from ..dynamics.exact import Model
 from ..kinematics import direct_kinematics, elbows, task_velocity
-from ..output.files import write_text
+from .files import write_text
 
 #: Constraint softness: as stiff as MuJoCo allows (impedance 0.9999).
 SOLREF = "0.0005 1"

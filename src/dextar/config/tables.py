@@ -1,0 +1,390 @@
+"""One frozen dataclass per TOML table, built and validated at the boundary.
+
+Each table declares its keys (:class:`dextar.params.Param`: type, unit, default, bounds) and
+holds its values in config units (mm, deg, kg, s, N m) after :func:`read_params` has checked
+them; errors name ``[table].key``. The conversion to the run's units happens once, where the
+:class:`~dextar.config.scenario.Scenario` builds the run's objects.
+
+A new table is a new dataclass with ``NAME``, ``PARAMS`` and (if it needs more than the
+generic reading) ``from_toml``, and one line: ``register_table(MyTable)``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any, ClassVar, TypeVar
+
+from ..dynamics import Inertia, Rod
+from ..dynamics.friction import DEFAULT_COULOMB_SPEED_DEG_S
+from ..errors import ConfigError, DextarError
+from ..geometry import DEXTAR_MM, FiveBar, canonical_working_mode, parse_assembly_mode, preset
+from ..kinematics.checker import Tolerances
+from ..laws import LawType, law_type
+from ..params import Param, read_params, to_run_units
+from ..paths import Path, PathType, path_type
+from ..units import Units
+
+T = TypeVar("T", bound="Table")
+
+#: Figures a run can draw (``[output].figures``).
+FIGURES = ("fig3", "fig4", "fig5", "fig6", "fig7", "fig8", "fig9", "workspace", "animation")
+#: Most samples a run writes (a 200 s motion at 1 kHz).
+MAX_SAMPLES = 200_000
+
+
+class Table:
+    """Base of the table dataclasses: the generic reading of ``PARAMS``."""
+
+    NAME: ClassVar[str] = ""
+    PARAMS: ClassVar[dict[str, Param]] = {}
+
+    @classmethod
+    def from_toml(cls: type[T], raw: Mapping[str, object]) -> T:
+        """The table from its TOML contents (validated; absent keys take their defaults)."""
+        return cls(**read_params(cls.NAME, raw, cls.PARAMS))
+
+
+#: The table registry: TOML name -> dataclass.
+TABLES: dict[str, type[Table]] = {}
+
+
+def register_table(cls: type[T]) -> type[T]:
+    """Make ``[cls.NAME]`` a known table of the config files."""
+    TABLES[cls.NAME] = cls
+    return cls
+
+
+@dataclass(frozen=True)
+class RobotTable(Table):
+    """``[robot]``: the geometry in mm (a preset, lengths overriding it) and the modes."""
+
+    NAME: ClassVar[str] = "robot"
+    PARAMS: ClassVar[dict[str, Param]] = {
+        "preset": Param("text", "", None, "a named geometry: dextar"),
+        **{k: Param("number", "mm", None, f"length {k}", positive=True)
+           for k in ("l1", "l2", "L1", "L2", "d")},
+        "working_mode": Param("text", "", "+-", "++, +-, -+ or -- (aliases pp, pm, mp, mm)"),
+        "assembly_mode": Param("choice", "", "up", "up or down", choices=("up", "down")),
+    }
+
+    geometry_mm: FiveBar = DEXTAR_MM
+    working_mode: str = "+-"
+    assembly_mode: str = "up"
+
+    @classmethod
+    def from_toml(cls, raw: Mapping[str, object]) -> RobotTable:
+        """Read ``[robot]``: without a preset, all five lengths are required."""
+        t = read_params(cls.NAME, raw, cls.PARAMS)
+        lengths = {k: t[k] for k in ("l1", "l2", "L1", "L2", "d") if k in t}
+        try:
+            if "preset" in t:
+                geom = FiveBar(**{**preset(t["preset"]).as_dict(), **lengths})
+            elif lengths:
+                missing = [k for k in ("l1", "l2", "L1", "L2", "d") if k not in lengths]
+                if missing:
+                    raise ConfigError(f"config key [robot].{missing[0]} is required when no "
+                                      "preset is given")
+                geom = FiveBar(**lengths)
+            else:
+                geom = DEXTAR_MM
+            mode = canonical_working_mode(t["working_mode"])
+            parse_assembly_mode(t["assembly_mode"])
+        except ConfigError:
+            raise
+        except DextarError as exc:
+            raise ConfigError(f"config table [robot]: {exc}") from None
+        return cls(geom, mode, t["assembly_mode"])
+
+
+@dataclass(frozen=True)
+class PathTable(Table):
+    """``[path]``: a registered path type and its keys (config units)."""
+
+    NAME: ClassVar[str] = "path"
+
+    type: str = "arc"
+    values: Mapping[str, Any] = field(default_factory=lambda: {
+        "radius": 120.0, "center": (0.0, 0.0), "start_deg": 0.0, "end_deg": 180.0})
+
+    @classmethod
+    def from_toml(cls, raw: Mapping[str, object]) -> PathTable:
+        """Read ``[path]`` against the keys its type registered."""
+        kind = path_type(raw.get("type", "arc"))
+        values = read_params(cls.NAME, raw, kind.params, ignore=("type",))
+        return cls(kind.name, values)
+
+    @property
+    def kind(self) -> PathType:
+        """The registered path type."""
+        return path_type(self.type)
+
+    def build(self, units: Units) -> Path:
+        """The path in the run's units."""
+        try:
+            return self.kind.build(to_run_units(self.values, self.kind.params, units), units)
+        except ConfigError:
+            raise
+        except DextarError as exc:
+            raise ConfigError(f"config table [path]: {exc}") from None
+
+    def summary(self) -> dict[str, Any]:
+        """The path as configured, JSON-ready (lengths in mm, angles in degrees)."""
+        out: dict[str, Any] = {"type": self.type}
+        for k, v in self.values.items():
+            unit = self.kind.params[k].unit
+            name = f"{k}_mm" if unit == "mm" else k
+            out[name] = [list(w) for w in v] if isinstance(v, tuple) and v and isinstance(
+                v[0], tuple) else list(v) if isinstance(v, tuple) else v
+        return out
+
+
+@dataclass(frozen=True)
+class LawTable(Table):
+    """``[law]``: a registered law and its keys (config units)."""
+
+    NAME: ClassVar[str] = "law"
+
+    type: str = "optimal"
+    values: Mapping[str, Any] = field(default_factory=lambda: {"duration": 1.0, "eta": 0.1})
+
+    @classmethod
+    def from_toml(cls, raw: Mapping[str, object]) -> LawTable:
+        """Read ``[law]`` against the keys its law registered."""
+        if "samples" in raw:
+            raise ConfigError("config key [law].samples is not known: use [output].samples "
+                              "(the number of samples written)")
+        kind = law_type(raw.get("type", "optimal"))
+        return cls(kind.name, read_params(cls.NAME, raw, kind.params, ignore=("type",)))
+
+    @property
+    def kind(self) -> LawType:
+        """The registered law."""
+        return law_type(self.type)
+
+    def run_values(self, units: Units) -> dict[str, Any]:
+        """The law's keys in the run's units."""
+        return to_run_units(self.values, self.kind.params, units)
+
+    @property
+    def duration_s(self) -> float:
+        """The configured duration in seconds (1 s when the law has none): the time unit of
+        the paper's units."""
+        d = self.values.get("duration")
+        return 1.0 if d is None else float(d)
+
+
+def _pair(unit: str, help: str, default: float | None = None, **kw: Any) -> Param:
+    """A number or [motor A, motor D] key (its default a pair too)."""
+    return Param("pair", unit, None if default is None else (default, default), help, **kw)
+
+
+@dataclass(frozen=True)
+class InertiaTable(Table):
+    """``[inertia]``: masses (kg), centres of mass (mm), inertias (kg mm^2)."""
+
+    NAME: ClassVar[str] = "inertia"
+    PARAMS: ClassVar[dict[str, Param]] = {
+        "effector_mass": Param("number", "kg", 1.0, "end-effector mass", positive=True),
+        "payload": Param("number", "kg", 0.0, "payload at P", minimum=0.0),
+        "proximal_mass": _pair("kg", "proximal rods' masses", None, minimum=0.0),
+        "distal_mass": _pair("kg", "distal rods' masses", None, minimum=0.0),
+        "proximal_com": _pair("mm", "proximal centres of mass from the joint"),
+        "distal_com": _pair("mm", "distal centres of mass from the elbow"),
+        "proximal_inertia": _pair("", "proximal inertias about the com, kg mm^2", minimum=0.0),
+        "distal_inertia": _pair("", "distal inertias about the com, kg mm^2", minimum=0.0),
+        "rotor_inertia": _pair("", "rotor inertias, kg mm^2", 0.0, minimum=0.0),
+    }
+
+    effector_mass: float = 1.0
+    payload: float = 0.0
+    proximal_mass: tuple[float, float] | None = None
+    distal_mass: tuple[float, float] | None = None
+    proximal_com: tuple[float, float] | None = None
+    distal_com: tuple[float, float] | None = None
+    proximal_inertia: tuple[float, float] | None = None
+    distal_inertia: tuple[float, float] | None = None
+    rotor_inertia: tuple[float, float] = (0.0, 0.0)
+
+    def build(self, units: Units, g: FiveBar, friction: FrictionTable,
+              gravity: GravityTable) -> Inertia:
+        """The run's :class:`~dextar.dynamics.Inertia` (uniform rods where not given; the
+        paper's Fig. 9 ratios 0.08 and 0.1 of the end-effector mass by default)."""
+        m = self.effector_mass
+
+        def rods(masses: tuple[float, float] | None, coms: tuple[float, float] | None,
+                 inert: tuple[float, float] | None, lengths: tuple[float, float],
+                 ratio: float) -> tuple[Rod, Rod]:
+            ms = masses or (ratio * m, ratio * m)
+            out = []
+            for k in range(2):
+                c = coms[k] if coms else 0.5 * lengths[k]
+                i = inert[k] if inert else ms[k] * lengths[k] ** 2 / 12.0
+                out.append(Rod(units.mass(ms[k]), units.length(c), units.inertia(i)))
+            return out[0], out[1]
+
+        try:
+            return Inertia(
+                proximal=rods(self.proximal_mass, self.proximal_com, self.proximal_inertia,
+                              (g.l1, g.l2), 0.08),
+                distal=rods(self.distal_mass, self.distal_com, self.distal_inertia,
+                            (g.L1, g.L2), 0.1),
+                effector_mass=units.mass(m), payload=units.mass(self.payload),
+                rotor=(units.inertia(self.rotor_inertia[0]),
+                       units.inertia(self.rotor_inertia[1])),
+                viscous=(units.torque(friction.viscous[0]) / units.time_s,
+                         units.torque(friction.viscous[1]) / units.time_s),
+                coulomb=(units.torque(friction.coulomb[0]), units.torque(friction.coulomb[1])),
+                gravity=(units.acceleration(gravity.vector[0]),
+                         units.acceleration(gravity.vector[1])),
+                coulomb_speed=math.radians(friction.coulomb_speed_deg_s) * units.time_s)
+        except DextarError as exc:
+            raise ConfigError(f"config table [inertia]: {exc}") from None
+
+
+@dataclass(frozen=True)
+class FrictionTable(Table):
+    """``[friction]``: ``tau_f = viscous qdot + coulomb tanh(qdot / v_s)`` per motor."""
+
+    NAME: ClassVar[str] = "friction"
+    PARAMS: ClassVar[dict[str, Param]] = {
+        "viscous": _pair("", "viscous coefficients, N m s/rad", 0.0, minimum=0.0),
+        "coulomb": _pair("N m", "Coulomb torques", 0.0, minimum=0.0),
+        "coulomb_speed_deg_s": Param("number", "", DEFAULT_COULOMB_SPEED_DEG_S,
+                                     "regularisation speed v_s, deg/s", positive=True),
+    }
+
+    viscous: tuple[float, float] = (0.0, 0.0)
+    coulomb: tuple[float, float] = (0.0, 0.0)
+    coulomb_speed_deg_s: float = DEFAULT_COULOMB_SPEED_DEG_S
+
+
+@dataclass(frozen=True)
+class GravityTable(Table):
+    """``[gravity]``: the in-plane gravity vector, mm/s^2."""
+
+    NAME: ClassVar[str] = "gravity"
+    PARAMS: ClassVar[dict[str, Param]] = {
+        "vector": Param("point", "", (0.0, 0.0), "gravity [gx, gy] in mm/s^2")}
+
+    vector: tuple[float, float] = (0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class ControlTable(Table):
+    """``[control]``: the computed-torque simulation (``dextar simulate``)."""
+
+    NAME: ClassVar[str] = "control"
+    PARAMS: ClassVar[dict[str, Param]] = {
+        "natural_frequency_hz": Param("number", "", 10.0, "closed-loop natural frequency, Hz",
+                                      positive=True),
+        "damping": Param("number", "", 1.0, "damping ratio", positive=True),
+        "mass_error": Param("number", "", 0.2, "the plant's masses are (1 + this) times the "
+                            "model's", minimum=-0.99),
+        "payload": Param("number", "kg", None, "payload unknown to the controller (default "
+                         "0.1 of the end-effector mass)", minimum=0.0),
+        "torque_limit": Param("number", "N m", None, "saturation of each motor",
+                              positive=True),
+        "initial_error_deg": Param("point", "", (0.0, 0.0), "initial joint error [deg, deg]"),
+    }
+
+    natural_frequency_hz: float = 10.0
+    damping: float = 1.0
+    mass_error: float = 0.2
+    payload: float | None = None
+    torque_limit: float | None = None
+    initial_error_deg: tuple[float, float] = (0.0, 0.0)
+
+    def run_values(self, units: Units, effector_kg: float) -> dict[str, Any]:
+        """The controller's settings in run units (and their config values)."""
+        payload = 0.1 * effector_kg if self.payload is None else self.payload
+        return {
+            "natural_frequency": 2 * math.pi * self.natural_frequency_hz * units.time_s,
+            "natural_frequency_hz": self.natural_frequency_hz, "damping": self.damping,
+            "mass_error": self.mass_error, "payload": units.mass(payload),
+            "payload_kg": payload,
+            "torque_limit": None if self.torque_limit is None else units.torque(
+                self.torque_limit),
+            "torque_limit_nm": self.torque_limit,
+            "initial_error": tuple(math.radians(v) for v in self.initial_error_deg),
+        }
+
+
+@dataclass(frozen=True)
+class PaperTable(Table):
+    """``[paper]``: the interpretation of the paper's model and its Fig. 7."""
+
+    NAME: ClassVar[str] = "paper"
+    PARAMS: ClassVar[dict[str, Param]] = {
+        "beta0_time": Param("number", "", 0.5, "beta0 at this fraction of the motion time",
+                            minimum=0.0, maximum=1.0),
+        "fig7_distal_mass_ratio": Param("number", "", 0.5, "Fig. 7: mL / m", minimum=0.0),
+        "fig7_lambda": Param("number", "", 0.5, "Fig. 7: lambda", minimum=0.0, maximum=1.0),
+    }
+
+    beta0_time: float = 0.5
+    fig7_distal_mass_ratio: float = 0.5
+    fig7_lambda: float = 0.5
+
+
+@dataclass(frozen=True)
+class OutputTable(Table):
+    """``[output]``: the run's unit system and what is written."""
+
+    NAME: ClassVar[str] = "output"
+    PARAMS: ClassVar[dict[str, Param]] = {
+        "units": Param("choice", "", "paper", "paper or si", choices=("paper", "si")),
+        "samples": Param("integer", "", 1001, "samples written", minimum=2,
+                         maximum=MAX_SAMPLES),
+        "figures": Param("text", "", None, "figures to draw"),  # a list: read below
+        "animation_frames": Param("integer", "", 41, "frames of the animation", minimum=2,
+                                  maximum=1000),
+    }
+
+    units: str = "paper"
+    samples: int = 1001
+    figures: tuple[str, ...] = FIGURES
+    animation_frames: int = 41
+
+    @classmethod
+    def from_toml(cls, raw: Mapping[str, object]) -> OutputTable:
+        """Read ``[output]``; ``figures`` is a list of figure names."""
+        rest = {k: v for k, v in raw.items() if k != "figures"}
+        t = read_params(cls.NAME, rest, cls.PARAMS)
+        figures = raw.get("figures", list(FIGURES))
+        if not isinstance(figures, list):
+            raise ConfigError(f"config key [output].figures must be a list, got "
+                              f"{type(figures).__name__} {figures!r}")
+        for f in figures:
+            if f not in FIGURES:
+                raise ConfigError(f"config key [output].figures: unknown figure {f!r}; known: "
+                                  f"{', '.join(FIGURES)}")
+        t.pop("figures", None)
+        return cls(figures=tuple(figures), **t)
+
+
+@dataclass(frozen=True)
+class TolerancesTable(Table):
+    """``[tolerances]``: the geometry checker's tolerances (see
+    :class:`dextar.kinematics.checker.Tolerances`)."""
+
+    NAME: ClassVar[str] = "tolerances"
+    PARAMS: ClassVar[dict[str, Param]] = {
+        "type1": Param("number", "", Tolerances.type1, "smallest normalised distance to a "
+                       "serial singularity", minimum=0.0, maximum=1.0),
+        "type2": Param("number", "", Tolerances.type2, "smallest normalised distance to a "
+                       "parallel singularity", minimum=0.0, maximum=1.0),
+    }
+
+    type1: float = Tolerances.type1
+    type2: float = Tolerances.type2
+
+    def tolerances(self) -> Tolerances:
+        """The checker's :class:`Tolerances`."""
+        return Tolerances(type1=self.type1, type2=self.type2)
+
+
+for _cls in (RobotTable, PathTable, LawTable, InertiaTable, FrictionTable, GravityTable,
+             ControlTable, PaperTable, OutputTable, TolerancesTable):
+    register_table(_cls)

@@ -1,0 +1,69 @@
+"""The exact closed-chain dynamics along a path, for laws planned under motor limits.
+
+:class:`RobotAlongPath` implements :class:`dextar.laws.time_optimal.PathDynamics`: the
+coefficients ``a = M q'``, ``b = M q'' + c(q, q')``, ``g`` of the path dynamics on a grid of
+arc lengths (from the joint path ``q(s)`` of the inverse kinematics), and the torque and speed
+ratios of a law through the exact model with gravity and friction.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..kinematics.checker import Tolerances
+from ..laws import Law, UniformLaw
+from ..laws.time_optimal import PathCoefficients, TimeOptimalLaw, solve_time_optimal_law
+from ..paths import Path
+from ..trajectory import sample_trajectory
+from ..units import Units
+from .exact import Model, gravity_torques, inverse_dynamics, mass_matrix
+
+
+@dataclass(frozen=True)
+class RobotAlongPath:
+    """A robot model following ``path`` in working mode ``mode``.
+
+    ``units`` only serves the words of an error (points in mm, times in s).
+    """
+
+    model: Model
+    path: Path
+    mode: str = "+-"
+    units: Units | None = None
+
+    def coefficients(self, segments: int) -> PathCoefficients:
+        """The path dynamics on ``segments + 1`` equally spaced arc lengths."""
+        S = self.path.length
+        # a unit-speed law makes t = s, qdot = q', qddot = q''
+        jp = sample_trajectory(self.model.robot, self.path, UniformLaw(S, S), mode=self.mode,
+                               samples=segments + 1, units=self.units)
+        robot, ine = self.model.robot, self.model.inertia
+        quiet = Model(robot, ine.frictionless(), jp.assembly)
+        a = np.einsum("nij,nj->ni", mass_matrix(quiet, jp.q), jp.dq)
+        b = inverse_dynamics(quiet, jp.q, jp.dq, jp.ddq)
+        g = gravity_torques(Model(robot, ine, jp.assembly), jp.q)
+        return PathCoefficients(jp.t, jp.P, a, b, g, jp.dq, np.array(ine.coulomb, float),
+                                np.array(ine.viscous, float))
+
+    def ratios(self, law: Law, times: np.ndarray, torque_limit: np.ndarray,
+               speed_limit: np.ndarray) -> tuple[float, float]:
+        """Largest torque and speed ratios of ``law`` at ``times`` (exact model)."""
+        tr = sample_trajectory(self.model.robot, self.path, law, mode=self.mode, times=times,
+                               tolerances=Tolerances(0.0, 0.0))
+        tau = inverse_dynamics(Model(self.model.robot, self.model.inertia, tr.assembly), tr.q,
+                               tr.dq, tr.ddq)
+        return (float((np.abs(tau) / torque_limit).max()),
+                float((np.abs(tr.dq) / speed_limit).max()))
+
+
+def time_optimal_law(model: Model, path: Path, *, torque_limit: tuple[float, float],
+                     speed_limit: tuple[float, float] | None = None, mode: str = "+-",
+                     grid: int = 400, tol: float = 1e-3,
+                     units: Units | None = None) -> TimeOptimalLaw:
+    """The fastest rest-to-rest law along ``path`` for ``model`` within the motors' torque
+    (and speed) limits; see :func:`dextar.laws.time_optimal.solve_time_optimal_law`."""
+    return solve_time_optimal_law(RobotAlongPath(model, path, mode, units),
+                                  torque_limit=torque_limit, speed_limit=speed_limit, grid=grid,
+                                  tol=tol, units=units)

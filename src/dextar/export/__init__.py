@@ -1,1 +1,0 @@
-"""Exports to other tools (MuJoCo)."""

@@ -1,0 +1,301 @@
+"""One function per command: read the config, compute through the stages, write the outputs,
+and return what to print. The command line (:mod:`dextar.cli`) only parses, calls one of
+these and prints its :class:`JobResult`.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .config import RobotTable, Scenario, check_tables, load_scenario, load_toml
+from .config.tables import TABLES
+from .errors import ConfigError
+from .laws import Law
+
+
+@dataclass(frozen=True)
+class JobResult:
+    """What a command reports: a JSON payload, the same in words, warnings for stderr and,
+    for ``--out -``, the data for stdout."""
+
+    payload: dict[str, Any]
+    text: str
+    warnings: list[str] = field(default_factory=list)
+    data: str | None = None
+
+
+def shown(path: str | Path, name: str | None = None) -> str:
+    """A path as printed: no doubled or trailing separators."""
+    p = Path(path)
+    return str(p / name) if name else str(p)
+
+
+def out_file(out: str, *suffixes: str) -> Path | None:
+    """The ``--out`` file, refused unless it ends in one of ``suffixes``; None for ``-``."""
+    if out == "-":
+        return None
+    p = Path(out)
+    if p.suffix.lower() not in suffixes:
+        raise ConfigError(f"--out {out!r} must end in {' or '.join(suffixes)} (or be - for "
+                          "stdout)")
+    if p.is_dir():
+        raise ConfigError(f"--out {out!r} is a directory")
+    return p
+
+
+def _write(out: Path | None, text: str) -> tuple[str, str | None]:
+    """Write ``text`` atomically to ``out``; for None (stdout) hand it back as data."""
+    from .output.files import write_text
+
+    if out is None:
+        return "stdout", text
+    write_text(out, text)
+    return str(out), None
+
+
+def _units_note(sc: Scenario) -> str:
+    u = sc.units
+    n = u.names
+    if u.system == "paper":
+        return (f"paper units: length L = {u.length_mm:g} mm, mass m = {u.mass_kg:g} kg, "
+                f"time T = {u.time_s:g} s; angles in rad")
+    return f"SI units: {n['length']}, {n['mass']}, {n['time']}; torques in N m; angles in rad"
+
+
+def _law_line(sc: Scenario, law: Law) -> str:
+    u = sc.units
+    secs = law.duration * u.time_s
+    time = (f"{secs:.6g} s" if u.system == "si"
+            else f"{law.duration:.6g} {u.names['time']} ({secs:.6g} s)")
+    return f"{law.name} law: motion time {time}; status {law.status}: {law.message}"
+
+
+def _law_payload(sc: Scenario, law: Law) -> dict[str, Any]:
+    return {"law": law.name, "duration": law.duration,
+            "duration_s": law.duration * sc.units.time_s, "status": int(law.status),
+            "success": bool(law.success), "message": law.message}
+
+
+def _law_warnings(command: str, law: Law) -> list[str]:
+    if law.success:
+        return []
+    return [f"dextar {command}: warning: {law.name} law status {law.status}: {law.message}"]
+
+
+# ----------------------------------------------------------------------------- kinematics
+def robot_table(path: str | None) -> RobotTable:
+    """``[robot]`` of a config file (the DexTAR without one)."""
+    if path is None:
+        return RobotTable()
+    doc = load_toml(path)
+    check_tables(doc, set(TABLES))
+    return RobotTable.from_toml(doc.get("robot", {}))
+
+
+def ik(x: float, y: float, *, mode: str | None = None, robot: str | None = None) -> JobResult:
+    """Actuator angles (deg) for the point ``(x, y)`` mm."""
+    from .kinematics import inverse_kinematics
+
+    rc = robot_table(robot)
+    mode = mode or rc.working_mode
+    q = inverse_kinematics(rc.geometry_mm, [x, y], mode)
+    phi, psi = (float(v) for v in np.degrees(q))
+    return JobResult({"phi_deg": phi, "psi_deg": psi, "mode": mode},
+                     f"phi = {phi:.6f} deg, psi = {psi:.6f} deg (working mode {mode})")
+
+
+def fk(phi: float, psi: float, *, assembly: str | None = None,
+       robot: str | None = None) -> JobResult:
+    """The end-effector (mm) for the actuator angles ``(phi, psi)`` deg."""
+    from .kinematics import direct_kinematics
+
+    rc = robot_table(robot)
+    assembly = assembly or rc.assembly_mode
+    P = direct_kinematics(rc.geometry_mm, np.radians([phi, psi]), assembly)
+    x, y = float(P[0]), float(P[1])
+    return JobResult({"x_mm": x, "y_mm": y, "assembly": assembly},
+                     f"x = {x:.6f} mm, y = {y:.6f} mm (assembly mode {assembly})")
+
+
+def workspace(out: str, *, mode: str | None = None, resolution: int = 301,
+              robot: str | None = None) -> JobResult:
+    """The workspace map of a working mode, drawn to ``out`` (PNG or SVG)."""
+    from .kinematics import workspace_map
+    from .output.figures import plot_workspace
+    from .output.files import save_figure
+
+    rc = robot_table(robot)
+    mode = mode or rc.working_mode
+    path = out_file(out, ".png", ".svg")
+    if path is None:
+        raise ConfigError("--out - is for CSV and JSON; a workspace map is a PNG or SVG file")
+    ws = workspace_map(rc.geometry_mm, mode, resolution=resolution)
+    save_figure(plot_workspace(ws), path, dpi=150)
+    area = ws.reachable_area
+    reach = ws.dexterity[ws.reachable]
+    payload = {"out": str(path), "mode": mode, "robot_mm": rc.geometry_mm.as_dict(),
+               "resolution": [int(ws.x.size), int(ws.y.size)], "reachable_area_mm2": area,
+               "dexterity_mean": float(reach.mean()) if reach.size else 0.0,
+               "dexterity_max": float(reach.max()) if reach.size else 0.0,
+               "type2_curve_in_workspace": bool((ws.type2[ws.reachable] > 0).any()
+                                                and (ws.type2[ws.reachable] < 0).any())}
+    return JobResult(payload, f"wrote {path} (working mode {mode}, reachable area {area:.0f} "
+                     "mm^2)")
+
+
+# ----------------------------------------------------------------------------- stages
+def plan(config: str | None, out: str) -> JobResult:
+    """The configured law along the path: samples to CSV, motion time, solver status."""
+    from .output.tables import csv_text, trajectory_columns
+
+    path = out_file(out, ".csv")
+    sc = load_scenario(config)
+    law = sc.law()
+    tr = sc.trajectory(law)
+    where, data = _write(path, csv_text(trajectory_columns(tr, sc.units)))
+    payload: dict[str, Any] = {"out": where, "samples": int(tr.t.size), **_law_payload(sc, law),
+                               "units": sc.units.describe()}
+    lines = [_law_line(sc, law)]
+    kin, inert = getattr(law, "kinetic", None), getattr(law, "inertial", None)
+    if law.name == "optimal" and kin is not None and inert is not None:
+        payload.update(cost=kin + inert, cost_kinetic=kin, cost_inertial=inert)
+        lines.append(f"cost Phi = {kin + inert:.10g} (kinetic {kin:.10g}, inertial "
+                     f"{inert:.10g}) [{sc.units.names['energy']} x {sc.units.names['time']}]")
+    lines.append(f"wrote {where}: {tr.t.size} samples, working mode {tr.mode} "
+                 f"({_units_note(sc)})")
+    return JobResult(payload, "\n".join(lines), _law_warnings("plan", law), data)
+
+
+def torques(config: str | None, out: str) -> JobResult:
+    """Exact (and paper-model) torques, powers, energy and joint forces to CSV."""
+    from .analysis import analyze
+    from .dynamics.paper import paper_model_limits
+    from .output.tables import csv_text, torque_columns
+
+    path = out_file(out, ".csv")
+    sc = load_scenario(config)
+    an = analyze(sc.inputs(), sc.law())
+    where, data = _write(path, csv_text(torque_columns(an)))
+    peak = np.abs(an.tau).max(axis=0)
+    payload: dict[str, Any] = {"out": where, "samples": int(an.trajectory.t.size),
+                               **_law_payload(sc, an.law),
+                               "peak_torque": [float(v) for v in peak],
+                               "units": sc.units.describe()}
+    text = (f"{_law_line(sc, an.law)}\nwrote {where}: {an.trajectory.t.size} samples; peak "
+            f"|tau| = {peak[0]:.6g}, {peak[1]:.6g} [{sc.units.names['torque']}] "
+            f"({_units_note(sc)})")
+    if an.paper is not None:
+        payload["paper_model_error"] = an.paper.error
+        text += (f"\npaper model (42) error: max {an.paper.error['max_relative']:.1%}, RMS "
+                 f"{an.paper.error['rms_relative']:.1%} of the peak exact torque")
+    else:
+        why = paper_model_limits(sc.robot, sc.inertia)
+        text += f"\nno paper-model columns: the paper's simplified model does not apply ({why})"
+    return JobResult(payload, text, _law_warnings("torques", an.law), data)
+
+
+def simulate(config: str | None, out: str, *, force: bool = False) -> JobResult:
+    """Computed-torque tracking of the configured motion by a perturbed plant."""
+    from .dynamics import Model
+    from .output.figures import png_bytes, tracking_figure
+    from .output.outdir import OutputDir
+    from .output.tables import csv_text, unit_tokens
+    from .simulation import simulate_computed_torque
+
+    sc = load_scenario(config)
+    tr = sc.trajectory()
+    c = sc.control
+    controller = Model(sc.robot, sc.inertia, tr.assembly)
+    plant_inertia = sc.inertia.scaled_masses(1.0 + c["mass_error"])
+    plant_inertia = plant_inertia.with_(payload=plant_inertia.payload + c["payload"])
+    plant = Model(sc.robot, plant_inertia, tr.assembly)
+    res = simulate_computed_torque(tr, controller, plant, natural_frequency=c["natural_frequency"],
+                                   damping=c["damping"], torque_limit=c["torque_limit"],
+                                   initial_error=c["initial_error"])
+    mm = sc.units.length_mm
+    u = unit_tokens(sc.units)
+    cols = {f"t_{u['time']}": res.t, "phi_des_rad": tr.q[:, 0], "psi_des_rad": tr.q[:, 1],
+            "phi_rad": res.q[:, 0], "psi_rad": res.q[:, 1], "err_phi_rad": res.joint_error[:, 0],
+            "err_psi_rad": res.joint_error[:, 1], "task_error_mm": res.task_error * mm,
+            f"tau1_{u['torque']}": res.tau[:, 0], f"tau2_{u['torque']}": res.tau[:, 1],
+            "saturated": res.saturated.astype(float)}
+    summ = res.summary()
+    report = {"units": sc.units.describe(), "control": dict(c),
+              "status": res.status, "message": res.message,
+              "max_task_error_mm": summ["max_task_error"] * mm,
+              "rms_task_error_mm": summ["rms_task_error"] * mm,
+              "final_task_error_mm": summ["final_task_error"] * mm,
+              "max_joint_error_deg": float(np.degrees(summ["max_joint_error_rad"])),
+              "saturated_fraction": summ["saturated_fraction"]}
+    fig = tracking_figure(res, sc.units, c["mass_error"], c["payload_kg"])
+    with OutputDir(out, force=force) as od:
+        od.write_text("tracking.csv", csv_text(cols))
+        od.write_bytes("tracking.png", png_bytes(fig))
+        od.write_text("tracking.json", json.dumps(report, indent=2, default=str) + "\n")
+    warnings = []
+    if summ["saturated_fraction"] > 0:
+        warnings.append(f"dextar simulate: warning: the torque limit {c['torque_limit_nm']:g} "
+                        f"N m saturates a motor during {summ['saturated_fraction']:.1%} of the "
+                        "motion; tracking is not guaranteed")
+    files = ", ".join(shown(out, n) for n in ("tracking.csv", "tracking.png", "tracking.json"))
+    return JobResult(report, f"wrote {files}: max task error "
+                     f"{report['max_task_error_mm']:.4g} mm, max joint error "
+                     f"{report['max_joint_error_deg']:.4g} deg, torque saturated "
+                     f"{report['saturated_fraction']:.1%} of the time", warnings)
+
+
+def export_mjcf(config: str | None, out: str) -> JobResult:
+    """The MuJoCo model of the configured robot with a keyframe at the motion's start."""
+    from .output.mjcf import to_mjcf
+
+    sc = load_scenario(config)
+    path = out_file(out, ".xml")
+    tr = sc.trajectory(samples=2)
+    where, data = _write(path, to_mjcf(sc.model(tr.assembly), start=(tr.q[0], tr.dq[0])))
+    return JobResult({"out": where, "units": sc.units.describe()},
+                     f"wrote {where} (MuJoCo model in {_units_note(sc)}; keyframe 'start' at "
+                     "the motion's start)", data=data)
+
+
+def run(config: str | None, out: str, *, force: bool = False,
+        quiet: bool = False) -> JobResult:
+    """The main job: the paper's example (or the configured scenario) end to end, every file
+    written to ``out``."""
+    from .analysis import analyze, run_summary, validation
+    from .output.outdir import OutputDir
+    from .output.run import Progress, staged, write_run
+
+    sc = load_scenario(config)
+    prog = Progress(enabled=not quiet and sys.stderr.isatty())
+    stage = staged(prog)
+    inputs = sc.inputs()
+    with OutputDir(out, force=force) as od:
+        an = stage(f"{sc.law_table.type} law, trajectory and torques",
+                   lambda: analyze(inputs, sc.law()))
+        uniform = stage("uniform law (Fig. 3)", lambda: inputs.trajectory(sc.law("uniform")))
+        checks = stage("validation (power balance, forward re-simulation)",
+                       lambda: validation(an))
+        s = run_summary(an, checks, inputs.trajectory(uniform.law, samples=201))
+        write_run(od, an, uniform, s, figures=sc.output.figures,
+                  animation_frames=sc.output.animation_frames, stage=stage, progress=prog)
+    law = s["law"]
+    warnings = ([] if law["success"] else
+                [f"dextar run: warning: {law['type']} law status {law['status']}: "
+                 f"{law['message']}"])
+    lines = [f"wrote {len(s['files'])} files to {shown(out)} (open "
+             f"{shown(out, 'report.html')})",
+             f"{law['type']} law: motion time {law['duration_s']:.6g} s; status "
+             f"{law['status']}: {law['message']}"]
+    if "cost" in s:
+        lines.append(f"cost Phi = {s['cost']['total']:.8g} [{s['cost']['unit']}]")
+    lines.append(f"peak |tau| exact = {max(s['torques']['exact']['peak']):.6g} "
+                 f"{s['units']['torque_unit']}")
+    lines += [f"  {c['verdict']:>11}: {c['claim']} ({c['value']:.3g})"
+              for c in s.get("claims", [])]
+    return JobResult(s, "\n".join(lines), warnings)

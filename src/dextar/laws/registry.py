@@ -1,0 +1,92 @@
+"""Laws of motion by their config name (``[law].type``): each declares its keys and builds a
+:class:`~dextar.laws.base.Law` from a :class:`LawRequest`.
+
+Adding a law is one file: the law and one :func:`register_law` call. The config files, the
+command line's help and the docs list the laws from here. For example, a constant-speed law
+under another name::
+
+    from dextar.laws import Law, LawType, Param, register_law
+
+    register_law(LawType("steady", {"duration": Param("number", "s", 1.0, positive=True)},
+                         lambda req: UniformLaw(req.path.length, req.params["duration"])))
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from ..errors import ConfigError
+from ..params import Param
+from ..paths import Path
+from ..units import Units
+from .base import Law
+
+
+@dataclass(frozen=True)
+class LawRequest:
+    """What a law is planned from.
+
+    Attributes
+    ----------
+    path : Path
+        The path, in run units.
+    params : mapping
+        The law's config keys, in run units.
+    mass : float
+        The moving point mass at P (run units), for laws that weigh it (the optimal law).
+    dynamics : object, optional
+        The robot along the path (a :class:`~dextar.laws.time_optimal.PathDynamics`), for
+        laws planned under motor limits; None when the law does not need it.
+    units : Units
+        The run's units (for the words of an error).
+    """
+
+    path: Path
+    params: Mapping[str, Any]
+    mass: float
+    dynamics: Any
+    units: Units
+
+
+@dataclass(frozen=True)
+class LawType:
+    """A registered law.
+
+    Attributes
+    ----------
+    name : str
+        Its config name (``[law].type``).
+    params : mapping of str to Param
+        Its config keys.
+    build : callable
+        ``build(request) -> Law``.
+    help : str
+        One line for the docs.
+    needs_dynamics : bool
+        The law is planned on the robot's dynamics (motor limits): the request carries them.
+    """
+
+    name: str
+    params: Mapping[str, Param]
+    build: Callable[[LawRequest], Law]
+    help: str = ""
+    needs_dynamics: bool = False
+
+
+LAW_TYPES: dict[str, LawType] = {}
+
+
+def register_law(kind: LawType) -> LawType:
+    """Add a law to the registry (a later registration of the same name replaces it)."""
+    LAW_TYPES[kind.name] = kind
+    return kind
+
+
+def law_type(name: object) -> LawType:
+    """The registered law ``name``; a :class:`ConfigError` lists the known ones."""
+    if not isinstance(name, str) or name not in LAW_TYPES:
+        raise ConfigError(f"config key [law].type must be one of {', '.join(LAW_TYPES)}, got "
+                          f"{name!r}")
+    return LAW_TYPES[name]
