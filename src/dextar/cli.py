@@ -195,8 +195,25 @@ def cmd_run(args: argparse.Namespace) -> int:
     return _print(args, jobs.run(args.config, args.out, force=args.force, quiet=args.quiet))
 
 
+def _registries_help() -> str:
+    """The registered config tables, path types and laws (read when the parser is built, so
+    a type registered by a plug-in is listed too)."""
+    from .config import TABLES
+    from .laws import LAW_TYPES
+    from .paths import PATH_TYPES
+
+    laws = "\n".join(f"  {k:<14} {v.help}" for k, v in LAW_TYPES.items())
+    paths = "\n".join(f"  {k:<14} {v.help}" for k, v in PATH_TYPES.items())
+    return (f"config tables: {', '.join(f'[{t}]' for t in TABLES)}\n"
+            f"[path].type:\n{paths}\n[law].type:\n{laws}")
+
+
 def _register_stages(sub: Any) -> None:
+    epilog = _registries_help()
+
     def cfg(sp: argparse.ArgumentParser) -> None:
+        sp.formatter_class = argparse.RawDescriptionHelpFormatter
+        sp.epilog = epilog
         sp.add_argument("config", nargs="?", help="TOML config (default: the paper's example)")
         sp.add_argument("--json", action="store_true", help="print one JSON object")
 

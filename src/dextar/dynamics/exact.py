@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -80,51 +80,125 @@ class _Py:
         return x if x > 0.0 else 0.0
 
 
-def _kernel(model: Model, q1: Any, q2: Any, w1: Any, w2: Any, a1: Any, a2: Any, *,
-            gravity: bool, friction: bool, xp: Any, extra: bool = False) -> dict[str, Any]:
-    """Torques (and, with ``extra``, everything the energies and reactions need)."""
-    r, ine = model.robot, model.inertia
+class Pose(NamedTuple):
+    """Positions of one configuration (each field an array or a float): the motor angles'
+    cosines and sines, the elbows B and C, P by direct kinematics, ``P - B`` (``u``),
+    ``P - C`` (``e``), ``b1, b2`` (the diagonal of ``B``), ``det A`` and its inverse, and the
+    circle-intersection discriminant ``wsq`` over ``del2 = |B - C|^2`` (for the checks)."""
+
+    c1: Any
+    s1: Any
+    c2: Any
+    s2: Any
+    Bx: Any
+    By: Any
+    Cx: Any
+    Cy: Any
+    Px: Any
+    Py: Any
+    ux: Any
+    uy: Any
+    ex: Any
+    ey: Any
+    b1: Any
+    b2: Any
+    det: Any
+    idet: Any
+    wsq: Any
+    del2: Any
+
+
+class Rates(NamedTuple):
+    """Velocities of B, C, P and the velocity-product terms of ``A Pddot - B qddot = b``."""
+
+    dPx: Any
+    dPy: Any
+    dBx: Any
+    dBy: Any
+    dCx: Any
+    dCy: Any
+    bias1: Any
+    bias2: Any
+
+
+class Loads(NamedTuple):
+    """Accelerations of B, C, P, the inertia forces of the distal rods and of the point mass
+    (gravity included), the distal rods' angular accelerations and the motor torques."""
+
+    ddPx: Any
+    ddPy: Any
+    ddBx: Any
+    ddBy: Any
+    ddCx: Any
+    ddCy: Any
+    f3x: Any
+    f3y: Any
+    f4x: Any
+    f4y: Any
+    fPx: Any
+    fPy: Any
+    alpha3: Any
+    alpha4: Any
+    tau1: Any
+    tau2: Any
+
+
+def _pose(model: Model, q1: Any, q2: Any, xp: Any) -> Pose:
+    """Direct kinematics and the velocity-relation matrices, once per configuration."""
+    r = model.robot
     l1, l2, L1, L2 = r.l1, r.l2, r.L1, r.L2
     half = 0.5 * r.d
-    sigma = parse_assembly_mode(model.assembly)
     c1, s1 = xp.cos_sin(q1)
     c2, s2 = xp.cos_sin(q2)
     Bx, By = half + l1 * c1, l1 * s1
     Cx, Cy = l2 * c2 - half, l2 * s2
-    # direct kinematics: P from the circles (B, L1) and (C, L2)
+    # P from the circles (B, L1) and (C, L2)
     vx, vy = Bx - Cx, By - Cy
     del2 = vx * vx + vy * vy
     k = 0.5 * (del2 + (L2 * L2 - L1 * L1))
     wsq = (L2 * L2) * del2 - k * k
     h = xp.sqrt(xp.clip0(wsq))
-    if sigma < 0:
+    if parse_assembly_mode(model.assembly) < 0:
         h = -h
     inv = 1.0 / del2
     Px = Cx + (k * vx - h * vy) * inv
     Py = Cy + (k * vy + h * vx) * inv
-    ux, uy = Px - Bx, Py - By  # P - B
-    ex, ey = Px - Cx, Py - Cy  # P - C
+    ux, uy = Px - Bx, Py - By
+    ex, ey = Px - Cx, Py - Cy
     b1 = l1 * (c1 * uy - s1 * ux)
     b2 = l2 * (c2 * ey - s2 * ex)
     det = ux * ey - uy * ex
-    idet = 1.0 / det
-    # velocities
-    r1, r2 = b1 * w1, b2 * w2
-    dPx = (ey * r1 - uy * r2) * idet
-    dPy = (ux * r2 - ex * r1) * idet
-    dBx, dBy = -l1 * s1 * w1, l1 * c1 * w1
-    dCx, dCy = -l2 * s2 * w2, l2 * c2 * w2
+    return Pose(c1, s1, c2, s2, Bx, By, Cx, Cy, Px, Py, ux, uy, ex, ey, b1, b2, det, 1.0 / det,
+                wsq, del2)
+
+
+def _rates(model: Model, p: Pose, w1: Any, w2: Any) -> Rates:
+    """Velocities for the joint rates ``w1, w2`` (``Pdot = A^-1 B qdot``)."""
+    l1, l2 = model.robot.l1, model.robot.l2
+    r1, r2 = p.b1 * w1, p.b2 * w2
+    dPx = (p.ey * r1 - p.uy * r2) * p.idet
+    dPy = (p.ux * r2 - p.ex * r1) * p.idet
+    dBx, dBy = -l1 * p.s1 * w1, l1 * p.c1 * w1
+    dCx, dCy = -l2 * p.s2 * w2, l2 * p.c2 * w2
     gx1, gy1 = dPx - dBx, dPy - dBy
     gx2, gy2 = dPx - dCx, dPy - dCy
-    bias1 = -(gx1 * gx1 + gy1 * gy1) - l1 * w1 * w1 * (ux * c1 + uy * s1)
-    bias2 = -(gx2 * gx2 + gy2 * gy2) - l2 * w2 * w2 * (ex * c2 + ey * s2)
-    r1 = b1 * a1 + bias1
-    r2 = b2 * a2 + bias2
-    ddPx = (ey * r1 - uy * r2) * idet
-    ddPy = (ux * r2 - ex * r1) * idet
+    bias1 = -(gx1 * gx1 + gy1 * gy1) - l1 * w1 * w1 * (p.ux * p.c1 + p.uy * p.s1)
+    bias2 = -(gx2 * gx2 + gy2 * gy2) - l2 * w2 * w2 * (p.ex * p.c2 + p.ey * p.s2)
+    return Rates(dPx, dPy, dBx, dBy, dCx, dCy, bias1, bias2)
+
+
+def _loads(model: Model, p: Pose, v: Rates, w1: Any, w2: Any, a1: Any, a2: Any, *,
+           gravity: bool, friction: bool) -> Loads:
+    """Accelerations, inertia forces and the motor torques (Kane's equations)."""
+    r, ine = model.robot, model.inertia
+    l1, l2, L1, L2 = r.l1, r.l2, r.L1, r.L2
+    r1 = p.b1 * a1 + v.bias1
+    r2 = p.b2 * a2 + v.bias2
+    ddPx = (p.ey * r1 - p.uy * r2) * p.idet
+    ddPy = (p.ux * r2 - p.ex * r1) * p.idet
     ww1, ww2 = w1 * w1, w2 * w2
-    ddBx, ddBy = -l1 * (s1 * a1 + c1 * ww1), l1 * (c1 * a1 - s1 * ww1)
-    ddCx, ddCy = -l2 * (s2 * a2 + c2 * ww2), l2 * (c2 * a2 - s2 * ww2)
+    ddBx, ddBy = -l1 * (p.s1 * a1 + p.c1 * ww1), l1 * (p.c1 * a1 - p.s1 * ww1)
+    ddCx, ddCy = -l2 * (p.s2 * a2 + p.c2 * ww2), l2 * (p.c2 * a2 - p.s2 * ww2)
     gx, gy = ine.gravity if gravity else (0.0, 0.0)
     rod1, rod2 = ine.proximal
     rod3, rod4 = ine.distal
@@ -132,39 +206,37 @@ def _kernel(model: Model, q1: Any, q2: Any, w1: Any, w2: Any, a1: Any, a2: Any, 
     # distal rod 3 (B -> P)
     f3x = rod3.mass * (ddBx + lam3 * (ddPx - ddBx) - gx)
     f3y = rod3.mass * (ddBy + lam3 * (ddPy - ddBy) - gy)
-    alpha3 = (ux * (ddPy - ddBy) - uy * (ddPx - ddBx)) / (L1 * L1)
+    alpha3 = (p.ux * (ddPy - ddBy) - p.uy * (ddPx - ddBx)) / (L1 * L1)
     k3 = rod3.inertia * alpha3 / (L1 * L1)
     # distal rod 4 (C -> P)
     f4x = rod4.mass * (ddCx + lam4 * (ddPx - ddCx) - gx)
     f4y = rod4.mass * (ddCy + lam4 * (ddPy - ddCy) - gy)
-    alpha4 = (ex * (ddPy - ddCy) - ey * (ddPx - ddCx)) / (L2 * L2)
+    alpha4 = (p.ex * (ddPy - ddCy) - p.ey * (ddPx - ddCx)) / (L2 * L2)
     k4 = rod4.inertia * alpha4 / (L2 * L2)
     mP = ine.point_mass
     fPx, fPy = mP * (ddPx - gx), mP * (ddPy - gy)
-    FPx = fPx + lam3 * f3x + lam4 * f4x - k3 * uy - k4 * ey
-    FPy = fPy + lam3 * f3y + lam4 * f4y + k3 * ux + k4 * ex
-    FBx, FBy = (1.0 - lam3) * f3x + k3 * uy, (1.0 - lam3) * f3y - k3 * ux
-    FCx, FCy = (1.0 - lam4) * f4x + k4 * ey, (1.0 - lam4) * f4y - k4 * ex
+    FPx = fPx + lam3 * f3x + lam4 * f4x - k3 * p.uy - k4 * p.ey
+    FPy = fPy + lam3 * f3y + lam4 * f4y + k3 * p.ux + k4 * p.ex
+    FBx, FBy = (1.0 - lam3) * f3x + k3 * p.uy, (1.0 - lam3) * f3y - k3 * p.ux
+    FCx, FCy = (1.0 - lam4) * f4x + k4 * p.ey, (1.0 - lam4) * f4y - k4 * p.ex
     J1 = ine.rotor[0] + rod1.about_joint
     J2 = ine.rotor[1] + rod2.about_joint
-    tau1 = (l1 * (c1 * FBy - s1 * FBx) + b1 * (ey * FPx - ex * FPy) * idet + J1 * a1
-            - rod1.mass * rod1.com * (c1 * gy - s1 * gx))
-    tau2 = (l2 * (c2 * FCy - s2 * FCx) + b2 * (ux * FPy - uy * FPx) * idet + J2 * a2
-            - rod2.mass * rod2.com * (c2 * gy - s2 * gx))
+    tau1 = (l1 * (p.c1 * FBy - p.s1 * FBx) + p.b1 * (p.ey * FPx - p.ex * FPy) * p.idet
+            + J1 * a1 - rod1.mass * rod1.com * (p.c1 * gy - p.s1 * gx))
+    tau2 = (l2 * (p.c2 * FCy - p.s2 * FCx) + p.b2 * (p.ux * FPy - p.uy * FPx) * p.idet
+            + J2 * a2 - rod2.mass * rod2.com * (p.c2 * gy - p.s2 * gx))
     if friction:
         tau1 = tau1 + friction_torque(w1, ine.viscous[0], ine.coulomb[0], ine.coulomb_speed)
         tau2 = tau2 + friction_torque(w2, ine.viscous[1], ine.coulomb[1], ine.coulomb_speed)
-    out = {"tau1": tau1, "tau2": tau2, "det": det, "wsq": wsq, "del2": del2}
-    if extra:
-        out.update(locals())
-    return out
+    return Loads(ddPx, ddPy, ddBx, ddBy, ddCx, ddCy, f3x, f3y, f4x, f4y, fPx, fPy, alpha3,
+                 alpha4, tau1, tau2)
 
 
-def _check_state(model: Model, res: dict[str, Any], q: np.ndarray, offset: int,
+def _check_state(model: Model, pose: Pose, q: np.ndarray, offset: int,
                  t: np.ndarray | None) -> None:
     r = model.robot
-    bad_fk = res["wsq"] < -1e-12 * (r.L2 * r.L2) * res["del2"]
-    dist = np.abs(res["det"]) / (r.L1 * r.L2)
+    bad_fk = pose.wsq < -1e-12 * (r.L2 * r.L2) * pose.del2
+    dist = np.abs(pose.det) / (r.L1 * r.L2)
     bad_sing = dist < model.tol
     for bad, kind in ((bad_fk, "fk"), (bad_sing, "sing")):
         if np.any(bad):
@@ -183,6 +255,9 @@ def _check_state(model: Model, res: dict[str, Any], q: np.ndarray, offset: int,
 
 def _run(model: Model, q: object, dq: object, ddq: object, *, gravity: bool, friction: bool,
          t: object = None, keys: tuple[str, ...] = ("tau1", "tau2")) -> dict[str, np.ndarray]:
+    """Evaluate the kernel on samples (..., 2) in cache-sized blocks: the pose once per
+    sample, then the rates and loads; returns the fields ``keys`` of :class:`Pose`,
+    :class:`Rates` and :class:`Loads`, each of the leading shape."""
     q0 = as_points(q, "q")
     shape = q0.shape[:-1]
     qf = q0.reshape(-1, 2)
@@ -192,16 +267,18 @@ def _run(model: Model, q: object, dq: object, ddq: object, *, gravity: bool, fri
         raise ParameterError(f"q, dq, ddq must have the same number of samples, got "
                              f"{len(qf)}, {len(dqf)}, {len(ddqf)}")
     tt = None if t is None else np.asarray(t, dtype=float).reshape(-1)
-    extra = any(k not in ("tau1", "tau2") for k in keys)
     out = {k: np.empty(len(qf)) for k in keys}
     for blk in blocks(len(qf)):
-        with np.errstate(divide="ignore", invalid="ignore"):  # checked right below
-            res = _kernel(model, qf[blk, 0], qf[blk, 1], dqf[blk, 0], dqf[blk, 1],
-                          ddqf[blk, 0], ddqf[blk, 1], gravity=gravity, friction=friction,
-                          xp=_Np, extra=extra)
-        _check_state(model, res, qf, blk.start, tt)
+        w1, w2, a1, a2 = dqf[blk, 0], dqf[blk, 1], ddqf[blk, 0], ddqf[blk, 1]
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # checked below
+            pose = _pose(model, qf[blk, 0], qf[blk, 1], _Np)
+            rates = _rates(model, pose, w1, w2)
+            loads = _loads(model, pose, rates, w1, w2, a1, a2, gravity=gravity,
+                           friction=friction)
+        _check_state(model, pose, qf, blk.start, tt)
         for k in keys:
-            out[k][blk] = res[k]
+            src = loads if k in Loads._fields else rates if k in Rates._fields else pose
+            out[k][blk] = getattr(src, k)
     return {k: v.reshape(shape) for k, v in out.items()}
 
 
@@ -230,16 +307,22 @@ def inverse_dynamics(model: Model, q: object, dq: object, ddq: object, *,
 
 
 def mass_matrix(model: Model, q: object) -> np.ndarray:
-    """The inertia matrix ``M(q)``, shape (..., 2, 2), symmetric positive definite."""
-    q = as_points(q, "q")
-    z = np.zeros_like(q)
-    cols = []
-    for k in range(2):
-        e = np.zeros_like(q)
-        e[..., k] = 1.0
-        out = _run(model, q, z, e, gravity=False, friction=False)
-        cols.append(np.stack([out["tau1"], out["tau2"]], axis=-1))
-    return np.stack(cols, axis=-1)
+    """The inertia matrix ``M(q)``, shape (..., 2, 2), symmetric positive definite (the pose
+    computed once per sample, the two columns from unit accelerations)."""
+    q0 = as_points(q, "q")
+    qf = q0.reshape(-1, 2)
+    M = np.empty((len(qf), 2, 2))
+    for blk in blocks(len(qf)):
+        zero = np.zeros(blk.stop - blk.start)
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            pose = _pose(model, qf[blk, 0], qf[blk, 1], _Np)
+            still = _rates(model, pose, zero, zero)
+            for k, (a1, a2) in enumerate(((1.0, 0.0), (0.0, 1.0))):
+                col = _loads(model, pose, still, zero, zero, a1, a2, gravity=False,
+                             friction=False)
+                M[blk, 0, k], M[blk, 1, k] = col.tau1, col.tau2
+        _check_state(model, pose, qf, blk.start, None)
+    return M.reshape(q0.shape[:-1] + (2, 2))
 
 
 def bias_forces(model: Model, q: object, dq: object) -> np.ndarray:
@@ -324,16 +407,19 @@ def joint_reactions(model: Model, q: object, dq: object, ddq: object) -> Reactio
 
 def state_dynamics(model: Model, q: Any, dq: Any) -> tuple[np.ndarray, np.ndarray]:
     """``M(q)`` (2x2) and ``h(q, qdot) = c + g + friction`` (2,) at one state, on plain floats
-    (fast enough to call from an ODE integrator)."""
+    (fast enough to call from an ODE integrator): the pose is computed once."""
     q1, q2 = float(q[0]), float(q[1])
     w1, w2 = float(dq[0]), float(dq[1])
-    h = _kernel(model, q1, q2, w1, w2, 0.0, 0.0, gravity=True, friction=True, xp=_Py)
-    dist = abs(h["det"]) / (model.robot.L1 * model.robot.L2)
-    if h["wsq"] < 0 or dist < model.tol:
+    pose = _pose(model, q1, q2, _Py)
+    dist = abs(pose.det) / (model.robot.L1 * model.robot.L2)
+    if pose.wsq < 0 or dist < model.tol:
         raise SingularityError(
             f"parallel (type 2) singularity: q = ({math.degrees(q1):.6g}, "
             f"{math.degrees(q2):.6g}) deg, normalised distance {dist:.3g}")
-    m1 = _kernel(model, q1, q2, 0.0, 0.0, 1.0, 0.0, gravity=False, friction=False, xp=_Py)
-    m2 = _kernel(model, q1, q2, 0.0, 0.0, 0.0, 1.0, gravity=False, friction=False, xp=_Py)
-    M = np.array([[m1["tau1"], m2["tau1"]], [m1["tau2"], m2["tau2"]]])
-    return M, np.array([h["tau1"], h["tau2"]])
+    h = _loads(model, pose, _rates(model, pose, w1, w2), w1, w2, 0.0, 0.0, gravity=True,
+               friction=True)
+    still = _rates(model, pose, 0.0, 0.0)
+    m1 = _loads(model, pose, still, 0.0, 0.0, 1.0, 0.0, gravity=False, friction=False)
+    m2 = _loads(model, pose, still, 0.0, 0.0, 0.0, 1.0, gravity=False, friction=False)
+    M = np.array([[m1.tau1, m2.tau1], [m1.tau2, m2.tau2]])
+    return M, np.array([h.tau1, h.tau2])

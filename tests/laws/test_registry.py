@@ -1,0 +1,68 @@
+"""A new law is one file plus its tests: a toy law registered from outside the package,
+through the public registry, plans from a config, and the docs and help list it."""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import pytest
+
+from dextar.config import scenario_from_dict
+from dextar.laws import LAW_TYPES, Law, LawType, Param, register_law
+from dextar.paths import PATH_TYPES
+
+
+@dataclass(frozen=True)
+class ConstantAcceleration(Law):
+    """Accelerate at a constant rate over the whole path: s = S (t / T)^2 (not rest to
+    rest: the toy of the registry test)."""
+
+    distance: float
+    duration: float
+    name: str = field(default="const-accel", init=False)
+
+    def _evaluate(self, t: np.ndarray) -> np.ndarray:
+        S, T = self.distance, self.duration
+        return np.stack([S * (t / T) ** 2, 2 * S * t / T**2, np.full_like(t, 2 * S / T**2),
+                         np.zeros_like(t)])
+
+
+@pytest.fixture
+def toy_law():
+    kind = register_law(LawType(
+        "const-accel", {"duration": Param("number", "s", 1.0, "motion time", positive=True)},
+        lambda req: ConstantAcceleration(req.path.length, req.params["duration"]),
+        "constant acceleration from rest"))
+    yield kind
+    LAW_TYPES.pop("const-accel")
+
+
+def test_a_toy_law_registered_from_outside_plans_from_a_config(toy_law):
+    sc = scenario_from_dict({"law": {"type": "const-accel", "duration": 0.5},
+                             "output": {"units": "si", "samples": 101}})
+    law = sc.law()
+    assert isinstance(law, ConstantAcceleration) and law.duration == 0.5
+    tr = sc.trajectory(law)
+    assert tr.t[-1] == 0.5 and np.allclose(tr.dds, 2 * sc.path.length / 0.25)
+    # its keys are checked like any other's
+    with pytest.raises(Exception, match=r"\[law\]\.duration must be positive"):
+        scenario_from_dict({"law": {"type": "const-accel", "duration": -1.0}})
+
+
+def test_the_command_line_plans_with_it_and_its_help_lists_it(toy_law, tmp_path, capsys):
+    from dextar.cli import build_parser, main
+
+    cfg = tmp_path / "c.toml"
+    cfg.write_text('[law]\ntype = "const-accel"\nduration = 0.4\n[output]\nunits = "si"\n')
+    assert main(["plan", str(cfg), "--out", str(tmp_path / "p.csv"), "--json"]) == 0
+    assert '"law": "const-accel"' in capsys.readouterr().out
+    helptext = build_parser().format_help() + "".join(
+        a.choices["plan"].format_help() for a in build_parser()._subparsers._group_actions)
+    assert "const-accel" in helptext
+
+
+def test_readme_lists_every_registered_path_and_law():
+    from pathlib import Path
+
+    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
+    for name in [*PATH_TYPES, *(k for k in LAW_TYPES if k != "const-accel")]:
+        assert f'`"{name}"`' in readme, name
