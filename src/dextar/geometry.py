@@ -12,6 +12,7 @@ Assembly mode (direct kinematics branch): ``sign((B - C) x (P - C))``, ``+1`` = 
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
@@ -45,15 +46,12 @@ class FiveBar:
     def __post_init__(self) -> None:
         for name in ("l1", "l2", "L1", "L2", "d"):
             value = getattr(self, name)
-            try:
-                value = float(value)
-            except (TypeError, ValueError):
-                raise GeometryError(f"geometry length {name} = {value!r} is not a number") from None
+            if not isinstance(value, numbers.Real) or isinstance(value, bool):
+                raise GeometryError(f"geometry length {name} = {value!r} is not a number")
             if not math.isfinite(value) or value <= 0.0:
                 raise GeometryError(
                     f"geometry length {name} = {value!r} must be positive and finite"
                 )
-            object.__setattr__(self, name, value)
         # Each leg reaches an annulus about its pivot; the two annuli must overlap.
         r1, R1 = abs(self.l1 - self.L1), self.l1 + self.L1
         r2, R2 = abs(self.l2 - self.L2), self.l2 + self.L2
@@ -95,6 +93,7 @@ class FiveBar:
         return FiveBar(*(factor * v for v in (self.l1, self.l2, self.L1, self.L2, self.d)))
 
     def as_dict(self) -> dict[str, float]:
+        """The five lengths by name."""
         return {"l1": self.l1, "l2": self.l2, "L1": self.L1, "L2": self.L2, "d": self.d}
 
 

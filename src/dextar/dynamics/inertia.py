@@ -9,6 +9,7 @@ and Coulomb friction at the motors; an in-plane gravity vector.
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -18,11 +19,11 @@ from ..geometry import FiveBar
 from .friction import friction_torque
 
 
-def _check(name: str, value: float, *, positive: bool = False) -> float:
-    try:
-        value = float(value)
-    except (TypeError, ValueError):
-        raise ParameterError(f"{name} = {value!r} is not a number") from None
+def _check(name: str, value: object, *, positive: bool = False) -> float:
+    """Check a non-negative (or positive) finite number; returns it as a float."""
+    if not isinstance(value, numbers.Real) or isinstance(value, bool):
+        raise ParameterError(f"{name} = {value!r} is not a number")
+    value = float(value)
     if not math.isfinite(value):
         raise ParameterError(f"{name} = {value!r} must be finite")
     if value < 0 or (positive and value == 0):
@@ -39,15 +40,14 @@ class Rod:
     com: float
     inertia: float
 
-    def validated(self, name: str) -> Rod:
+    def check(self, name: str) -> None:
+        """Raise :class:`ParameterError`, naming the rod, for an invalid value."""
         m = _check(f"{name} mass", self.mass)
-        c = float(self.com)
-        if not math.isfinite(c):
+        if not (isinstance(self.com, numbers.Real) and math.isfinite(self.com)):
             raise ParameterError(f"{name} centre of mass {self.com!r} must be finite")
         i = _check(f"{name} inertia", self.inertia)
         if m == 0 and (i > 0):
             raise ParameterError(f"{name}: a massless rod cannot have inertia {i:g}")
-        return Rod(m, c, i)
 
     @staticmethod
     def uniform(mass: float, length: float) -> Rod:
@@ -99,22 +99,20 @@ class Inertia:
             rods = getattr(self, attr)
             if len(rods) != 2:
                 raise ParameterError(f"{attr} must hold two rods")
-            object.__setattr__(self, attr, tuple(r.validated(n) for r, n in
-                                                 zip(rods, labels, strict=True)))
-        object.__setattr__(self, "effector_mass", _check("effector mass", self.effector_mass))
-        object.__setattr__(self, "payload", _check("payload", self.payload))
+            for r, n in zip(rods, labels, strict=True):
+                r.check(n)
+        _check("effector mass", self.effector_mass)
+        _check("payload", self.payload)
         for attr in ("rotor", "viscous", "coulomb"):
-            pair = tuple(getattr(self, attr))
+            pair = getattr(self, attr)
             if len(pair) != 2:
                 raise ParameterError(f"{attr} must be a pair (motor A, motor D)")
-            object.__setattr__(self, attr, tuple(_check(f"{attr} {k + 1}", v)
-                                                 for k, v in enumerate(pair)))
-        g = tuple(float(v) for v in self.gravity)
-        if len(g) != 2 or not all(math.isfinite(v) for v in g):
+            for k, v in enumerate(pair):
+                _check(f"{attr} {k + 1}", v)
+        g = self.gravity
+        if len(g) != 2 or not all(isinstance(v, numbers.Real) and math.isfinite(v) for v in g):
             raise ParameterError(f"gravity {self.gravity!r} must be a finite 2-vector")
-        object.__setattr__(self, "gravity", g)
-        object.__setattr__(self, "coulomb_speed", _check("Coulomb regularisation speed",
-                                                         self.coulomb_speed, positive=True))
+        _check("Coulomb regularisation speed", self.coulomb_speed, positive=True)
 
     @property
     def point_mass(self) -> float:

@@ -108,31 +108,26 @@ class MinimumJerkLaw(Law):
         ])
 
 
-@dataclass(frozen=True)
 class TrapezoidalLaw(Law):
     """Trapezoidal velocity: accelerate at ``amax``, cruise at ``v <= vmax``, decelerate.
 
     With ``duration=None`` the law is the fastest one within the limits (a triangle when
     ``vmax`` is not reached); with a duration the cruise speed is chosen to arrive at exactly
-    that time, which must be feasible with ``amax`` and ``vmax``.
+    that time, which must be feasible with ``amax`` and ``vmax``. Read-only once built.
     """
 
-    distance: float
-    vmax: float
-    amax: float
-    duration: float | None = None  # type: ignore[assignment]
-    name: str = field(default="trapezoid", init=False)
-    cruise: float = field(default=0.0, init=False)
+    name = "trapezoid"
 
-    def __post_init__(self) -> None:
-        S = _positive("distance", self.distance)
-        vmax = _positive("vmax", self.vmax)
-        a = _positive("amax", self.amax)
-        if self.duration is None:
-            v = min(vmax, math.sqrt(S * a))
+    def __init__(self, distance: float, vmax: float, amax: float,
+                 duration: float | None = None) -> None:
+        S = _positive("distance", distance)
+        vm = _positive("vmax", vmax)
+        a = _positive("amax", amax)
+        if duration is None:
+            v = min(vm, math.sqrt(S * a))
             T = S / v + v / a
         else:
-            T = _positive("duration", self.duration)
+            T = _positive("duration", duration)
             disc = a * a * T * T - 4 * a * S
             if disc < 0:
                 tmin = 2 * math.sqrt(S / a)
@@ -140,11 +135,20 @@ class TrapezoidalLaw(Law):
                                      f"duration {T:.6g} with amax {a:.6g} (needs at least "
                                      f"{tmin:.6g})")
             v = 0.5 * (a * T - math.sqrt(disc))
-            if v > vmax * (1 + 1e-12):
+            if v > vm * (1 + 1e-12):
                 raise ParameterError(f"trapezoid: duration {T:.6g} needs cruise speed {v:.6g} "
-                                     f"above vmax {vmax:.6g}")
-        object.__setattr__(self, "duration", T)
-        object.__setattr__(self, "cruise", v)
+                                     f"above vmax {vm:.6g}")
+        self._values = (S, vm, a, T, v)
+
+    distance = property(lambda self: self._values[0], doc="Path length covered.")
+    vmax = property(lambda self: self._values[1], doc="Speed limit.")
+    amax = property(lambda self: self._values[2], doc="Acceleration.")
+    duration = property(lambda self: self._values[3], doc="Motion time.")
+    cruise = property(lambda self: self._values[4], doc="Cruise speed.")
+
+    def __repr__(self) -> str:
+        return (f"TrapezoidalLaw(distance={self.distance!r}, vmax={self.vmax!r}, "
+                f"amax={self.amax!r}, duration={self.duration!r})")
 
     def breakpoints(self) -> np.ndarray:
         """The ends of the acceleration and deceleration phases."""

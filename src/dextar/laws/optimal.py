@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import lru_cache
 from typing import Any
 
@@ -202,8 +202,7 @@ def solve_optimal_law(path: Path, *, duration: float = 1.0, eta: float = 0.1, ma
                      nodes=nodes, iterations=iters,
                      message=f"converged ({method}): residual {resid:.1e} with {nodes} nodes")
     kin, inert = law_cost(law, path, m, eta, nodes=max(64, 2 * nodes))
-    object.__setattr__(law, "kinetic", kin)
-    object.__setattr__(law, "inertial", inert)
+    law = replace(law, kinetic=kin, inertial=inert)
     bc = law.evaluate(np.array([0.0, T]))
     bc_err = max(abs(bc[0, 0]), abs(bc[0, 1] - S), abs(bc[1, 0]) * T, abs(bc[1, 1]) * T) / S
     if bc_err > 1e-8:

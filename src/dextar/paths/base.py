@@ -13,6 +13,7 @@ import math
 from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import Any
 
 import numpy as np
 from scipy.interpolate import CubicHermiteSpline, make_interp_spline
@@ -134,7 +135,9 @@ class Arc(Path):
         if not (math.isfinite(self.p0) and math.isfinite(self.p1) and self.p1 > self.p0):
             raise ParameterError(f"arc angles must satisfy start < end, got {self.p0!r}, "
                                  f"{self.p1!r}")
-        object.__setattr__(self, "center", tuple(float(c) for c in self.center))
+        c = np.asarray(self.center, dtype=float)
+        if c.shape != (2,) or not np.isfinite(c).all():
+            raise ParameterError(f"arc centre {self.center!r} must be a finite point (x, y)")
 
     @property
     def constant_curvature(self) -> float:  # type: ignore[override]  # a property, not a field
@@ -177,8 +180,6 @@ class Line(Path):
             raise ParameterError("line start and end must be two finite points (x, y)")
         if np.allclose(a, b):
             raise ParameterError("line start and end must differ")
-        object.__setattr__(self, "start", tuple(a.tolist()))
-        object.__setattr__(self, "end", tuple(b.tolist()))
 
     def derivatives(self, p: object) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         p = self._check_parameter(p)
@@ -209,7 +210,6 @@ class Spline(Path):
 
     waypoints: tuple[tuple[float, float], ...]
     p0: float = field(default=0.0, init=False)
-    p1: float = field(default=1.0, init=False)
 
     def __post_init__(self) -> None:
         w = np.asarray(self.waypoints, dtype=float)
@@ -221,15 +221,25 @@ class Spline(Path):
         if (chord <= 0).any():
             i = int(np.flatnonzero(chord <= 0)[0])
             raise ParameterError(f"spline waypoints {i} and {i + 1} coincide")
-        object.__setattr__(self, "waypoints", tuple(map(tuple, w.tolist())))
-        knots = np.concatenate([[0.0], np.cumsum(chord)])
-        object.__setattr__(self, "p1", float(knots[-1]))
+
+    @cached_property
+    def _knots(self) -> np.ndarray:
+        """Cumulative chord length at the waypoints (the parameter)."""
+        w = np.asarray(self.waypoints, dtype=float)
+        return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(w, axis=0), axis=1))])
+
+    @property
+    def p1(self) -> float:  # type: ignore[override]  # derived from the waypoints
+        """The total chord length."""
+        return float(self._knots[-1])
+
+    @cached_property
+    def _spl(self) -> Any:
+        w = np.asarray(self.waypoints, dtype=float)
         if len(w) == 2:  # the straight segment (a quintic would overshoot it)
-            spl = make_interp_spline(knots, w, k=1)
-        else:
-            bc = [(3, np.zeros(2)), (4, np.zeros(2))]
-            spl = make_interp_spline(knots, w, k=5, bc_type=(bc, bc))
-        object.__setattr__(self, "_spl", spl)
+            return make_interp_spline(self._knots, w, k=1)
+        bc = [(3, np.zeros(2)), (4, np.zeros(2))]
+        return make_interp_spline(self._knots, w, k=5, bc_type=(bc, bc))
 
     @property
     def constant_curvature(self) -> float | None:  # type: ignore[override]  # a property here
@@ -238,7 +248,7 @@ class Spline(Path):
 
     def derivatives(self, p: object) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         p = self._check_parameter(p)
-        spl = self._spl  # type: ignore[attr-defined]
+        spl = self._spl
         vals = [spl(p, nu=k) if k <= spl.k else np.zeros(p.shape + (2,)) for k in range(4)]
         return vals[0], vals[1], vals[2], vals[3]
 
@@ -264,12 +274,19 @@ class ExpressionPath(Path):
             raise ParameterError(f"expression path needs p0 < p1, got {self.p0!r}, {self.p1!r}")
         if not (math.isfinite(self.scale) and self.scale > 0):
             raise ParameterError(f"expression path scale {self.scale!r} must be positive")
-        object.__setattr__(self, "_ex", Expression.parse(self.x))
-        object.__setattr__(self, "_ey", Expression.parse(self.y))
+        _ = (self._ex, self._ey)  # parse now: a bad expression fails at construction
+
+    @cached_property
+    def _ex(self) -> Expression:
+        return Expression.parse(self.x)
+
+    @cached_property
+    def _ey(self) -> Expression:
+        return Expression.parse(self.y)
 
     def derivatives(self, p: object) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         p = self._check_parameter(p)
-        xs = self._ex(p)  # type: ignore[attr-defined]  # set in __post_init__
-        ys = self._ey(p)  # type: ignore[attr-defined]
+        xs = self._ex(p)
+        ys = self._ey(p)
         r = [self.scale * np.stack([a, b], -1) for a, b in zip(xs, ys, strict=True)]
         return r[0], r[1], r[2], r[3]
