@@ -2,12 +2,17 @@
 
 from __future__ import annotations
 
+from typing import Any, TypeAlias
+
 import numpy as np
 
 from .errors import ParameterError
 
+#: A NumPy array (any shape and dtype; dextar computes in float64).
+Array: TypeAlias = np.ndarray[Any, Any]
 
-def as_points(values: object, name: str) -> np.ndarray:
+
+def as_points(values: object, name: str) -> Array:
     """Float array of shape (..., 2), finite; raises naming ``name`` and the first bad index."""
     arr = np.asarray(values, dtype=float)
     if arr.ndim == 0 or arr.shape[-1] != 2:
@@ -16,13 +21,13 @@ def as_points(values: object, name: str) -> np.ndarray:
     return arr
 
 
-def check_finite(arr: np.ndarray, name: str) -> None:
+def check_finite(arr: Array, name: str) -> None:
     if not np.isfinite(arr).all():
         idx = first_index(~np.isfinite(arr))
         raise ParameterError(f"{name} has a non-finite value at index {idx}")
 
 
-def first_index(mask: np.ndarray) -> tuple[int, ...] | int:
+def first_index(mask: Array) -> tuple[int, ...] | int:
     """Index of the first True of ``mask`` (an int for 1-D or 0-D masks, else a tuple)."""
     flat = int(np.flatnonzero(mask)[0])
     if mask.ndim <= 1:
@@ -35,16 +40,16 @@ def where(index: tuple[int, ...] | int, shape: tuple[int, ...]) -> str:
     return "" if shape == () else f" at index {index}"
 
 
-def cross(ax: np.ndarray, ay: np.ndarray, bx: np.ndarray, by: np.ndarray) -> np.ndarray:
+def cross(ax: Array, ay: Array, bx: Array, by: Array) -> Array:
     """z component of the 2-D cross product a x b."""
-    return ax * by - ay * bx
+    return np.asarray(ax * by - ay * bx)
 
 
 #: Samples per block in the vectorised kernels: blocks this size stay in cache.
 CHUNK = 32768
 
 
-def cos_sin(angle: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def cos_sin(angle: Array) -> tuple[Array, Array]:
     """``(cos, sin)`` of ``angle`` through the half-angle tangent (one ``tan`` instead of a
     ``cos`` and a ``sin``: several times faster in NumPy, accurate to a few ulp)."""
     t = np.tan(0.5 * angle)

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._arrays import Array
 from .errors import GeometryError, ParameterError
 
 WORKING_MODES: tuple[str, ...] = ("++", "+-", "-+", "--")
@@ -69,12 +70,12 @@ class FiveBar:
 
     # ------------------------------------------------------------------ derived quantities
     @property
-    def A(self) -> np.ndarray:
+    def A(self) -> Array:
         """Pivot of leg 1, shape (2,)."""
         return np.array([0.5 * self.d, 0.0])
 
     @property
-    def D(self) -> np.ndarray:
+    def D(self) -> Array:
         """Pivot of leg 2, shape (2,)."""
         return np.array([-0.5 * self.d, 0.0])
 

@@ -26,7 +26,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, cast
 
 from .errors import ConfigError
 from .units import Units
@@ -87,7 +87,7 @@ def _check_number(table: str, key: str, p: Param, v: object) -> float:
     where = f"config key [{table}].{key}"
     if not _is_number(v):
         raise ConfigError(f"{where} must be a number, got {type(v).__name__} {v!r}")
-    x = float(v)  # type: ignore[arg-type]  # a number, checked above
+    x = float(cast(float, v))  # a number, checked above
     if not math.isfinite(x):
         raise ConfigError(f"{where} must be finite, got {v!r}")
     if p.positive and not x > 0:

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._arrays import Array
 from .errors import ParameterError
 from .geometry import FiveBar, assembly_mode_name, parse_working_mode, working_mode_name
 from .kinematics import assembly_mode, inverse_kinematics, joint_acceleration, joint_velocity
@@ -43,21 +44,21 @@ class Trajectory:
     law: Law
     mode: str
     assembly: str
-    t: np.ndarray
-    s: np.ndarray
-    ds: np.ndarray
-    dds: np.ndarray
-    p: np.ndarray
-    dp: np.ndarray
-    ddp: np.ndarray
-    P: np.ndarray
-    dP: np.ndarray
-    ddP: np.ndarray
-    q: np.ndarray
-    dq: np.ndarray
-    ddq: np.ndarray
+    t: Array
+    s: Array
+    ds: Array
+    dds: Array
+    p: Array
+    dp: Array
+    ddp: Array
+    P: Array
+    dP: Array
+    ddP: Array
+    q: Array
+    dq: Array
+    ddq: Array
 
-    def columns(self) -> dict[str, np.ndarray]:
+    def columns(self) -> dict[str, Array]:
         """The plan columns: ``t, p, dp, ddp, x, y, dx, dy, ddx, ddy, phi, psi, dphi, dpsi,
         ddphi, ddpsi``."""
         return {
@@ -69,7 +70,7 @@ class Trajectory:
         }
 
 
-def path_motion(path: Path, law: Law, t: np.ndarray) -> tuple[np.ndarray, ...]:
+def path_motion(path: Path, law: Law, t: Array) -> tuple[Array, ...]:
     """Path parameter and end-effector motion at times ``t``.
 
     Returns ``(s, ds, dds, p, dp, ddp, P, dP, ddP)``; with ``v = |r'(p)|`` and
@@ -89,7 +90,7 @@ def path_motion(path: Path, law: Law, t: np.ndarray) -> tuple[np.ndarray, ...]:
 
 
 def sample_trajectory(robot: FiveBar, path: Path, law: Law, *, mode: str = "+-",
-                      samples: int = 1001, times: np.ndarray | None = None,
+                      samples: int = 1001, times: Array | None = None,
                       tolerances: Tolerances = DEFAULT_TOLERANCES,
                       units: Units | None = None) -> Trajectory:
     """Sample ``law`` along ``path`` and map it to joint space in working mode ``mode``.
@@ -175,7 +176,7 @@ class _Words:
     def time(self, t: float) -> str:
         return f"t = {t:.6g}" if self.units is None else self.units.time_text(t)
 
-    def point(self, P: np.ndarray) -> str:
+    def point(self, P: Array) -> str:
         return f"({P[0]:.6g}, {P[1]:.6g})" if self.units is None else self.units.point_text(P)
 
     def length(self, x: float) -> str:

@@ -13,7 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
+from ._arrays import Array
 
 
 @dataclass(frozen=True)
@@ -62,7 +62,7 @@ class Units:
     def speed(self, mm_s: float) -> float:
         return mm_s / (self.length_mm / self.time_s)
 
-    def torque_in_nm(self, run: np.ndarray | float) -> np.ndarray | float:
+    def torque_in_nm(self, run: Array | float) -> Array | float:
         """Run torque units to N m."""
         return run * (self.mass_kg * self.length_mm**2 / self.time_s**2) / 1e6
 

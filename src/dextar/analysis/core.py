@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from .._arrays import Array
 from ..dynamics import Inertia, Model, Reactions, inverse_dynamics, joint_reactions, kinetic_energy
 from ..dynamics.forward import forward_dynamics, torques_from_samples
 from ..dynamics.paper import (
@@ -72,7 +73,7 @@ class RunInputs:
     source: str = ""
 
     def trajectory(self, law: Law, *, samples: int | None = None,
-                   times: np.ndarray | None = None) -> Trajectory:
+                   times: Array | None = None) -> Trajectory:
         """``law`` sampled along the path (``samples`` or the run's samples, or ``times``)."""
         return sample_trajectory(self.robot, self.path, law, mode=self.mode,
                                  samples=samples or self.samples, times=times,
@@ -90,14 +91,14 @@ class PaperComparison:
     friction, which the paper's model leaves out, are excluded from both)."""
 
     model: PaperModel
-    beta: np.ndarray
-    tau: np.ndarray
+    beta: Array
+    tau: Array
     error: dict[str, float]
-    T_exact: np.ndarray
-    T_fd: np.ndarray
-    T_approx: np.ndarray
-    T_S: np.ndarray
-    T_r: np.ndarray
+    T_exact: Array
+    T_fd: Array
+    T_approx: Array
+    T_S: Array
+    T_r: Array
     fig7: dict[str, float]
 
 
@@ -110,13 +111,13 @@ class Analysis:
     law: Law
     trajectory: Trajectory
     model: Model
-    tau: np.ndarray
-    power: np.ndarray
-    energy: np.ndarray
+    tau: Array
+    power: Array
+    energy: Array
     reactions: Reactions
     paper: PaperComparison | None
 
-    def reaction_magnitudes(self) -> dict[str, np.ndarray]:
+    def reaction_magnitudes(self) -> dict[str, Array]:
         """Magnitudes of the passive-joint forces: at B and C (proximal on distal rod) and
         at P (each distal rod on the end-effector)."""
         r = self.reactions
@@ -154,7 +155,7 @@ def analyze(inputs: RunInputs, law: Law) -> Analysis:
     return Analysis(inputs, law, tr, model, tau, power, energy, reactions, paper)
 
 
-def _paper(sc: RunInputs, law: Law, tr: Trajectory, tau: np.ndarray) -> PaperComparison:
+def _paper(sc: RunInputs, law: Law, tr: Trajectory, tau: Array) -> PaperComparison:
     t0 = sc.beta0_time * law.duration
     mid = sample_trajectory(sc.robot, sc.path, law, mode=sc.mode, times=np.array([t0]))
     beta0 = float(base_angle(sc.robot, mid.q)[0])
@@ -178,7 +179,7 @@ def _paper(sc: RunInputs, law: Law, tr: Trajectory, tau: np.ndarray) -> PaperCom
                            {"distal_mass": mL, "JL": JL, "lambda": lam})
 
 
-def power_balance_times(law: Law, interior: int = 201) -> tuple[np.ndarray, float]:
+def power_balance_times(law: Law, interior: int = 201) -> tuple[Array, float]:
     """Times for the power balance and the finite-difference step ``h``: ``interior`` times
     (at most), each at least ``5 h`` from the ends and from every breakpoint of the law (where
     its acceleration jumps and the energy is not smooth)."""

@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from .. import __version__
+from .._arrays import Array
 from ..dynamics.paper import paper_model_limits
 from ..geometry import DEXTAR_MM
 from ..laws import Law, OptimalLaw, TrapezoidalLaw
@@ -64,7 +65,7 @@ def law_summary(sc: RunInputs, law: Law, an: Analysis | None = None) -> dict[str
     return out
 
 
-def _stats(tau: np.ndarray) -> dict[str, list[float]]:
+def _stats(tau: Array) -> dict[str, list[float]]:
     return {"peak": [float(v) for v in np.abs(tau).max(axis=0)],
             "rms": [float(v) for v in np.sqrt(np.mean(tau**2, axis=0))]}
 

@@ -11,7 +11,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from functools import cached_property
 from pathlib import Path as FilePath
-from typing import Any
+from typing import Any, TypeVar
 
 from ..analysis import RunInputs
 from ..dynamics import Inertia, Model, RobotAlongPath
@@ -39,6 +39,8 @@ from .tables import (
 )
 from .toml import check_tables, load_toml
 
+T = TypeVar("T", bound=Table)
+
 
 @dataclass(frozen=True)
 class Scenario:
@@ -51,36 +53,42 @@ class Scenario:
         """The parsed table ``[name]``."""
         return self.tables[name]
 
+    def _get(self, cls: type[T]) -> T:
+        t = self.tables[cls.NAME]
+        if not isinstance(t, cls):
+            raise TypeError(f"table [{cls.NAME}] holds {type(t).__name__}, not {cls.__name__}")
+        return t
+
     # ------------------------------------------------------------------ the tables, typed
     @property
     def robot_table(self) -> RobotTable:
         """``[robot]``."""
-        return self.tables["robot"]  # type: ignore[return-value]  # registered type
+        return self._get(RobotTable)
 
     @property
     def path_table(self) -> PathTable:
         """``[path]``."""
-        return self.tables["path"]  # type: ignore[return-value]
+        return self._get(PathTable)
 
     @property
     def law_table(self) -> LawTable:
         """``[law]``."""
-        return self.tables["law"]  # type: ignore[return-value]
+        return self._get(LawTable)
 
     @property
     def output(self) -> OutputTable:
         """``[output]``."""
-        return self.tables["output"]  # type: ignore[return-value]
+        return self._get(OutputTable)
 
     @property
     def paper(self) -> PaperTable:
         """``[paper]``."""
-        return self.tables["paper"]  # type: ignore[return-value]
+        return self._get(PaperTable)
 
     @property
     def tolerances(self) -> Tolerances:
         """The geometry checker's tolerances (``[tolerances]``)."""
-        t: TolerancesTable = self.tables["tolerances"]  # type: ignore[assignment]
+        t = self._get(TolerancesTable)
         return t.tolerances()
 
     # ------------------------------------------------------------------ the run's objects
@@ -89,7 +97,7 @@ class Scenario:
         """The run's unit system (``[output].units``)."""
         if self.output.units == "si":
             return Units("si", 1000.0, 1.0, 1.0)
-        inertia: InertiaTable = self.tables["inertia"]  # type: ignore[assignment]
+        inertia = self._get(InertiaTable)
         return Units("paper", self.robot_mm.L1, inertia.effector_mass, self.law_table.duration_s)
 
     @property
@@ -125,9 +133,9 @@ class Scenario:
     @cached_property
     def inertia(self) -> Inertia:
         """Masses, inertias, friction and gravity in run units."""
-        t: InertiaTable = self.tables["inertia"]  # type: ignore[assignment]
-        f: FrictionTable = self.tables["friction"]  # type: ignore[assignment]
-        g: GravityTable = self.tables["gravity"]  # type: ignore[assignment]
+        t = self._get(InertiaTable)
+        f = self._get(FrictionTable)
+        g = self._get(GravityTable)
         return t.build(self.units, self.robot_mm, f, g)
 
     @property
@@ -138,8 +146,8 @@ class Scenario:
     @property
     def control(self) -> dict[str, Any]:
         """The control simulation's settings in run units."""
-        t: ControlTable = self.tables["control"]  # type: ignore[assignment]
-        inertia: InertiaTable = self.tables["inertia"]  # type: ignore[assignment]
+        t = self._get(ControlTable)
+        inertia = self._get(InertiaTable)
         return t.run_values(self.units, inertia.effector_mass)
 
     def model(self, assembly: str | None = None) -> Model:

@@ -77,10 +77,11 @@ class RobotTable(Table):
     def from_toml(cls, raw: Mapping[str, object]) -> RobotTable:
         """Read ``[robot]``: without a preset, all five lengths are required."""
         t = read_params(cls.NAME, raw, cls.PARAMS)
-        lengths = {k: t[k] for k in ("l1", "l2", "L1", "L2", "d") if k in t}
+        lengths: dict[str, float] = {k: t[k] for k in ("l1", "l2", "L1", "L2", "d") if k in t}
         try:
             if "preset" in t:
-                geom = FiveBar(**{**preset(t["preset"]).as_dict(), **lengths})
+                merged: dict[str, float] = {**preset(t["preset"]).as_dict(), **lengths}
+                geom = FiveBar(**merged)
             elif lengths:
                 missing = [k for k in ("l1", "l2", "L1", "L2", "d") if k not in lengths]
                 if missing:

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._arrays import Array
 from ..kinematics.checker import Tolerances
 from ..laws import Law, UniformLaw
 from ..laws.time_optimal import PathCoefficients, TimeOptimalLaw, solve_time_optimal_law
@@ -47,8 +48,8 @@ class RobotAlongPath:
         return PathCoefficients(jp.t, jp.P, a, b, g, jp.dq, np.array(ine.coulomb, float),
                                 np.array(ine.viscous, float))
 
-    def ratios(self, law: Law, times: np.ndarray, torque_limit: np.ndarray,
-               speed_limit: np.ndarray) -> tuple[float, float]:
+    def ratios(self, law: Law, times: Array, torque_limit: Array,
+               speed_limit: Array) -> tuple[float, float]:
         """Largest torque and speed ratios of ``law`` at ``times`` (exact model)."""
         tr = sample_trajectory(self.model.robot, self.path, law, mode=self.mode, times=times,
                                tolerances=Tolerances(0.0, 0.0))

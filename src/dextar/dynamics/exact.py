@@ -29,7 +29,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from .._arrays import as_points, blocks, cos_sin
+from .._arrays import Array, as_points, blocks, cos_sin
 from ..errors import AssemblyError, ParameterError, SingularityError
 from ..geometry import FiveBar, parse_assembly_mode
 from ..kinematics import DEFAULT_SINGULARITY_TOL
@@ -232,8 +232,8 @@ def _loads(model: Model, p: Pose, v: Rates, w1: Any, w2: Any, a1: Any, a2: Any, 
                  alpha4, tau1, tau2)
 
 
-def _check_state(model: Model, pose: Pose, q: np.ndarray, offset: int,
-                 t: np.ndarray | None) -> None:
+def _check_state(model: Model, pose: Pose, q: Array, offset: int,
+                 t: Array | None) -> None:
     r = model.robot
     bad_fk = pose.wsq < -1e-12 * (r.L2 * r.L2) * pose.del2
     dist = np.abs(pose.det) / (r.L1 * r.L2)
@@ -254,7 +254,7 @@ def _check_state(model: Model, pose: Pose, q: np.ndarray, offset: int,
 
 
 def _run(model: Model, q: object, dq: object, ddq: object, *, gravity: bool, friction: bool,
-         t: object = None, keys: tuple[str, ...] = ("tau1", "tau2")) -> dict[str, np.ndarray]:
+         t: object = None, keys: tuple[str, ...] = ("tau1", "tau2")) -> dict[str, Array]:
     """Evaluate the kernel on samples (..., 2) in cache-sized blocks: the pose once per
     sample, then the rates and loads; returns the fields ``keys`` of :class:`Pose`,
     :class:`Rates` and :class:`Loads`, each of the leading shape."""
@@ -283,7 +283,7 @@ def _run(model: Model, q: object, dq: object, ddq: object, *, gravity: bool, fri
 
 
 def inverse_dynamics(model: Model, q: object, dq: object, ddq: object, *,
-                     t: object = None) -> np.ndarray:
+                     t: object = None) -> Array:
     """Motor torques ``tau = M(q) qddot + c(q, qdot) + g(q) + friction``.
 
     Parameters
@@ -306,7 +306,7 @@ def inverse_dynamics(model: Model, q: object, dq: object, ddq: object, *,
     return np.stack([out["tau1"], out["tau2"]], axis=-1)
 
 
-def mass_matrix(model: Model, q: object) -> np.ndarray:
+def mass_matrix(model: Model, q: object) -> Array:
     """The inertia matrix ``M(q)``, shape (..., 2, 2), symmetric positive definite (the pose
     computed once per sample, the two columns from unit accelerations)."""
     q0 = as_points(q, "q")
@@ -325,14 +325,14 @@ def mass_matrix(model: Model, q: object) -> np.ndarray:
     return M.reshape(q0.shape[:-1] + (2, 2))
 
 
-def bias_forces(model: Model, q: object, dq: object) -> np.ndarray:
+def bias_forces(model: Model, q: object, dq: object) -> Array:
     """Velocity-product torques ``c(q, qdot)`` (Coriolis and centrifugal), shape (..., 2)."""
     q = as_points(q, "q")
     out = _run(model, q, dq, np.zeros_like(q), gravity=False, friction=False)
     return np.stack([out["tau1"], out["tau2"]], axis=-1)
 
 
-def gravity_torques(model: Model, q: object) -> np.ndarray:
+def gravity_torques(model: Model, q: object) -> Array:
     """Gravity torques ``g(q)``, shape (..., 2) (what the motors must hold at rest)."""
     q = as_points(q, "q")
     z = np.zeros_like(q)
@@ -340,7 +340,7 @@ def gravity_torques(model: Model, q: object) -> np.ndarray:
     return np.stack([out["tau1"], out["tau2"]], axis=-1)
 
 
-def kinetic_energy(model: Model, q: object, dq: object) -> np.ndarray:
+def kinetic_energy(model: Model, q: object, dq: object) -> Array:
     """Exact kinetic energy of the whole mechanism (rods, rotors, point mass at P)."""
     q = as_points(q, "q")
     keys = ("dPx", "dPy", "dBx", "dBy", "dCx", "dCy", "ux", "uy", "ex", "ey")
@@ -374,10 +374,10 @@ class Reactions:
         Force of each distal rod (BP, CP) on the end-effector at P.
     """
 
-    B: np.ndarray
-    C: np.ndarray
-    P1: np.ndarray
-    P2: np.ndarray
+    B: Array
+    C: Array
+    P1: Array
+    P2: Array
 
 
 def joint_reactions(model: Model, q: object, dq: object, ddq: object) -> Reactions:
@@ -405,7 +405,7 @@ def joint_reactions(model: Model, q: object, dq: object, ddq: object) -> Reactio
     return Reactions(B, C, P1, P2)
 
 
-def state_dynamics(model: Model, q: Any, dq: Any) -> tuple[np.ndarray, np.ndarray]:
+def state_dynamics(model: Model, q: Any, dq: Any) -> tuple[Array, Array]:
     """``M(q)`` (2x2) and ``h(q, qdot) = c + g + friction`` (2,) at one state, on plain floats
     (fast enough to call from an ODE integrator): the pose is computed once."""
     q1, q2 = float(q[0]), float(q[1])

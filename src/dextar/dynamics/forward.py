@@ -9,10 +9,11 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.interpolate import CubicSpline
 
+from .._arrays import Array
 from ..errors import ConvergenceError, ParameterError, SingularityError
 from .exact import Model, inverse_dynamics, mass_matrix, state_dynamics
 
-TorqueFunction = Callable[[float, np.ndarray, np.ndarray], np.ndarray]
+TorqueFunction = Callable[[float, Array, Array], Array]
 
 
 @dataclass(frozen=True)
@@ -33,11 +34,11 @@ class ForwardResult:
         The integrator's message.
     """
 
-    t: np.ndarray
-    q: np.ndarray
-    dq: np.ndarray
-    ddq: np.ndarray
-    tau: np.ndarray
+    t: Array
+    q: Array
+    dq: Array
+    ddq: Array
+    tau: Array
     nfev: int
     message: str
     status: int = 0
@@ -48,7 +49,7 @@ class ForwardResult:
         return self.status == 0
 
 
-def torques_from_samples(t: np.ndarray, tau: np.ndarray) -> TorqueFunction:
+def torques_from_samples(t: Array, tau: Array) -> TorqueFunction:
     """A torque function interpolating samples ``tau`` (n, 2) at times ``t`` (n,) by cubic
     splines (open loop: the state is ignored)."""
     t = np.asarray(t, dtype=float)
@@ -57,8 +58,8 @@ def torques_from_samples(t: np.ndarray, tau: np.ndarray) -> TorqueFunction:
         raise ParameterError(f"torque samples must have shape ({t.size}, 2), got {tau.shape}")
     spl = CubicSpline(t, tau, axis=0)
 
-    def fn(time: float, _q: np.ndarray, _dq: np.ndarray) -> np.ndarray:
-        return spl(time)
+    def fn(time: float, _q: Array, _dq: Array) -> Array:
+        return np.asarray(spl(time))
 
     return fn
 
@@ -91,7 +92,7 @@ def forward_dynamics(model: Model, torque: TorqueFunction, q0: object, dq0: obje
         raise ParameterError("initial state must be finite")
     nfev = 0
 
-    def rhs(time: float, y: np.ndarray) -> np.ndarray:
+    def rhs(time: float, y: Array) -> Array:
         nonlocal nfev
         nfev += 1
         q, dq = y[:2], y[2:]

@@ -11,9 +11,11 @@ from __future__ import annotations
 import math
 import numbers
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 
+from .._arrays import Array
 from ..errors import ParameterError
 from ..geometry import FiveBar
 from .friction import friction_torque
@@ -125,22 +127,22 @@ class Inertia:
 
     @classmethod
     def uniform(cls, robot: FiveBar, *, proximal_mass: float, distal_mass: float,
-                effector_mass: float = 1.0, **kwargs: object) -> Inertia:
+                effector_mass: float = 1.0, **kwargs: Any) -> Inertia:
         """Uniform rods of the given masses (the same on both legs)."""
         return cls(
             proximal=(Rod.uniform(proximal_mass, robot.l1), Rod.uniform(proximal_mass, robot.l2)),
             distal=(Rod.uniform(distal_mass, robot.L1), Rod.uniform(distal_mass, robot.L2)),
-            effector_mass=effector_mass, **kwargs)  # type: ignore[arg-type]
+            effector_mass=effector_mass, **kwargs)
 
-    def with_(self, **changes: object) -> Inertia:
+    def with_(self, **changes: Any) -> Inertia:
         """A copy with some fields changed."""
-        return replace(self, **changes)  # type: ignore[arg-type]
+        return replace(self, **changes)
 
     def frictionless(self) -> Inertia:
         """The same inertia without gravity or friction (the inertial part of the dynamics)."""
         return replace(self, gravity=(0.0, 0.0), viscous=(0.0, 0.0), coulomb=(0.0, 0.0))
 
-    def friction_torques(self, dq: object) -> np.ndarray:
+    def friction_torques(self, dq: object) -> Array:
         """Friction torques of both motors at joint rates ``dq`` (..., 2), same shape."""
         dq = np.asarray(dq, dtype=float)
         return np.stack([friction_torque(dq[..., k], self.viscous[k], self.coulomb[k],
@@ -150,10 +152,11 @@ class Inertia:
         """Every mass and inertia (rods, effector, payload, rotors) times ``factor``."""
         def rod(r: Rod) -> Rod:
             return Rod(r.mass * factor, r.com, r.inertia * factor)
-        return replace(self, proximal=tuple(map(rod, self.proximal)),  # type: ignore[arg-type]
-                       distal=tuple(map(rod, self.distal)),  # type: ignore[arg-type]
+        p1, p2 = self.proximal
+        d1, d2 = self.distal
+        return replace(self, proximal=(rod(p1), rod(p2)), distal=(rod(d1), rod(d2)),
                        effector_mass=self.effector_mass * factor, payload=self.payload * factor,
-                       rotor=tuple(r * factor for r in self.rotor))  # type: ignore[arg-type]
+                       rotor=(self.rotor[0] * factor, self.rotor[1] * factor))
 
 
 def paper_inertia(robot: FiveBar, *, effector_mass: float = 1.0, distal_ratio: float = 0.1,

@@ -42,10 +42,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 
-from .._arrays import as_points
+from .._arrays import Array, as_points
 from ..errors import ParameterError
 from ..geometry import FiveBar
 from ..kinematics import elbows
@@ -83,13 +84,13 @@ class PaperModel:
     def C4(self) -> float:
         return self.mL * (1 - self.lam) ** 2 * self.l**2 / 2
 
-    def _K_S(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def _K_S(self, x: Array) -> tuple[Array, Array]:
         b = self.beta0
         K = self.C2 * np.cos(x + 2 * b) + self.C3 * np.cos(x + b) + self.C4 * np.cos(x)
         S = self.C2 * np.sin(x + 2 * b) + self.C3 * np.sin(x + b) + self.C4 * np.sin(x)
         return K, S
 
-    def torques(self, q: object, dq: object, ddq: object) -> np.ndarray:
+    def torques(self, q: object, dq: object, ddq: object) -> Array:
         """The paper's torques (42), shape (..., 2)."""
         q, dq, ddq = as_points(q, "q"), as_points(dq, "dq"), as_points(ddq, "ddq")
         K, S = self._K_S(q[..., 0] - q[..., 1])
@@ -97,20 +98,20 @@ class PaperModel:
         M2 = self.C1 * ddq[..., 1] + ddq[..., 0] * K - dq[..., 0] ** 2 * S
         return np.stack([M1, M2], axis=-1)
 
-    def energy(self, q: object, dq: object) -> np.ndarray:
+    def energy(self, q: object, dq: object) -> Array:
         """The paper's total kinetic energy (40)."""
         q, dq = as_points(q, "q"), as_points(dq, "dq")
         K, _ = self._K_S(q[..., 0] - q[..., 1])
-        return (self.C1 * (dq[..., 0] ** 2 + dq[..., 1] ** 2) / 2
+        return np.asarray(self.C1 * (dq[..., 0] ** 2 + dq[..., 1] ** 2) / 2
                 + dq[..., 0] * dq[..., 1] * K)
 
 
-def base_angle(robot: FiveBar, q: object) -> np.ndarray:
+def base_angle(robot: FiveBar, q: object) -> Array:
     """Angle ``beta`` at the base of the triangle CPB, ``cos beta = |BC| / (2 L)`` (22)."""
     _require_symmetric(robot)
     B, C = elbows(robot, q)
     half = 0.5 * np.linalg.norm(B - C, axis=-1) / robot.L1
-    return np.arccos(np.clip(half, -1.0, 1.0))
+    return np.asarray(np.arccos(np.clip(half, -1.0, 1.0)))
 
 
 def _require_symmetric(robot: FiveBar) -> None:
@@ -152,8 +153,8 @@ def paper_model(robot: FiveBar, inertia: Inertia, beta0: float, *,
 
 
 # --------------------------------------------------------------------------- energies
-def _effector_velocity_23(robot: FiveBar, q: np.ndarray, dq: np.ndarray, beta: np.ndarray,
-                          dbeta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _effector_velocity_23(robot: FiveBar, q: Array, dq: Array, beta: Array,
+                          dbeta: Array) -> tuple[Array, Array]:
     """End-effector velocity from (28), the derivative of (23)."""
     l, dl = robot.l1, robot.d / robot.l1
     phi, psi = q[..., 0], q[..., 1]
@@ -167,7 +168,7 @@ def _effector_velocity_23(robot: FiveBar, q: np.ndarray, dq: np.ndarray, beta: n
     return vx, vy
 
 
-def effector_position_23(robot: FiveBar, q: object) -> np.ndarray:
+def effector_position_23(robot: FiveBar, q: object) -> Array:
     """End-effector position by the paper's direct kinematics (23), with ``d/l``."""
     _require_symmetric(robot)
     q = as_points(q, "q")
@@ -180,33 +181,33 @@ def effector_position_23(robot: FiveBar, q: object) -> np.ndarray:
     return np.stack([x, y], axis=-1)
 
 
-def effector_energy_fd(robot: FiveBar, mass: float, t: np.ndarray, q: np.ndarray) -> np.ndarray:
+def effector_energy_fd(robot: FiveBar, mass: float, t: Array, q: Array) -> Array:
     """``T_comp`` of Fig. 6: (30) with rates by finite differences of the sampled angles."""
     _require_symmetric(robot)
     q = as_points(q, "q")
     t = np.asarray(t, dtype=float)
     beta = base_angle(robot, q)
-    order = 2 if len(t) >= 3 else 1  # second-order differences need three samples
-    dq = np.gradient(q, t, axis=0, edge_order=order)
-    dbeta = np.gradient(beta, t, edge_order=order)
+    order: Literal[1, 2] = 2 if len(t) >= 3 else 1  # second-order differences need 3 samples
+    dq = np.asarray(np.gradient(q, t, axis=0, edge_order=order))
+    dbeta = np.asarray(np.gradient(beta, t, edge_order=order))
     vx, vy = _effector_velocity_23(robot, q, dq, beta, dbeta)
-    return 0.5 * mass * (vx * vx + vy * vy)
+    return np.asarray(0.5 * mass * (vx * vx + vy * vy))
 
 
 def effector_energy_const_beta(robot: FiveBar, mass: float, beta0: float, q: object,
-                               dq: object) -> np.ndarray:
+                               dq: object) -> Array:
     """``T_approx`` of Fig. 6: (32), the end-effector energy with ``beta`` frozen at
     ``beta0``."""
     _require_symmetric(robot)
     q, dq = as_points(q, "q"), as_points(dq, "dq")
     w1, w2 = dq[..., 0], dq[..., 1]
     c = robot.l1**2 / (4 * math.cos(beta0) ** 2)
-    return 0.5 * mass * c * (w1 * w1 + w2 * w2
-                             + 2 * w1 * w2 * np.cos(q[..., 0] - q[..., 1] + 2 * beta0))
+    return np.asarray(0.5 * mass * c * (w1 * w1 + w2 * w2
+                             + 2 * w1 * w2 * np.cos(q[..., 0] - q[..., 1] + 2 * beta0)))
 
 
 def triangle_energies(robot: FiveBar, mL: float, JL: float, lam: float, q: object, dq: object,
-                      dP: object) -> tuple[np.ndarray, np.ndarray]:
+                      dP: object) -> tuple[Array, Array]:
     """Fig. 7: translational ``T_S = mL |Sdot|^2`` (34) and rotational
     ``T_r = JL alphadot^2 / 2`` (37)-(38) energies of the triangle CPB (mass ``2 mL``)."""
     _require_symmetric(robot)
@@ -223,7 +224,7 @@ def triangle_energies(robot: FiveBar, mL: float, JL: float, lam: float, q: objec
     return T_S, 0.5 * JL * alpha_dot**2
 
 
-def torque_error(exact: np.ndarray, approx: np.ndarray) -> dict[str, float]:
+def torque_error(exact: Array, approx: Array) -> dict[str, float]:
     """Max and RMS of ``approx - exact`` over both motors, and both relative to the peak
     exact torque."""
     err = np.asarray(approx) - np.asarray(exact)

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._arrays import Array
 from ..errors import ParameterError, ReachError, SingularityError
 from ..geometry import FiveBar
 
@@ -57,12 +58,12 @@ class PoseDistances:
     samples of a motion reveals a crossing between them.
     """
 
-    type1: np.ndarray
-    type2: np.ndarray
-    type2_signed: np.ndarray
+    type1: Array
+    type2: Array
+    type2_signed: Array
 
 
-def reach_violation(robot: FiveBar, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def reach_violation(robot: FiveBar, P: Array) -> tuple[Array, Array]:
     """How far each point (n, 2) is out of reach of each leg (n, 2), 0 when within reach
     (up to :data:`REACH_SLACK` of the leg's reach), and ``|P - pivot|`` (n, 2)."""
     out = np.zeros(P.shape)
@@ -77,7 +78,7 @@ def reach_violation(robot: FiveBar, P: np.ndarray) -> tuple[np.ndarray, np.ndarr
     return out, rho
 
 
-def pose_distances(robot: FiveBar, q: np.ndarray, P: np.ndarray) -> PoseDistances:
+def pose_distances(robot: FiveBar, q: Array, P: Array) -> PoseDistances:
     """Normalised distances of the poses ``(q, P)`` (each (n, 2)) to both singularities."""
     c1, s1 = np.cos(q[:, 0]), np.sin(q[:, 0])
     c2, s2 = np.cos(q[:, 1]), np.sin(q[:, 1])
@@ -90,8 +91,8 @@ def pose_distances(robot: FiveBar, q: np.ndarray, P: np.ndarray) -> PoseDistance
     return PoseDistances(np.minimum(b1, b2), np.abs(det), det)
 
 
-def check_reach(robot: FiveBar, P: np.ndarray, where: Callable[[int], str],
-                point: Callable[[np.ndarray], str], length: Callable[[float], str]) -> None:
+def check_reach(robot: FiveBar, P: Array, where: Callable[[int], str],
+                point: Callable[[Array], str], length: Callable[[float], str]) -> None:
     """Raise :class:`ReachError` for the first point (n, 2) out of reach of a leg.
 
     ``where(i)`` names the sample (a time, a path parameter, an index), ``point(P)`` and
@@ -108,11 +109,11 @@ def check_reach(robot: FiveBar, P: np.ndarray, where: Callable[[int], str],
                          f"{length(rout)})")
 
 
-def check_poses(robot: FiveBar, q: np.ndarray, P: np.ndarray, *,
+def check_poses(robot: FiveBar, q: Array, P: Array, *,
                 tolerances: Tolerances = DEFAULT_TOLERANCES, type1: bool = True,
                 type2: bool = True, crossings: bool = True,
-                joint_limits: np.ndarray | None = None, where: Callable[[int], str],
-                point: Callable[[np.ndarray], str], mode: str = "") -> PoseDistances:
+                joint_limits: Array | None = None, where: Callable[[int], str],
+                point: Callable[[Array], str], mode: str = "") -> PoseDistances:
     """Check a sequence of poses ``(q, P)`` (each (n, 2)) and return their distances.
 
     Raises :class:`SingularityError` for the first pose within the tolerance of a singularity

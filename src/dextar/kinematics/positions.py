@@ -12,14 +12,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._arrays import as_points, blocks, cos_sin, cross, flat_index, where
+from .._arrays import Array, as_points, blocks, cos_sin, cross, flat_index, where
 from ..errors import AssemblyError, ReachError
 from ..geometry import FiveBar, parse_assembly_mode, parse_working_mode
 
 
 def _leg_solve(
-    ux: np.ndarray, uy: np.ndarray, l: float, L: float, sign: int
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    ux: Array, uy: Array, l: float, L: float, sign: int
+) -> tuple[Array, Array, Array]:
     """Angle of the proximal rod of one leg, the squared distance to the pivot and the mask of
     points out of reach (where the angle is meaningless but finite)."""
     rho2 = ux * ux + uy * uy
@@ -36,7 +36,7 @@ def _leg_solve(
 
 
 def _reach_error(
-    P: np.ndarray, shape: tuple[int, ...], i: int, rho2: float, l: float, L: float, leg: int
+    P: Array, shape: tuple[int, ...], i: int, rho2: float, l: float, L: float, leg: int
 ) -> ReachError:
     rho = float(np.sqrt(rho2))
     rin, rout = abs(l - L), l + L
@@ -51,7 +51,7 @@ def _reach_error(
 
 def inverse_kinematics(
     robot: FiveBar, points: object, mode: str | tuple[int, int] = "+-", *, unwrap: bool = False
-) -> np.ndarray:
+) -> Array:
     """Actuator angles ``(phi, psi)`` that place the end-effector at ``points``.
 
     Parameters
@@ -98,7 +98,7 @@ def inverse_kinematics(
     return q
 
 
-def elbows(robot: FiveBar, q: object) -> tuple[np.ndarray, np.ndarray]:
+def elbows(robot: FiveBar, q: object) -> tuple[Array, Array]:
     """Elbow positions ``B`` and ``C``, each of shape (..., 2), for angles ``q`` (..., 2)."""
     q = as_points(q, "q")
     half = 0.5 * robot.d
@@ -109,7 +109,7 @@ def elbows(robot: FiveBar, q: object) -> tuple[np.ndarray, np.ndarray]:
     return B, C
 
 
-def direct_kinematics(robot: FiveBar, q: object, assembly: str | int = "up") -> np.ndarray:
+def direct_kinematics(robot: FiveBar, q: object, assembly: str | int = "up") -> Array:
     """End-effector position for actuator angles ``q``.
 
     Parameters
@@ -166,7 +166,7 @@ def direct_kinematics(robot: FiveBar, q: object, assembly: str | int = "up") -> 
     return P.reshape(q0.shape)
 
 
-def working_mode(robot: FiveBar, q: object, points: object) -> np.ndarray:
+def working_mode(robot: FiveBar, q: object, points: object) -> Array:
     """Working-mode signs ``(s1, s2)`` of configurations, shape (..., 2), entries +1/-1 (0 when
     a leg is exactly stretched or folded)."""
     P = as_points(points, "points")
@@ -177,7 +177,7 @@ def working_mode(robot: FiveBar, q: object, points: object) -> np.ndarray:
     return np.stack([s1, s2], axis=-1).astype(int)
 
 
-def assembly_mode(robot: FiveBar, q: object, points: object) -> np.ndarray:
+def assembly_mode(robot: FiveBar, q: object, points: object) -> Array:
     """Assembly sign ``sign((B - C) x (P - C))`` of configurations, shape (...,)."""
     P = as_points(points, "points")
     B, C = elbows(robot, q)

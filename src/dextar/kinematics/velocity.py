@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._arrays import as_points, cos_sin, first_index, where
+from .._arrays import Array, as_points, cos_sin, first_index, where
 from ..errors import SingularityError
 from ..geometry import FiveBar
 
@@ -31,17 +31,17 @@ DEFAULT_SINGULARITY_TOL = 1e-3
 class _Frame:
     """Component arrays shared by the first- and second-order relations."""
 
-    c1: np.ndarray
-    s1: np.ndarray
-    c2: np.ndarray
-    s2: np.ndarray
-    ux: np.ndarray  # P - B
-    uy: np.ndarray
-    vx: np.ndarray  # P - C
-    vy: np.ndarray
-    b1: np.ndarray  # (B - A) x (P - B)
-    b2: np.ndarray  # (C - D) x (P - C)
-    det: np.ndarray  # det A = (P - B) x (P - C)
+    c1: Array
+    s1: Array
+    c2: Array
+    s2: Array
+    ux: Array  # P - B
+    uy: Array
+    vx: Array  # P - C
+    vy: Array
+    b1: Array  # (B - A) x (P - B)
+    b2: Array  # (C - D) x (P - C)
+    det: Array  # det A = (P - B) x (P - C)
 
 
 def _frame(robot: FiveBar, q: object, points: object) -> _Frame:
@@ -60,7 +60,7 @@ def _frame(robot: FiveBar, q: object, points: object) -> _Frame:
     return _Frame(c1, s1, c2, s2, ux, uy, vx, vy, b1, b2, det)
 
 
-def velocity_matrices(robot: FiveBar, q: object, points: object) -> tuple[np.ndarray, np.ndarray]:
+def velocity_matrices(robot: FiveBar, q: object, points: object) -> tuple[Array, Array]:
     """The matrices ``A`` and ``B`` of ``A Pdot = B qdot``.
 
     Parameters
@@ -83,7 +83,7 @@ def velocity_matrices(robot: FiveBar, q: object, points: object) -> tuple[np.nda
 
 def singularity_distances(
     robot: FiveBar, q: object, points: object
-) -> tuple[np.ndarray, np.ndarray]:
+) -> tuple[Array, Array]:
     """Normalised distances to a serial (type 1) and a parallel (type 2) singularity.
 
     Returns
@@ -96,18 +96,18 @@ def singularity_distances(
     return _type1(robot, f), np.abs(f.det) / (robot.L1 * robot.L2)
 
 
-def parallel_indicator(robot: FiveBar, q: object, points: object) -> np.ndarray:
+def parallel_indicator(robot: FiveBar, q: object, points: object) -> Array:
     """Signed ``det A / (L1 L2)``, shape (...,): its sign flips across a parallel singularity,
     so a change of sign between two samples of a motion reveals a crossing between them."""
     return _frame(robot, q, points).det / (robot.L1 * robot.L2)
 
 
-def _type1(robot: FiveBar, f: _Frame) -> np.ndarray:
+def _type1(robot: FiveBar, f: _Frame) -> Array:
     return np.minimum(np.abs(f.b1) / (robot.l1 * robot.L1), np.abs(f.b2) / (robot.l2 * robot.L2))
 
 
 def _raise_if_near(
-    kind: int, dist: np.ndarray, tol: float, q: object, points: object, context: str = ""
+    kind: int, dist: Array, tol: float, q: object, points: object, context: str = ""
 ) -> None:
     bad = dist < tol
     if not bad.any():
@@ -148,7 +148,7 @@ def check_singularities(
 
 def jacobian(
     robot: FiveBar, q: object, points: object, *, tol: float = DEFAULT_SINGULARITY_TOL
-) -> np.ndarray:
+) -> Array:
     """``J = A^-1 B`` (shape (..., 2, 2)): ``Pdot = J qdot``.
 
     Raises :class:`SingularityError` within ``tol`` of a parallel singularity.
@@ -165,14 +165,14 @@ def jacobian(
     return J
 
 
-def _solve_A(f: _Frame, rx: np.ndarray, ry: np.ndarray) -> np.ndarray:
+def _solve_A(f: _Frame, rx: Array, ry: Array) -> Array:
     inv = 1.0 / f.det
     return np.stack([(f.vy * rx - f.uy * ry) * inv, (f.ux * ry - f.vx * rx) * inv], axis=-1)
 
 
 def task_velocity(
     robot: FiveBar, q: object, points: object, dq: object, *, tol: float = DEFAULT_SINGULARITY_TOL
-) -> np.ndarray:
+) -> Array:
     """End-effector velocity ``Pdot`` (..., 2) from actuator rates ``dq`` (..., 2)."""
     f = _frame(robot, q, points)
     _raise_if_near(2, np.abs(f.det) / (robot.L1 * robot.L2), tol, q, points)
@@ -187,7 +187,7 @@ def joint_velocity(
     dpoints: object,
     *,
     tol: float = DEFAULT_SINGULARITY_TOL,
-) -> np.ndarray:
+) -> Array:
     """Actuator rates ``qdot`` (..., 2) from end-effector velocity ``dpoints`` (..., 2).
 
     Raises :class:`SingularityError` within ``tol`` of a serial singularity.
@@ -205,8 +205,8 @@ def joint_velocity(
 
 
 def _bias(
-    robot: FiveBar, f: _Frame, dq: np.ndarray, dP: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
+    robot: FiveBar, f: _Frame, dq: Array, dP: Array
+) -> tuple[Array, Array]:
     """The velocity-product term ``b`` of ``A Pddot - B qddot = b``."""
     w1, w2 = dq[..., 0], dq[..., 1]
     # Pdot - Bdot, Bdot = l1 w1 (-s1, c1)
@@ -228,7 +228,7 @@ def joint_acceleration(
     ddpoints: object,
     *,
     tol: float = DEFAULT_SINGULARITY_TOL,
-) -> np.ndarray:
+) -> Array:
     """Actuator accelerations ``qddot = B^-1 (A Pddot - b)``, shape (..., 2)."""
     f = _frame(robot, q, points)
     _raise_if_near(1, _type1(robot, f), tol, q, points)
@@ -255,7 +255,7 @@ def task_acceleration(
     ddq: object,
     *,
     tol: float = DEFAULT_SINGULARITY_TOL,
-) -> tuple[np.ndarray, np.ndarray]:
+) -> tuple[Array, Array]:
     """End-effector velocity and acceleration ``(Pdot, Pddot)`` from ``q, qdot, qddot``.
 
     ``Pddot = A^-1 (B qddot + b)``; both arrays of shape (..., 2).

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._arrays import Array
 from ..errors import ParameterError
 from ..geometry import FiveBar, parse_working_mode, working_mode_name
 from .positions import _leg_solve
@@ -34,11 +35,11 @@ class WorkspaceMap:
     """
 
     robot: FiveBar
-    x: np.ndarray
-    y: np.ndarray
-    reachable: np.ndarray
-    type2: np.ndarray
-    dexterity: np.ndarray
+    x: Array
+    y: Array
+    reachable: Array
+    type2: Array
+    dexterity: Array
     mode: str
 
     @property

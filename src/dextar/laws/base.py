@@ -13,7 +13,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._arrays import Array
 from ..errors import ParameterError
+from ..paths import Path
 
 
 def _positive(name: str, value: float) -> float:
@@ -39,15 +41,15 @@ class Law(ABC):
         """True when the law was found as asked (``status == 0``)."""
         return self.status == 0
 
-    def breakpoints(self) -> np.ndarray:
+    def breakpoints(self) -> Array:
         """Times inside ``(0, duration)`` where the acceleration jumps (none by default)."""
         return np.empty(0)
 
     @abstractmethod
-    def _evaluate(self, t: np.ndarray) -> np.ndarray:
+    def _evaluate(self, t: Array) -> Array:
         """Rows ``s, sdot, sddot, sdddot`` at ``t``, shape (4, ...)."""
 
-    def evaluate(self, t: object) -> np.ndarray:
+    def evaluate(self, t: object) -> Array:
         """``s, sdot, sddot, sdddot`` at times ``t``, stacked in an array of shape (4, ...)."""
         t = np.asarray(t, dtype=float)
         T = self.duration
@@ -57,11 +59,11 @@ class Law(ABC):
             raise ParameterError(f"time t = {v:.6g} outside the law's interval [0, {T:.6g}]")
         return self._evaluate(np.clip(t, 0.0, T))
 
-    def cost_parts(self, path: object, mass: float, eta: float) -> tuple[float, float]:
+    def cost_parts(self, path: Path, mass: float, eta: float) -> tuple[float, float]:
         """The functional's kinetic and inertial parts for this law along ``path``."""
         return law_cost(self, path, mass, eta)
 
-    def times(self, samples: int) -> np.ndarray:
+    def times(self, samples: int) -> Array:
         if int(samples) < 2:
             raise ParameterError(f"samples = {samples} must be at least 2")
         return np.linspace(0.0, self.duration, int(samples))
@@ -79,7 +81,7 @@ class UniformLaw(Law):
         _positive("distance", self.distance)
         _positive("duration", self.duration)
 
-    def _evaluate(self, t: np.ndarray) -> np.ndarray:
+    def _evaluate(self, t: Array) -> Array:
         v = self.distance / self.duration
         return np.stack([v * t, np.full_like(t, v), np.zeros_like(t), np.zeros_like(t)])
 
@@ -97,7 +99,7 @@ class MinimumJerkLaw(Law):
         _positive("distance", self.distance)
         _positive("duration", self.duration)
 
-    def _evaluate(self, t: np.ndarray) -> np.ndarray:
+    def _evaluate(self, t: Array) -> Array:
         S, T = self.distance, self.duration
         u = t / T
         return np.stack([
@@ -150,12 +152,12 @@ class TrapezoidalLaw(Law):
         return (f"TrapezoidalLaw(distance={self.distance!r}, vmax={self.vmax!r}, "
                 f"amax={self.amax!r}, duration={self.duration!r})")
 
-    def breakpoints(self) -> np.ndarray:
+    def breakpoints(self) -> Array:
         """The ends of the acceleration and deceleration phases."""
         ta = self.cruise / self.amax
         return np.unique([ta, self.duration - ta])
 
-    def _evaluate(self, t: np.ndarray) -> np.ndarray:
+    def _evaluate(self, t: Array) -> Array:
         a, v, T = self.amax, self.cruise, self.duration
         ta = v / a
         t_dec = T - ta
@@ -167,8 +169,8 @@ class TrapezoidalLaw(Law):
         return np.stack([s, ds, dds, np.zeros_like(t)])
 
 
-def law_cost(law: Law, path: object, mass: float, eta: float, *, nodes: int = 2000,
-             edges: np.ndarray | None = None) -> tuple[float, float]:
+def law_cost(law: Law, path: Path, mass: float, eta: float, *, nodes: int = 2000,
+             edges: Array | None = None) -> tuple[float, float]:
     """The two parts of the paper's functional for any law along ``path``:
     ``(m/2) Int |rdot|^2 dt`` and ``(eta m^2 / 2) Int |rddot|^2 dt``, with
     ``|rdot| = sdot`` and ``|rddot|^2 = sddot^2 + kappa^2 sdot^4`` (Gauss-Legendre quadrature
@@ -187,11 +189,11 @@ def law_cost(law: Law, path: object, mass: float, eta: float, *, nodes: int = 20
     return float(kin), float(inert)
 
 
-def _curvature_at_s(path: object, s: np.ndarray) -> np.ndarray:
+def _curvature_at_s(path: Path, s: Array) -> Array:
     k = getattr(path, "constant_curvature", None)
     if k is not None:
         return np.full_like(s, k)
-    return path.curvature(path.parameter_at(s))[0]  # type: ignore[attr-defined]
+    return np.asarray(path.curvature(path.parameter_at(s))[0])
 
 
 def _register() -> None:

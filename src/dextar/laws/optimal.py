@@ -38,12 +38,13 @@ from numpy.polynomial import chebyshev as cheb
 from scipy.integrate import solve_bvp
 from scipy.interpolate import make_interp_spline
 
+from .._arrays import Array
 from ..errors import ConvergenceError, ParameterError
 from ..paths import Path
 from .base import Law, _positive, law_cost
 
 
-def line_solution(G: float, tau: np.ndarray) -> np.ndarray:
+def line_solution(G: float, tau: Array) -> Array:
     """Closed-form optimal law on a straight line, ``sigma'''' = G^2 sigma''``, rest to rest.
 
     ``sigma = 1/2 + b (tau - 1/2) + e sinh(G (tau - 1/2))`` with
@@ -76,15 +77,19 @@ def line_solution(G: float, tau: np.ndarray) -> np.ndarray:
     return np.stack([0.5 + b * x + sh, b + G * ch, G * G * sh, G**3 * ch])
 
 
+#: ``sigma(tau, k)``: the k-th derivative of the normalised law at normalised times.
+SigmaFn = Callable[[Array, int], Array]
+
+
 @dataclass(frozen=True)
 class _Ops:
     """Chebyshev collocation operators for ``N + 1`` Lobatto points on ``tau`` in [0, 1]."""
 
-    x: np.ndarray  # nodes in [-1, 1], x_0 = 1 (tau = 1)
-    tau: np.ndarray
-    to_coef: np.ndarray  # values -> Chebyshev coefficients
-    Q: tuple[np.ndarray, ...]  # k-fold integration from tau = 0 in coefficient space, k = 1..4
-    M: tuple[np.ndarray, ...]  # the same from node values to node values
+    x: Array  # nodes in [-1, 1], x_0 = 1 (tau = 1)
+    tau: Array
+    to_coef: Array  # values -> Chebyshev coefficients
+    Q: tuple[Array, ...]  # k-fold integration from tau = 0 in coefficient space, k = 1..4
+    M: tuple[Array, ...]  # the same from node values to node values
 
 
 @lru_cache(maxsize=16)
@@ -121,7 +126,7 @@ class OptimalLaw(Law):
     duration: float
     eta: float
     mass: float
-    sigma: Callable[[np.ndarray, int], np.ndarray] = field(repr=False)  # (tau, k) -> sigma^(k)
+    sigma: Callable[[Array, int], Array] = field(repr=False)  # (tau, k) -> sigma^(k)
     kinetic: float = 0.0
     inertial: float = 0.0
     residual: float = 0.0
@@ -135,19 +140,20 @@ class OptimalLaw(Law):
     def cost(self) -> float:
         return self.kinetic + self.inertial
 
-    def cost_parts(self, path: object, mass: float, eta: float) -> tuple[float, float]:
+    def cost_parts(self, path: Path, mass: float, eta: float) -> tuple[float, float]:
+        """The functional's two parts (stored when ``mass`` and ``eta`` are the law's own)."""
         if mass == self.mass and eta == self.eta:
             return self.kinetic, self.inertial
         return law_cost(self, path, mass, eta)
 
-    def _sigma(self, t: np.ndarray, k: int) -> np.ndarray:
+    def _sigma(self, t: Array, k: int) -> Array:
         return self.sigma(t / self.duration, k)
 
-    def _evaluate(self, t: np.ndarray) -> np.ndarray:
+    def _evaluate(self, t: Array) -> Array:
         S, T = self.distance, self.duration
         return np.stack([S / T**k * self._sigma(t, k) for k in range(4)])
 
-    def fourth_derivative(self, t: object) -> np.ndarray:
+    def fourth_derivative(self, t: object) -> Array:
         """``s''''(t)`` of the computed law (for checking the ODE)."""
         t = np.asarray(t, dtype=float)
         return self.distance / self.duration**4 * self._sigma(t, 4)
@@ -210,7 +216,8 @@ def solve_optimal_law(path: Path, *, duration: float = 1.0, eta: float = 0.1, ma
     return law
 
 
-def _solve_spectral(path: Path, S: float, G: float, tol: float, max_nodes: int):
+def _solve_spectral(path: Path, S: float, G: float, tol: float, max_nodes: int
+                    ) -> tuple[SigmaFn | None, float, int, int, str]:
     """Constant curvature: Chebyshev collocation (spectral accuracy, milliseconds)."""
     solver = _Collocation(path, S, tol)
     # start with enough nodes to see the boundary layers (width 1/G)
@@ -226,13 +233,14 @@ def _solve_spectral(path: Path, S: float, G: float, tol: float, max_nodes: int):
         return None, np.inf, 0, solver.iterations, method
     coef, resid, N = state
 
-    def sigma(tau: np.ndarray, k: int) -> np.ndarray:
-        return cheb.chebval(2.0 * tau - 1.0, coef[k])
+    def sigma(tau: Array, k: int) -> Array:
+        return np.asarray(cheb.chebval(2.0 * tau - 1.0, coef[k]))
 
     return sigma, resid, N + 1, solver.iterations, "Chebyshev collocation"
 
 
-def _solve_local(path: Path, S: float, G: float, tol: float):
+def _solve_local(path: Path, S: float, G: float, tol: float
+                 ) -> tuple[SigmaFn | None, float, int, int, str]:
     """Varying curvature: collocation with local mesh refinement (scipy's solve_bvp), by
     continuation in the curvature (``kappa -> lam kappa``, ``lam`` from 0, the straight line
     whose solution is exact, to 1) with adaptive steps."""
@@ -242,14 +250,14 @@ def _solve_local(path: Path, S: float, G: float, tol: float):
     K_of = make_interp_spline(grid, path.curvature(path.parameter_at(grid * S))[0] * S, k=5)
     Ks_of = K_of.derivative()
 
-    def curvature(sig: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def curvature(sig: Array) -> tuple[Array, Array]:
         sig = np.clip(sig, 0.0, 1.0)
         return K_of(sig), Ks_of(sig)
 
     G2 = G * G
 
-    def make(lam: float) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
-        def fun(_tau: np.ndarray, y: np.ndarray) -> np.ndarray:
+    def make(lam: float) -> Callable[[Array, Array], Array]:
+        def fun(_tau: Array, y: Array) -> Array:
             K, Ks = curvature(y[0])
             K, Ks = lam * K, lam * Ks
             y1sq = y[1] * y[1]
@@ -257,7 +265,7 @@ def _solve_local(path: Path, S: float, G: float, tol: float):
                               + 3 * K * Ks * y1sq * y1sq])
         return fun
 
-    def bc(ya: np.ndarray, yb: np.ndarray) -> np.ndarray:
+    def bc(ya: Array, yb: Array) -> Array:
         return np.array([ya[0], ya[1], yb[0] - 1.0, yb[1]])
 
     mesh = np.linspace(0.0, 1.0, 61)
@@ -285,10 +293,10 @@ def _solve_local(path: Path, S: float, G: float, tol: float):
                                                  f"{lam:.3g} of the curvature: {trial.message})")
     sol = res.sol
 
-    def sigma(tau: np.ndarray, k: int) -> np.ndarray:
+    def sigma(tau: Array, k: int) -> Array:
         flat = np.asarray(tau, dtype=float).reshape(-1)
         vals = sol(flat, 1)[3] if k == 4 else sol(flat)[k]
-        return vals.reshape(np.shape(tau))
+        return np.asarray(vals).reshape(np.shape(tau))
 
     return (sigma, float(np.max(res.rms_residuals)), int(res.x.size), solves,
             "collocation with mesh refinement (solve_bvp)")
@@ -303,13 +311,13 @@ class _Collocation:
         self.Kc = None if kc is None else kc * S
         self.iterations = 0
 
-    def curvature(self, sig: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def curvature(self, sig: Array) -> tuple[Array, Array, Array]:
         """``K, K_sigma, K_sigma_sigma`` at ``sigma`` (clipped to the path)."""
         if self.Kc is not None:
             z = np.zeros_like(sig)
             return np.full_like(sig, self.Kc), z, z
 
-        def k_and_dk(sg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        def k_and_dk(sg: Array) -> tuple[Array, Array]:
             p = self.path.parameter_at(np.clip(sg, 0.0, 1.0) * self.S)
             k, dk = self.path.curvature(p)
             return k * self.S, dk * self.S**2
@@ -319,7 +327,7 @@ class _Collocation:
         Kss = (k_and_dk(sig + h)[1] - k_and_dk(sig - h)[1]) / (2 * h)
         return K, Ks, Kss
 
-    def rhs(self, G2: float, s: np.ndarray, s1: np.ndarray, s2: np.ndarray, jac: bool = False):
+    def rhs(self, G2: float, s: Array, s1: Array, s2: Array, jac: bool = False) -> Any:
         K, Ks, Kss = self.curvature(s)
         s1sq = s1 * s1
         F = (G2 + 6.0 * K * K * s1sq) * s2 + 3.0 * K * Ks * s1sq * s1sq
@@ -330,7 +338,8 @@ class _Collocation:
         F0 = 12.0 * K * Ks * s1sq * s2 + 3.0 * (Ks * Ks + K * Kss) * s1sq * s1sq
         return F, F0, F1, F2
 
-    def solve(self, G: float, N: int, guess: tuple | None, max_nodes: int):
+    def solve(self, G: float, N: int, guess: tuple[Any, ...] | None, max_nodes: int
+              ) -> tuple[tuple[Array, ...], float, int] | None:
         """Solve at ``G`` starting with ``N`` nodes; returns (coef, residual, N, u-evaluator)
         or None."""
         G2 = G * G
@@ -358,7 +367,8 @@ class _Collocation:
                 return None
             N *= 2
 
-    def _newton(self, G2: float, ops: _Ops, u: np.ndarray, c2: float, c3: float):
+    def _newton(self, G2: float, ops: _Ops, u: Array, c2: float, c3: float
+                ) -> tuple[Array, float, float] | None:
         M1, M2, M3, M4 = ops.M
         tau = ops.tau
         n = tau.size
@@ -396,7 +406,7 @@ class _Collocation:
         return (u, c2, c3) if scale_prev < 1e-12 else None
 
     @staticmethod
-    def _coefficients(ops: _Ops, u: np.ndarray, c2: float, c3: float) -> tuple[np.ndarray, ...]:
+    def _coefficients(ops: _Ops, u: Array, c2: float, c3: float) -> tuple[Array, ...]:
         a = ops.to_coef @ u
         # polynomial part c2 tau^2 + c3 tau^3 in x = 2 tau - 1, and its derivatives in tau
         p = np.polynomial.Polynomial([0.0, 0.0, c2, c3], domain=[0, 1], window=[0, 1])
@@ -414,7 +424,7 @@ class _Collocation:
         coefs.append(a)
         return tuple(coefs)
 
-    def _residual(self, G2: float, coef: tuple[np.ndarray, ...], N: int) -> tuple[float, float]:
+    def _residual(self, G2: float, coef: tuple[Array, ...], N: int) -> tuple[float, float]:
         m = 4 * N
         x = np.cos(np.pi * (np.arange(m) + 0.5) / m)
         s, s1, s2, _, u = (cheb.chebval(x, c) for c in coef)

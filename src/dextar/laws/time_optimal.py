@@ -46,6 +46,7 @@ from typing import Protocol
 
 import numpy as np
 
+from .._arrays import Array
 from ..errors import InfeasibleError, ParameterError
 from ..units import Units
 from .base import Law
@@ -79,10 +80,10 @@ class TimeOptimalLaw(Law):
 
     distance: float
     duration: float
-    knots_t: np.ndarray = field(repr=False)
-    knots_s: np.ndarray = field(repr=False)
-    knots_v: np.ndarray = field(repr=False)
-    accel: np.ndarray = field(repr=False)
+    knots_t: Array = field(repr=False)
+    knots_s: Array = field(repr=False)
+    knots_v: Array = field(repr=False)
+    accel: Array = field(repr=False)
     torque_limit: tuple[float, float] = (np.inf, np.inf)
     speed_limit: tuple[float, float] = (np.inf, np.inf)
     max_torque_ratio: float = 0.0
@@ -92,11 +93,11 @@ class TimeOptimalLaw(Law):
     solves: int = 1
     name: str = field(default="time-optimal", init=False)
 
-    def breakpoints(self) -> np.ndarray:
+    def breakpoints(self) -> Array:
         """The grid points, where the acceleration jumps."""
         return self.knots_t[1:-1]
 
-    def _evaluate(self, t: np.ndarray) -> np.ndarray:
+    def _evaluate(self, t: Array) -> Array:
         k = np.clip(np.searchsorted(self.knots_t, t, side="right") - 1, 0, self.accel.size - 1)
         tau = t - self.knots_t[k]
         u = self.accel[k]
@@ -123,14 +124,14 @@ class PathCoefficients:
         The motors' friction coefficients.
     """
 
-    s: np.ndarray
-    P: np.ndarray
-    a: np.ndarray
-    b: np.ndarray
-    g: np.ndarray
-    dq_ds: np.ndarray
-    coulomb: np.ndarray
-    viscous: np.ndarray
+    s: Array
+    P: Array
+    a: Array
+    b: Array
+    g: Array
+    dq_ds: Array
+    coulomb: Array
+    viscous: Array
 
 
 class PathDynamics(Protocol):
@@ -140,8 +141,8 @@ class PathDynamics(Protocol):
         """The coefficients on ``segments + 1`` equally spaced arc lengths."""
         ...
 
-    def ratios(self, law: Law, times: np.ndarray, torque_limit: np.ndarray,
-               speed_limit: np.ndarray) -> tuple[float, float]:
+    def ratios(self, law: Law, times: Array, torque_limit: Array,
+               speed_limit: Array) -> tuple[float, float]:
         """Largest ``|tau_i| / torque_limit_i`` and ``|qdot_i| / speed_limit_i`` of ``law``
         at ``times`` (exact model with gravity and friction)."""
         ...
@@ -194,7 +195,7 @@ def solve_time_optimal_law(dynamics: PathDynamics, *, torque_limit: tuple[float,
     length = float(co.s[-1])
     _check_holding(co, tmax, units)
     ds = length / n
-    x0: np.ndarray | None = None  # tangent points of the viscous bound
+    x0: Array | None = None  # tangent points of the viscous bound
     scale_t, scale_w = 1.0, 1.0
     law: TimeOptimalLaw | None = None
     has_viscous = bool(np.any(co.viscous > 0))
@@ -250,7 +251,7 @@ def _torque(units: Units | None, value: float) -> str:
     return f"{value:.6g}" if units is None else units.torque_text(value)
 
 
-def _check_holding(co: PathCoefficients, tmax: np.ndarray, units: Units | None) -> None:
+def _check_holding(co: PathCoefficients, tmax: Array, units: Units | None) -> None:
     """Gravity alone must be within the limits everywhere on the path."""
     ratio = np.abs(co.g) / tmax
     if ratio.max() > 1.0:
@@ -262,8 +263,8 @@ def _check_holding(co: PathCoefficients, tmax: np.ndarray, units: Units | None) 
             f"{_describe(co, int(k), units)}, above its limit {_torque(units, tmax[i])}")
 
 
-def _friction_bounds(co: PathCoefficients, x0: np.ndarray | None
-                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def _friction_bounds(co: PathCoefficients, x0: Array | None
+                     ) -> tuple[Array, Array, Array, Array]:
     """Friction ``f`` in ``[phi_lo + psi_lo x, phi_hi + psi_hi x]`` at each grid point,
     arrays (N + 1, 2)."""
     sg = np.sign(co.dq_ds)
@@ -289,8 +290,8 @@ def _friction_bounds(co: PathCoefficients, x0: np.ndarray | None
     return phi_lo, psi_lo, phi_hi, psi_hi
 
 
-def _rows(co: PathCoefficients, ds: float, tmax: np.ndarray, wmax: np.ndarray,
-          x0: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _rows(co: PathCoefficients, ds: float, tmax: Array, wmax: Array,
+          x0: Array | None) -> tuple[Array, Array, Array]:
     """Static rows ``Gu u + Gx x <= h`` of every stage, arrays (N, m)."""
     phi_lo, psi_lo, phi_hi, psi_hi = _friction_bounds(co, x0)
     with np.errstate(divide="ignore"):
@@ -308,8 +309,8 @@ def _rows(co: PathCoefficients, ds: float, tmax: np.ndarray, wmax: np.ndarray,
     return Gu, Gx, h
 
 
-def _reachability(co: PathCoefficients, ds: float, tmax: np.ndarray, wmax: np.ndarray,
-                  x0: np.ndarray | None, units: Units | None) -> np.ndarray:
+def _reachability(co: PathCoefficients, ds: float, tmax: Array, wmax: Array,
+                  x0: Array | None, units: Units | None) -> Array:
     """Squared speeds ``x`` at the grid points of the fastest admissible motion."""
     Gu, Gx, h = _rows(co, ds, tmax, wmax, x0)
     n = Gu.shape[0]
@@ -376,7 +377,7 @@ def _reachability(co: PathCoefficients, ds: float, tmax: np.ndarray, wmax: np.nd
     return np.array(x)
 
 
-def _unreachable(co: PathCoefficients, k: int, tmax: np.ndarray, units: Units | None
+def _unreachable(co: PathCoefficients, k: int, tmax: Array, units: Units | None
                  ) -> InfeasibleError:
     need = np.abs(co.g[k]) + co.coulomb
     i = int(np.argmax(need / tmax))
@@ -388,7 +389,7 @@ def _unreachable(co: PathCoefficients, k: int, tmax: np.ndarray, units: Units | 
         "before the end of the path")
 
 
-def _law(S: float, s: np.ndarray, x: np.ndarray, tmax: np.ndarray, wmax: np.ndarray,
+def _law(S: float, s: Array, x: Array, tmax: Array, wmax: Array,
          solves: int) -> TimeOptimalLaw:
     v = np.sqrt(np.maximum(x, 0.0))
     den = v[:-1] + v[1:]

@@ -10,6 +10,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+from .._arrays import Array
 from ..analysis import Analysis
 from ..kinematics import WorkspaceMap, elbows, workspace_map
 from ..trajectory import Trajectory
@@ -26,7 +27,7 @@ def _labels(an: Analysis) -> dict[str, str]:
 
 
 def _time_plot(an: Analysis, title: str, ylabel: str,
-               curves: list[tuple[np.ndarray, np.ndarray, str, str]], *,
+               curves: list[tuple[Array, Array, str, str]], *,
                title_size: float = 12) -> Any:
     """One figure of curves ``(t, y, style, label)`` against time."""
     fig = Figure(figsize=(6.4, 4.2))
@@ -151,8 +152,8 @@ def animation_gif(an: Analysis, frames: int = 41) -> bytes:
         arm.set_data([r.A[0], B[i, 0], tr.P[i, 0], C[i, 0], r.D[0]],
                      [r.A[1], B[i, 1], tr.P[i, 1], C[i, 1], r.D[1]])
         label.set_text(f"t = {tr.t[i]:.3f} {an.inputs.units.names['time']}")
-        canvas.draw()
-        rgba = np.asarray(canvas.buffer_rgba())
+        canvas.draw()  # type: ignore[no-untyped-call]  # matplotlib's Agg canvas is untyped
+        rgba = np.asarray(canvas.buffer_rgba())  # type: ignore[no-untyped-call]
         images.append(Image.fromarray(rgba[..., :3]).convert("P", palette=Image.Palette.ADAPTIVE))
     buf = io.BytesIO()
     images[0].save(buf, format="GIF", save_all=True, append_images=images[1:], duration=80,
@@ -207,8 +208,8 @@ def tracking_figure(res: Any, units: Any, mass_error: float, payload_kg: float) 
 def plot_workspace(
     ws: WorkspaceMap,
     *,
-    path: np.ndarray | None = None,
-    pose: tuple[np.ndarray, np.ndarray] | None = None,
+    path: Array | None = None,
+    pose: tuple[Array, Array] | None = None,
     unit: str = "mm",
     ax: Any = None,
 ) -> Any:

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._arrays import Array
 from ..dynamics.exact import Model
 from ..kinematics import direct_kinematics, elbows, task_velocity
 from .files import write_text
@@ -49,7 +50,7 @@ def _inertial(mass: float, com: float, izz: float) -> str:
 
 
 def to_mjcf(model: Model, *, name: str = "dextar",
-            start: tuple[np.ndarray, np.ndarray] | None = None) -> str:
+            start: tuple[Array, Array] | None = None) -> str:
     """The MJCF text of ``model``: geometry, inertia, gravity, rotor inertia, viscous and
     Coulomb friction, and, given ``start = (q0, dq0)`` (each (2,)), a keyframe ``start`` with
     the loop closed at that state."""
@@ -107,12 +108,12 @@ def to_mjcf(model: Model, *, name: str = "dextar",
 
 
 def write_mjcf(model: Model, path: str, *,
-               start: tuple[np.ndarray, np.ndarray] | None = None) -> None:
+               start: tuple[Array, Array] | None = None) -> None:
     """Write :func:`to_mjcf` atomically to ``path``."""
     write_text(path, to_mjcf(model, start=start))
 
 
-def mujoco_state(model: Model, q: np.ndarray, dq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def mujoco_state(model: Model, q: Array, dq: Array) -> tuple[Array, Array]:
     """``qpos`` and ``qvel`` (each (n, 4)) of the MuJoCo model for actuator states ``q, dq``
     (n, 2)."""
     r = model.robot

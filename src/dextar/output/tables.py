@@ -30,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from .._arrays import Array
 from ..errors import NumericalError
 from ..units import Units
 
@@ -50,7 +51,7 @@ def unit_tokens(units: Units) -> dict[str, str]:
     return _TOKENS["si" if units.system == "si" else "paper"]
 
 
-def trajectory_columns(tr: Any, units: Units) -> dict[str, np.ndarray]:
+def trajectory_columns(tr: Any, units: Units) -> dict[str, Array]:
     """The motion columns of a trajectory: time, path parameter, end-effector and joints."""
     u = unit_tokens(units)
     return {
@@ -66,7 +67,7 @@ def trajectory_columns(tr: Any, units: Units) -> dict[str, np.ndarray]:
     }
 
 
-def csv_text(columns: dict[str, np.ndarray]) -> str:
+def csv_text(columns: dict[str, Array]) -> str:
     """CSV with a header row of the column names and one row per sample (17 digits).
 
     Raises :class:`~dextar.errors.NumericalError` naming the column and row of a value that
@@ -84,7 +85,7 @@ def csv_text(columns: dict[str, np.ndarray]) -> str:
     return buf.getvalue()
 
 
-def torque_columns(an: Any) -> dict[str, np.ndarray]:
+def torque_columns(an: Any) -> dict[str, Array]:
     """Motion columns plus the exact (and, where it applies, the paper's) torques, the motor
     powers, the mechanism's kinetic energy and the passive-joint force magnitudes of an
     :class:`~dextar.analysis.Analysis`."""
@@ -101,7 +102,7 @@ def torque_columns(an: Any) -> dict[str, np.ndarray]:
     return cols
 
 
-def run_columns(an: Any) -> dict[str, np.ndarray]:
+def run_columns(an: Any) -> dict[str, Array]:
     """The columns of ``dextar run``: :func:`torque_columns` and, where the paper's model
     applies, the end-effector energies of its Fig. 6 (exact ``m |Pdot|^2 / 2``, (30) by
     finite differences, (32) with ``beta`` frozen)."""

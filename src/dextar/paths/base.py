@@ -18,12 +18,13 @@ from typing import Any
 import numpy as np
 from scipy.interpolate import CubicHermiteSpline, make_interp_spline
 
+from .._arrays import Array
 from ..errors import ParameterError
 from .expression import Expression
 
 
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+def _cross(a: Array, b: Array) -> Array:
+    return np.asarray(a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0])
 
 
 class Path(ABC):
@@ -35,10 +36,10 @@ class Path(ABC):
     constant_curvature: float | None = None
 
     @abstractmethod
-    def derivatives(self, p: object) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    def derivatives(self, p: object) -> tuple[Array, Array, Array, Array]:
         """``r, r', r'', r'''`` at ``p`` (shape (...,)), each of shape (..., 2)."""
 
-    def _check_parameter(self, p: object) -> np.ndarray:
+    def _check_parameter(self, p: object) -> Array:
         p = np.asarray(p, dtype=float)
         span = self.p1 - self.p0
         bad = ~np.isfinite(p) | (p < self.p0 - 1e-9 * span) | (p > self.p1 + 1e-9 * span)
@@ -48,14 +49,14 @@ class Path(ABC):
                                  f"{self.p1:.6g}]")
         return p
 
-    def position(self, p: object) -> np.ndarray:
+    def position(self, p: object) -> Array:
         return self.derivatives(p)[0]
 
-    def speed(self, p: object) -> np.ndarray:
+    def speed(self, p: object) -> Array:
         """``ds/dp = |r'(p)|``."""
-        return np.linalg.norm(self.derivatives(p)[1], axis=-1)
+        return np.asarray(np.linalg.norm(self.derivatives(p)[1], axis=-1))
 
-    def curvature(self, p: object) -> tuple[np.ndarray, np.ndarray]:
+    def curvature(self, p: object) -> tuple[Array, Array]:
         """Signed curvature ``kappa`` and ``dkappa/ds`` at ``p``."""
         _, r1, r2, r3 = self.derivatives(p)
         v2 = np.sum(r1 * r1, axis=-1)
@@ -67,7 +68,7 @@ class Path(ABC):
 
     # ---------------------------------------------------------------- arc length
     @cached_property
-    def _table(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _table(self) -> tuple[Array, Array, Array]:
         """Parameter nodes, arc length at the nodes and speed at the nodes."""
         n = 4096
         nodes = np.linspace(self.p0, self.p1, n + 1)
@@ -87,9 +88,9 @@ class Path(ABC):
     def length(self) -> float:
         return float(self._table[1][-1])
 
-    def arc_length(self, p: object) -> np.ndarray:
+    def arc_length(self, p: object) -> Array:
         """Arc length ``s(p)`` from ``p0``."""
-        return self._forward(self._check_parameter(p))
+        return np.asarray(self._forward(self._check_parameter(p)))
 
     @cached_property
     def _forward(self) -> CubicHermiteSpline:
@@ -101,7 +102,7 @@ class Path(ABC):
         nodes, s, v = self._table
         return CubicHermiteSpline(s, nodes, 1.0 / v)
 
-    def parameter_at(self, s: object) -> np.ndarray:
+    def parameter_at(self, s: object) -> Array:
         """The parameter ``p(s)`` at arc length ``s`` (inverse of :meth:`arc_length`)."""
         s = np.asarray(s, dtype=float)
         total = self.length
@@ -110,9 +111,9 @@ class Path(ABC):
         p = np.clip(self._inverse(np.clip(s, 0.0, total)), self.p0, self.p1)
         for _ in range(2):  # Newton polish on s(p) - s = 0
             p = np.clip(p - (self.arc_length(p) - s) / self.speed(p), self.p0, self.p1)
-        return p
+        return np.asarray(p)
 
-    def sample(self, n: int = 400) -> np.ndarray:
+    def sample(self, n: int = 400) -> Array:
         """``n`` points along the path, shape (n, 2)."""
         return self.position(np.linspace(self.p0, self.p1, n))
 
@@ -144,7 +145,7 @@ class Arc(Path):
         """``1 / radius``."""
         return 1.0 / self.radius
 
-    def derivatives(self, p: object) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    def derivatives(self, p: object) -> tuple[Array, Array, Array, Array]:
         p = self._check_parameter(p)
         R = self.radius
         c, s = np.cos(p), np.sin(p)
@@ -156,10 +157,10 @@ class Arc(Path):
     def length(self) -> float:
         return self.radius * (self.p1 - self.p0)
 
-    def arc_length(self, p: object) -> np.ndarray:
+    def arc_length(self, p: object) -> Array:
         return self.radius * (self._check_parameter(p) - self.p0)
 
-    def parameter_at(self, s: object) -> np.ndarray:
+    def parameter_at(self, s: object) -> Array:
         p = self.p0 + np.asarray(s, dtype=float) / self.radius
         return np.clip(p, self.p0, self.p1)
 
@@ -181,7 +182,7 @@ class Line(Path):
         if np.allclose(a, b):
             raise ParameterError("line start and end must differ")
 
-    def derivatives(self, p: object) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    def derivatives(self, p: object) -> tuple[Array, Array, Array, Array]:
         p = self._check_parameter(p)
         a, b = np.asarray(self.start), np.asarray(self.end)
         r = a + p[..., None] * (b - a)
@@ -193,10 +194,10 @@ class Line(Path):
     def length(self) -> float:
         return float(np.hypot(self.end[0] - self.start[0], self.end[1] - self.start[1]))
 
-    def arc_length(self, p: object) -> np.ndarray:
+    def arc_length(self, p: object) -> Array:
         return self.length * self._check_parameter(p)
 
-    def parameter_at(self, s: object) -> np.ndarray:
+    def parameter_at(self, s: object) -> Array:
         return np.clip(np.asarray(s, dtype=float) / self.length, 0.0, 1.0)
 
 
@@ -223,7 +224,7 @@ class Spline(Path):
             raise ParameterError(f"spline waypoints {i} and {i + 1} coincide")
 
     @cached_property
-    def _knots(self) -> np.ndarray:
+    def _knots(self) -> Array:
         """Cumulative chord length at the waypoints (the parameter)."""
         w = np.asarray(self.waypoints, dtype=float)
         return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(w, axis=0), axis=1))])
@@ -246,7 +247,7 @@ class Spline(Path):
         """0 for the straight two-waypoint spline, else None (varying curvature)."""
         return 0.0 if len(self.waypoints) == 2 else None
 
-    def derivatives(self, p: object) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    def derivatives(self, p: object) -> tuple[Array, Array, Array, Array]:
         p = self._check_parameter(p)
         spl = self._spl
         vals = [spl(p, nu=k) if k <= spl.k else np.zeros(p.shape + (2,)) for k in range(4)]
@@ -284,7 +285,7 @@ class ExpressionPath(Path):
     def _ey(self) -> Expression:
         return Expression.parse(self.y)
 
-    def derivatives(self, p: object) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    def derivatives(self, p: object) -> tuple[Array, Array, Array, Array]:
         p = self._check_parameter(p)
         xs = self._ex(p)
         ys = self._ey(p)

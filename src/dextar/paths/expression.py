@@ -12,16 +12,18 @@ import ast
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any, TypeAlias
 
 import numpy as np
 
+from .._arrays import Array
 from ..errors import ParameterError
 
 # A node is a tuple: ("num", value) | ("var",) | (op, a, b) for op in + - * / ** |
 # ("neg", a) | ("fn", name, a)
-Node = tuple
+Node: TypeAlias = tuple[Any, ...]
 
-FUNCTIONS: dict[str, Callable[[np.ndarray], np.ndarray]] = {
+FUNCTIONS: dict[str, Callable[[Array], Array]] = {
     "sin": np.sin, "cos": np.cos, "tan": np.tan, "exp": np.exp, "log": np.log,
     "sqrt": np.sqrt, "sinh": np.sinh, "cosh": np.cosh, "tanh": np.tanh,
     "asin": np.arcsin, "acos": np.arccos, "atan": np.arctan,
@@ -38,7 +40,7 @@ def _num(v: float) -> Node:
 
 
 def _is(n: Node, v: float) -> bool:
-    return n[0] == "num" and n[1] == v
+    return bool(n[0] == "num" and n[1] == v)
 
 
 def add(a: Node, b: Node) -> Node:
@@ -100,13 +102,13 @@ def neg(a: Node) -> Node:
     if a[0] == "num":
         return _num(-a[1])
     if a[0] == "neg":
-        return a[1]
+        return tuple(a[1])
     return ("neg", a)
 
 
 def fn(name: str, a: Node) -> Node:
     if a[0] == "num":
-        return _num(float(FUNCTIONS[name](np.float64(a[1]))))
+        return _num(float(FUNCTIONS[name](np.asarray(a[1], dtype=float))))
     return ("fn", name, a)
 
 
@@ -202,7 +204,7 @@ def size(n: Node) -> int:
     return 1 + sum(size(c) for c in n[1:] if isinstance(c, tuple))
 
 
-def evaluate(n: Node, x: np.ndarray) -> np.ndarray:
+def evaluate(n: Node, x: Array) -> Array:
     kind = n[0]
     if kind == "num":
         return np.full(np.shape(x), n[1])
@@ -245,7 +247,7 @@ class Expression:
                 raise ParameterError(f"expression {text!r}: derivatives grow too large")
         return cls(text, tuple(trees))
 
-    def __call__(self, x: object) -> list[np.ndarray]:
+    def __call__(self, x: object) -> list[Array]:
         """Values of the expression and its derivatives at ``x`` (same shape as ``x``)."""
         x = np.asarray(x, dtype=float)
         with np.errstate(all="ignore"):

@@ -14,6 +14,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.interpolate import CubicHermiteSpline
 
+from .._arrays import Array
 from ..dynamics.exact import Model, state_dynamics
 from ..errors import ConvergenceError, ParameterError, SingularityError
 from ..kinematics import direct_kinematics
@@ -43,14 +44,14 @@ class ControlResult:
         The integrator's message.
     """
 
-    t: np.ndarray
-    q: np.ndarray
-    dq: np.ndarray
-    tau: np.ndarray
-    P: np.ndarray
-    joint_error: np.ndarray
-    task_error: np.ndarray
-    saturated: np.ndarray
+    t: Array
+    q: Array
+    dq: Array
+    tau: Array
+    P: Array
+    joint_error: Array
+    task_error: Array
+    saturated: Array
     torque_limit: float | None = None
     status: int = 0
     message: str = ""
@@ -105,7 +106,7 @@ def simulate_computed_torque(trajectory: Trajectory, controller: Model, plant: M
     dq_d = CubicHermiteSpline(tr.t, tr.dq, tr.ddq, axis=0)
     ddq_d = dq_d.derivative()
 
-    def control(t: float, q: np.ndarray, dq: np.ndarray) -> tuple[np.ndarray, bool]:
+    def control(t: float, q: Array, dq: Array) -> tuple[Array, bool]:
         M, h = state_dynamics(controller, q, dq)
         v = ddq_d(t) + kd * (dq_d(t) - dq) + kp * (q_d(t) - q)
         tau = M @ v + h
@@ -114,7 +115,7 @@ def simulate_computed_torque(trajectory: Trajectory, controller: Model, plant: M
             return clipped, bool(np.any(clipped != tau))
         return tau, False
 
-    def rhs(t: float, y: np.ndarray) -> np.ndarray:
+    def rhs(t: float, y: Array) -> Array:
         q, dq = y[:2], y[2:]
         tau, _ = control(t, q, dq)
         try:
