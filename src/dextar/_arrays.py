@@ -41,7 +41,7 @@ def where(index: tuple[int, ...] | int, shape: tuple[int, ...]) -> str:
 
 
 def cross(ax: Array, ay: Array, bx: Array, by: Array) -> Array:
-    """z component of the 2-D cross product a x b."""
+    """Z component of the 2-D cross product a x b."""
     return np.asarray(ax * by - ay * bx)
 
 

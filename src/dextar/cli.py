@@ -54,20 +54,21 @@ def _print(args: argparse.Namespace, res: Any) -> int:
     return 0
 
 
-def cmd_ik(args: argparse.Namespace) -> int:
+def _cmd_ik(args: argparse.Namespace) -> int:
     return _print(args, jobs.ik(args.x, args.y, mode=args.mode, robot=args.robot))
 
 
-def cmd_fk(args: argparse.Namespace) -> int:
+def _cmd_fk(args: argparse.Namespace) -> int:
     return _print(args, jobs.fk(args.phi, args.psi, assembly=args.assembly, robot=args.robot))
 
 
-def cmd_workspace(args: argparse.Namespace) -> int:
+def _cmd_workspace(args: argparse.Namespace) -> int:
     return _print(args, jobs.workspace(args.out, mode=args.mode, resolution=args.resolution,
                                        robot=args.robot))
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of every command (registered stages included)."""
     p = _Parser(prog="dextar", description="Five-bar (DexTAR) robot toolkit. Lengths in mm, "
                 "angles in degrees on the command line.")
     p.add_argument("--version", action="version", version=f"dextar {__version__}")
@@ -82,21 +83,21 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("y", type=float, help="y in mm")
     sp.add_argument("--mode", type=_mode_arg, help=MODE_HELP)
     common(sp)
-    sp.set_defaults(func=cmd_ik)
+    sp.set_defaults(func=_cmd_ik)
 
     sp = sub.add_parser("fk", help="direct kinematics: end-effector for actuator angles")
     sp.add_argument("phi", type=float, help="phi in degrees (motor at A)")
     sp.add_argument("psi", type=float, help="psi in degrees (motor at D)")
     sp.add_argument("--assembly", choices=["up", "down"], help="assembly mode")
     common(sp)
-    sp.set_defaults(func=cmd_fk)
+    sp.set_defaults(func=_cmd_fk)
 
     sp = sub.add_parser("workspace", help="workspace map with singularity curves and dexterity")
     sp.add_argument("--mode", type=_mode_arg, help=MODE_HELP)
     sp.add_argument("--out", default="workspace.png", help="PNG or SVG file")
     sp.add_argument("--resolution", type=int, default=301, help="grid points on the long side")
     common(sp)
-    sp.set_defaults(func=cmd_workspace)
+    sp.set_defaults(func=_cmd_workspace)
 
     for register in _EXTRA_COMMANDS:
         register(sub)
@@ -108,6 +109,7 @@ _EXTRA_COMMANDS: list[Callable[[Any], None]] = []
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line ``argv``; returns the exit status (0, 1 or 2; 130 on interrupt)."""
     parser = build_parser()
     # negative numbers are values, not options: "dextar ik -10 120"
     argv = list(sys.argv[1:] if argv is None else argv)
@@ -175,23 +177,23 @@ _ALIAS_OF = {v: k for k, v in MODE_ALIASES.items()}
 
 
 # ----------------------------------------------------------------------------- stages
-def cmd_plan(args: argparse.Namespace) -> int:
+def _cmd_plan(args: argparse.Namespace) -> int:
     return _print(args, jobs.plan(args.config, args.out))
 
 
-def cmd_torques(args: argparse.Namespace) -> int:
+def _cmd_torques(args: argparse.Namespace) -> int:
     return _print(args, jobs.torques(args.config, args.out))
 
 
-def cmd_simulate(args: argparse.Namespace) -> int:
+def _cmd_simulate(args: argparse.Namespace) -> int:
     return _print(args, jobs.simulate(args.config, args.out, force=args.force))
 
 
-def cmd_export(args: argparse.Namespace) -> int:
+def _cmd_export(args: argparse.Namespace) -> int:
     return _print(args, jobs.export_mjcf(args.config, args.out))
 
 
-def cmd_run(args: argparse.Namespace) -> int:
+def _cmd_run(args: argparse.Namespace) -> int:
     return _print(args, jobs.run(args.config, args.out, force=args.force, quiet=args.quiet))
 
 
@@ -220,31 +222,31 @@ def _register_stages(sub: Any) -> None:
     sp = sub.add_parser("plan", help="law of motion along the path: samples to CSV, cost")
     cfg(sp)
     sp.add_argument("--out", required=True, help="CSV file (- for stdout)")
-    sp.set_defaults(func=cmd_plan)
+    sp.set_defaults(func=_cmd_plan)
 
     sp = sub.add_parser("torques", help="exact and paper-model motor torques to CSV")
     cfg(sp)
     sp.add_argument("--out", required=True, help="CSV file (- for stdout)")
-    sp.set_defaults(func=cmd_torques)
+    sp.set_defaults(func=_cmd_torques)
 
     sp = sub.add_parser("simulate", help="computed-torque tracking against a perturbed plant")
     cfg(sp)
     sp.add_argument("--out", default="dextar-sim", help="output directory")
     sp.add_argument("--force", action="store_true", help="write into an existing directory")
-    sp.set_defaults(func=cmd_simulate)
+    sp.set_defaults(func=_cmd_simulate)
 
     sp = sub.add_parser("export", help="export the robot model (mjcf: MuJoCo XML)")
     sp.add_argument("format", choices=["mjcf"])
     cfg(sp)
     sp.add_argument("--out", required=True, help="XML file (- for stdout)")
-    sp.set_defaults(func=cmd_export)
+    sp.set_defaults(func=_cmd_export)
 
     sp = sub.add_parser("run", help="reproduce the paper end to end and write a report")
     cfg(sp)
     sp.add_argument("--out", default="dextar-out", help="output directory (default dextar-out)")
     sp.add_argument("--force", action="store_true", help="write into an existing directory")
     sp.add_argument("--quiet", action="store_true", help="no progress or summary output")
-    sp.set_defaults(func=cmd_run)
+    sp.set_defaults(func=_cmd_run)
 
 
 _EXTRA_COMMANDS.append(_register_stages)

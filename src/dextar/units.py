@@ -42,24 +42,31 @@ class Units:
 
     # conversions from config units to run units
     def length(self, mm: float) -> float:
+        """Millimetres to run length units."""
         return mm / self.length_mm
 
     def mass(self, kg: float) -> float:
+        """Kilograms to run mass units."""
         return kg / self.mass_kg
 
     def time(self, s: float) -> float:
+        """Seconds to run time units."""
         return s / self.time_s
 
     def inertia(self, kg_mm2: float) -> float:
+        """Kg mm^2 to run inertia units."""
         return kg_mm2 / (self.mass_kg * self.length_mm**2)
 
     def torque(self, n_m: float) -> float:
+        """N m to run torque units."""
         return n_m * 1e6 / (self.mass_kg * self.length_mm**2 / self.time_s**2)
 
     def acceleration(self, mm_s2: float) -> float:
+        """mm/s^2 to run acceleration units."""
         return mm_s2 / (self.length_mm / self.time_s**2)
 
     def speed(self, mm_s: float) -> float:
+        """mm/s to run speed units."""
         return mm_s / (self.length_mm / self.time_s)
 
     def torque_in_nm(self, run: Array | float) -> Array | float:

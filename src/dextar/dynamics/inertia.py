@@ -123,6 +123,7 @@ class Inertia:
 
     @property
     def has_friction(self) -> bool:
+        """True when a motor has viscous or Coulomb friction."""
         return any(self.viscous) or any(self.coulomb)
 
     @classmethod

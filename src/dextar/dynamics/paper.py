@@ -69,19 +69,23 @@ class PaperModel:
 
     @property
     def C1(self) -> float:
+        """``C1`` of (40) (mass times length squared)."""
         return self.C2 + (1 - self.lam**2) * self.mL * self.l**2 / 2 + self.Jl + self.Je
 
     @property
     def C2(self) -> float:
+        """``C2`` of (40)."""
         return ((1 + 2 * self.lam**2 * self.mL / self.m) * self.m * self.l**2
                 / (4 * math.cos(self.beta0) ** 2))
 
     @property
     def C3(self) -> float:
+        """``C3`` of (40)."""
         return self.mL * (1 - self.lam) * self.lam * self.l**2 / math.cos(self.beta0)
 
     @property
     def C4(self) -> float:
+        """``C4`` of (40)."""
         return self.mL * (1 - self.lam) ** 2 * self.l**2 / 2
 
     def _K_S(self, x: Array) -> tuple[Array, Array]:

@@ -44,6 +44,7 @@ class WorkspaceMap:
 
     @property
     def reachable_area(self) -> float:
+        """Area of the reachable grid cells (length unit squared)."""
         dx = self.x[1] - self.x[0]
         dy = self.y[1] - self.y[0]
         return float(self.reachable.sum() * dx * dy)

@@ -64,6 +64,7 @@ class Law(ABC):
         return law_cost(self, path, mass, eta)
 
     def times(self, samples: int) -> Array:
+        """``samples`` equally spaced times from 0 to the duration, shape (samples,)."""
         if int(samples) < 2:
             raise ParameterError(f"samples = {samples} must be at least 2")
         return np.linspace(0.0, self.duration, int(samples))
@@ -122,6 +123,7 @@ class TrapezoidalLaw(Law):
 
     def __init__(self, distance: float, vmax: float, amax: float,
                  duration: float | None = None) -> None:
+        """Plan the profile; raises :class:`ParameterError` when the duration is infeasible."""
         S = _positive("distance", distance)
         vm = _positive("vmax", vmax)
         a = _positive("amax", amax)

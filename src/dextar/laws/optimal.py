@@ -138,6 +138,7 @@ class OptimalLaw(Law):
 
     @property
     def cost(self) -> float:
+        """The functional ``Phi``, kinetic plus inertial part."""
         return self.kinetic + self.inertial
 
     def cost_parts(self, path: Path, mass: float, eta: float) -> tuple[float, float]:

@@ -50,14 +50,17 @@ def _angles(tr: Trajectory, title: str, an: Analysis) -> Any:
 
 
 def fig3(an: Analysis, uniform: Trajectory) -> Any:
+    """Fig. 3: the leading angles under the uniform law."""
     return _angles(uniform, "Fig. 3: leading angles, uniform motion on the path", an)
 
 
 def fig5(an: Analysis) -> Any:
+    """Fig. 5: the leading angles under the run's law."""
     return _angles(an.trajectory, f"Fig. 5: leading angles, {an.law.name} law", an)
 
 
 def fig4(an: Analysis) -> Any:
+    """Fig. 4: the robot at every eighth of the motion."""
     tr, r = an.trajectory, an.inputs.robot
     fig = Figure(figsize=(7.6, 5.0))
     ax = fig.subplots()
@@ -82,6 +85,7 @@ def fig4(an: Analysis) -> Any:
 
 
 def fig6(an: Analysis) -> Any:
+    """Fig. 6: the end-effector's kinetic energy, exact, (30) and (32)."""
     p, t = an.paper, an.trajectory.t
     assert p is not None, "Fig. 6 needs the paper's model"
     return _time_plot(an, "Fig. 6: kinetic energy of the end-effector", _labels(an)["E"], [
@@ -91,6 +95,7 @@ def fig6(an: Analysis) -> Any:
 
 
 def fig7(an: Analysis) -> Any:
+    """Fig. 7: translational against rotational energy of the triangle CPB."""
     p, t = an.paper, an.trajectory.t
     assert p is not None, "Fig. 7 needs the paper's model"
     f = p.fig7
@@ -102,6 +107,7 @@ def fig7(an: Analysis) -> Any:
 
 
 def fig8(an: Analysis) -> Any:
+    """Fig. 8: the driven rods' angular velocities."""
     tr = an.trajectory
     return _time_plot(an, f"Fig. 8: angular velocities of the rods, {an.law.name} law",
                       _labels(an)["w"], [(tr.t, tr.dq[:, 0], "-", r"$\dot\varphi(t)$"),
@@ -109,6 +115,7 @@ def fig8(an: Analysis) -> Any:
 
 
 def fig9(an: Analysis) -> Any:
+    """Fig. 9: motor torques, exact and (where it applies) the paper's (42)."""
     tr, ine = an.trajectory, an.inputs.inertia
     curves = [(tr.t, an.tau[:, 0], "b-", r"$M_1$ exact"), (tr.t, an.tau[:, 1], "g-", r"$M_2$ exact")]
     if an.paper is not None:
@@ -120,6 +127,7 @@ def fig9(an: Analysis) -> Any:
 
 
 def workspace_figure(an: Analysis) -> Any:
+    """The workspace of the run's working mode with the path and a pose."""
     sc = an.inputs
     ws = workspace_map(sc.robot, sc.mode, resolution=241)
     mid = len(an.trajectory.t) // 2
@@ -153,7 +161,7 @@ def animation_gif(an: Analysis, frames: int = 41) -> bytes:
                      [r.A[1], B[i, 1], tr.P[i, 1], C[i, 1], r.D[1]])
         label.set_text(f"t = {tr.t[i]:.3f} {an.inputs.units.names['time']}")
         canvas.draw()  # type: ignore[no-untyped-call]  # matplotlib's Agg canvas is untyped
-        rgba = np.asarray(canvas.buffer_rgba())  # type: ignore[no-untyped-call]
+        rgba = np.asarray(canvas.buffer_rgba())  # type: ignore[no-untyped-call]  # the same
         images.append(Image.fromarray(rgba[..., :3]).convert("P", palette=Image.Palette.ADAPTIVE))
     buf = io.BytesIO()
     images[0].save(buf, format="GIF", save_all=True, append_images=images[1:], duration=80,
@@ -162,12 +170,14 @@ def animation_gif(an: Analysis, frames: int = 41) -> bytes:
 
 
 def png_bytes(fig: Any, dpi: int = 110) -> bytes:
+    """A figure as PNG bytes."""
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=dpi)
     return buf.getvalue()
 
 
 def svg_bytes(fig: Any) -> bytes:
+    """A figure as SVG bytes."""
     buf = io.BytesIO()
     fig.savefig(buf, format="svg")
     return buf.getvalue()

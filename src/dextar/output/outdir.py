@@ -15,7 +15,10 @@ from ..errors import ConfigError
 
 
 class OutputDir:
+    """An output directory whose files appear only when complete (see the module doc)."""
+
     def __init__(self, path: str | os.PathLike[str], *, force: bool = False) -> None:
+        """Open ``path``; refused when it exists, holds files and ``force`` is false."""
         self.path = Path(path)
         if self.path.exists():
             if not self.path.is_dir():
@@ -29,6 +32,7 @@ class OutputDir:
         self.written: list[str] = []
 
     def write_bytes(self, name: str, data: bytes) -> Path:
+        """Write ``name`` in the staging folder, then rename it into place."""
         tmp = self.staging / name
         tmp.write_bytes(data)
         target = self.path / name
@@ -37,9 +41,11 @@ class OutputDir:
         return target
 
     def write_text(self, name: str, text: str) -> Path:
+        """Write ``name`` as UTF-8 text (see :meth:`write_bytes`)."""
         return self.write_bytes(name, text.encode("utf-8"))
 
     def close(self) -> None:
+        """Remove the staging folder."""
         shutil.rmtree(self.staging, ignore_errors=True)
 
     def __enter__(self) -> OutputDir:

@@ -21,12 +21,14 @@ class Progress:
     """Step messages on stderr for a person at a terminal (silent otherwise)."""
 
     def __init__(self, enabled: bool) -> None:
+        """Messages only when ``enabled`` (a person at a terminal)."""
         self.enabled = enabled
         self.t0 = time.perf_counter()
         self.timings: dict[str, float] = {}
         self._last = self.t0
 
     def step(self, name: str) -> None:
+        """Announce the step ``name``."""
         now = time.perf_counter()
         if self.enabled:
             sys.stderr.write(f"[{now - self.t0:5.1f} s] {name}\n")
@@ -34,6 +36,7 @@ class Progress:
         self._last = now
 
     def done(self, name: str) -> None:
+        """Record the time the step ``name`` took."""
         now = time.perf_counter()
         self.timings[name] = round(now - self._last, 4)
         self._last = now

@@ -50,6 +50,7 @@ class Path(ABC):
         return p
 
     def position(self, p: object) -> Array:
+        """The points ``r(p)``, shape (..., 2)."""
         return self.derivatives(p)[0]
 
     def speed(self, p: object) -> Array:
@@ -86,6 +87,7 @@ class Path(ABC):
 
     @property
     def length(self) -> float:
+        """Total arc length."""
         return float(self._table[1][-1])
 
     def arc_length(self, p: object) -> Array:
@@ -146,6 +148,7 @@ class Arc(Path):
         return 1.0 / self.radius
 
     def derivatives(self, p: object) -> tuple[Array, Array, Array, Array]:
+        """``r, r', r'', r'''`` at ``p`` (shape (...,)), each of shape (..., 2)."""
         p = self._check_parameter(p)
         R = self.radius
         c, s = np.cos(p), np.sin(p)
@@ -155,12 +158,15 @@ class Arc(Path):
 
     @property
     def length(self) -> float:
+        """``R (p1 - p0)``."""
         return self.radius * (self.p1 - self.p0)
 
     def arc_length(self, p: object) -> Array:
+        """``R (p - p0)``."""
         return self.radius * (self._check_parameter(p) - self.p0)
 
     def parameter_at(self, s: object) -> Array:
+        """``p0 + s / R``."""
         p = self.p0 + np.asarray(s, dtype=float) / self.radius
         return np.clip(p, self.p0, self.p1)
 
@@ -183,6 +189,7 @@ class Line(Path):
             raise ParameterError("line start and end must differ")
 
     def derivatives(self, p: object) -> tuple[Array, Array, Array, Array]:
+        """``r, r', r'', r'''`` at ``p`` (shape (...,)), each of shape (..., 2)."""
         p = self._check_parameter(p)
         a, b = np.asarray(self.start), np.asarray(self.end)
         r = a + p[..., None] * (b - a)
@@ -192,12 +199,15 @@ class Line(Path):
 
     @property
     def length(self) -> float:
+        """``|end - start|``."""
         return float(np.hypot(self.end[0] - self.start[0], self.end[1] - self.start[1]))
 
     def arc_length(self, p: object) -> Array:
+        """``p |end - start|``."""
         return self.length * self._check_parameter(p)
 
     def parameter_at(self, s: object) -> Array:
+        """``s / |end - start|``."""
         return np.clip(np.asarray(s, dtype=float) / self.length, 0.0, 1.0)
 
 
@@ -248,6 +258,7 @@ class Spline(Path):
         return 0.0 if len(self.waypoints) == 2 else None
 
     def derivatives(self, p: object) -> tuple[Array, Array, Array, Array]:
+        """``r, r', r'', r'''`` of the spline at ``p``, each of shape (..., 2)."""
         p = self._check_parameter(p)
         spl = self._spl
         vals = [spl(p, nu=k) if k <= spl.k else np.zeros(p.shape + (2,)) for k in range(4)]
@@ -286,6 +297,7 @@ class ExpressionPath(Path):
         return Expression.parse(self.y)
 
     def derivatives(self, p: object) -> tuple[Array, Array, Array, Array]:
+        """``r, r', r'', r'''`` of the expressions at ``p``, each of shape (..., 2)."""
         p = self._check_parameter(p)
         xs = self._ex(p)
         ys = self._ey(p)

@@ -43,7 +43,7 @@ def _is(n: Node, v: float) -> bool:
     return bool(n[0] == "num" and n[1] == v)
 
 
-def add(a: Node, b: Node) -> Node:
+def _add(a: Node, b: Node) -> Node:
     if _is(a, 0.0):
         return b
     if _is(b, 0.0):
@@ -53,17 +53,17 @@ def add(a: Node, b: Node) -> Node:
     return ("+", a, b)
 
 
-def sub(a: Node, b: Node) -> Node:
+def _sub(a: Node, b: Node) -> Node:
     if _is(b, 0.0):
         return a
     if _is(a, 0.0):
-        return neg(b)
+        return _neg(b)
     if a[0] == "num" and b[0] == "num":
         return _num(a[1] - b[1])
     return ("-", a, b)
 
 
-def mul(a: Node, b: Node) -> Node:
+def _mul(a: Node, b: Node) -> Node:
     if _is(a, 0.0) or _is(b, 0.0):
         return ZERO
     if _is(a, 1.0):
@@ -75,7 +75,7 @@ def mul(a: Node, b: Node) -> Node:
     return ("*", a, b)
 
 
-def div(a: Node, b: Node) -> Node:
+def _div(a: Node, b: Node) -> Node:
     if _is(a, 0.0):
         return ZERO
     if _is(b, 1.0):
@@ -85,7 +85,7 @@ def div(a: Node, b: Node) -> Node:
     return ("/", a, b)
 
 
-def power(a: Node, b: Node) -> Node:
+def _power(a: Node, b: Node) -> Node:
     if _is(b, 0.0):
         return ONE
     if _is(b, 1.0):
@@ -98,7 +98,7 @@ def power(a: Node, b: Node) -> Node:
     return ("**", a, b)
 
 
-def neg(a: Node) -> Node:
+def _neg(a: Node) -> Node:
     if a[0] == "num":
         return _num(-a[1])
     if a[0] == "neg":
@@ -106,7 +106,7 @@ def neg(a: Node) -> Node:
     return ("neg", a)
 
 
-def fn(name: str, a: Node) -> Node:
+def _fn(name: str, a: Node) -> Node:
     if a[0] == "num":
         return _num(float(FUNCTIONS[name](np.asarray(a[1], dtype=float))))
     return ("fn", name, a)
@@ -134,9 +134,9 @@ def parse(text: str, variable: str = "p") -> Node:
                                  f"{variable!r}; constants pi, e)")
         if isinstance(n, ast.UnaryOp) and isinstance(n.op, (ast.USub, ast.UAdd)):
             a = build(n.operand)
-            return neg(a) if isinstance(n.op, ast.USub) else a
+            return _neg(a) if isinstance(n.op, ast.USub) else a
         if isinstance(n, ast.BinOp):
-            ops = {ast.Add: add, ast.Sub: sub, ast.Mult: mul, ast.Div: div, ast.Pow: power}
+            ops = {ast.Add: _add, ast.Sub: _sub, ast.Mult: _mul, ast.Div: _div, ast.Pow: _power}
             for kind, make in ops.items():
                 if isinstance(n.op, kind):
                     return make(build(n.left), build(n.right))
@@ -149,29 +149,29 @@ def parse(text: str, variable: str = "p") -> Node:
                                      f"allowed: {', '.join(FUNCTIONS)}")
             if len(n.args) != 1 or n.keywords:
                 raise ParameterError(f"expression {text!r}: {name}() takes one argument")
-            return fn(name, build(n.args[0]))
+            return _fn(name, build(n.args[0]))
         raise ParameterError(f"expression {text!r}: {type(n).__name__} is not allowed")
 
     return build(tree.body)
 
 
 _DERIVATIVES: dict[str, Callable[[Node], Node]] = {
-    "sin": lambda a: fn("cos", a),
-    "cos": lambda a: neg(fn("sin", a)),
-    "tan": lambda a: add(ONE, power(fn("tan", a), _num(2))),
-    "exp": lambda a: fn("exp", a),
-    "log": lambda a: div(ONE, a),
-    "sqrt": lambda a: div(_num(0.5), fn("sqrt", a)),
-    "sinh": lambda a: fn("cosh", a),
-    "cosh": lambda a: fn("sinh", a),
-    "tanh": lambda a: sub(ONE, power(fn("tanh", a), _num(2))),
-    "asin": lambda a: div(ONE, fn("sqrt", sub(ONE, power(a, _num(2))))),
-    "acos": lambda a: neg(div(ONE, fn("sqrt", sub(ONE, power(a, _num(2)))))),
-    "atan": lambda a: div(ONE, add(ONE, power(a, _num(2)))),
+    "sin": lambda a: _fn("cos", a),
+    "cos": lambda a: _neg(_fn("sin", a)),
+    "tan": lambda a: _add(ONE, _power(_fn("tan", a), _num(2))),
+    "exp": lambda a: _fn("exp", a),
+    "log": lambda a: _div(ONE, a),
+    "sqrt": lambda a: _div(_num(0.5), _fn("sqrt", a)),
+    "sinh": lambda a: _fn("cosh", a),
+    "cosh": lambda a: _fn("sinh", a),
+    "tanh": lambda a: _sub(ONE, _power(_fn("tanh", a), _num(2))),
+    "asin": lambda a: _div(ONE, _fn("sqrt", _sub(ONE, _power(a, _num(2))))),
+    "acos": lambda a: _neg(_div(ONE, _fn("sqrt", _sub(ONE, _power(a, _num(2)))))),
+    "atan": lambda a: _div(ONE, _add(ONE, _power(a, _num(2)))),
 }
 
 
-def derivative(n: Node) -> Node:
+def _derivative(n: Node) -> Node:
     """The exact derivative of an expression tree with respect to its variable."""
     kind = n[0]
     if kind == "num":
@@ -179,42 +179,42 @@ def derivative(n: Node) -> Node:
     if kind == "var":
         return ONE
     if kind == "neg":
-        return neg(derivative(n[1]))
+        return _neg(_derivative(n[1]))
     if kind == "fn":
-        return mul(_DERIVATIVES[n[1]](n[2]), derivative(n[2]))
+        return _mul(_DERIVATIVES[n[1]](n[2]), _derivative(n[2]))
     a, b = n[1], n[2]
-    da, db = derivative(a), derivative(b)
+    da, db = _derivative(a), _derivative(b)
     if kind == "+":
-        return add(da, db)
+        return _add(da, db)
     if kind == "-":
-        return sub(da, db)
+        return _sub(da, db)
     if kind == "*":
-        return add(mul(da, b), mul(a, db))
+        return _add(_mul(da, b), _mul(a, db))
     if kind == "/":
-        return div(sub(mul(da, b), mul(a, db)), power(b, _num(2)))
+        return _div(_sub(_mul(da, b), _mul(a, db)), _power(b, _num(2)))
     # a ** b
     if b[0] == "num":
-        return mul(mul(b, power(a, _num(b[1] - 1.0))), da)
-    return mul(n, add(mul(db, fn("log", a)), div(mul(b, da), a)))
+        return _mul(_mul(b, _power(a, _num(b[1] - 1.0))), da)
+    return _mul(n, _add(_mul(db, _fn("log", a)), _div(_mul(b, da), a)))
 
 
-def size(n: Node) -> int:
+def _size(n: Node) -> int:
     if n[0] in ("num", "var"):
         return 1
-    return 1 + sum(size(c) for c in n[1:] if isinstance(c, tuple))
+    return 1 + sum(_size(c) for c in n[1:] if isinstance(c, tuple))
 
 
-def evaluate(n: Node, x: Array) -> Array:
+def _evaluate(n: Node, x: Array) -> Array:
     kind = n[0]
     if kind == "num":
         return np.full(np.shape(x), n[1])
     if kind == "var":
         return np.asarray(x, dtype=float)
     if kind == "neg":
-        return -evaluate(n[1], x)
+        return -_evaluate(n[1], x)
     if kind == "fn":
-        return FUNCTIONS[n[1]](evaluate(n[2], x))
-    a, b = evaluate(n[1], x), evaluate(n[2], x)
+        return FUNCTIONS[n[1]](_evaluate(n[2], x))
+    a, b = _evaluate(n[1], x), _evaluate(n[2], x)
     if kind == "+":
         return a + b
     if kind == "-":
@@ -240,10 +240,11 @@ class Expression:
 
     @classmethod
     def parse(cls, text: str, *, variable: str = "p", order: int = 3) -> Expression:
+        """Parse ``text`` in ``variable`` and differentiate it ``order`` times."""
         trees = [parse(text, variable)]
         for _ in range(order):
-            trees.append(derivative(trees[-1]))
-            if size(trees[-1]) > MAX_NODES:
+            trees.append(_derivative(trees[-1]))
+            if _size(trees[-1]) > MAX_NODES:
                 raise ParameterError(f"expression {text!r}: derivatives grow too large")
         return cls(text, tuple(trees))
 
@@ -251,7 +252,7 @@ class Expression:
         """Values of the expression and its derivatives at ``x`` (same shape as ``x``)."""
         x = np.asarray(x, dtype=float)
         with np.errstate(all="ignore"):
-            vals = [evaluate(t, x) for t in self.trees]
+            vals = [_evaluate(t, x) for t in self.trees]
         for k, v in enumerate(vals):
             if not np.isfinite(v).all():
                 bad = np.flatnonzero(~np.isfinite(np.broadcast_to(v, x.shape)))[0]
