@@ -37,7 +37,16 @@ def test_robot_file(tmp_path, capsys):
     f = tmp_path / "r.toml"
     f.write_text('[robot]\nl1 = 80\nl2 = 80\nL1 = 100\nL2 = 100\nd = 50\nworking_mode = "+-"\n')
     code, out, _ = run(["ik", "0", "150", "--robot", str(f), "--json"], capsys)
-    assert code == 0 and json.loads(out)["phi_deg"] != pytest.approx(60.5118, abs=1e-2)
+    assert code == 0
+    # closed form for this robot: law of cosines at A = (25, 0), elbow "+" (right of A -> P)
+    import math
+
+    rho = math.hypot(-25.0, 150.0)
+    alpha = math.acos((80**2 + rho**2 - 100**2) / (2 * 80 * rho))
+    phi = math.degrees(math.atan2(150.0, -25.0) - alpha)
+    d = json.loads(out)
+    assert d["phi_deg"] == pytest.approx(phi, abs=1e-9)
+    assert d["psi_deg"] == pytest.approx(180.0 - phi, abs=1e-9)  # the mirror image
 
 
 @pytest.mark.parametrize(
