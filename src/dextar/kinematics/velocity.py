@@ -22,9 +22,11 @@ import numpy as np
 from .._arrays import Array, as_points, cos_sin, first_index, where
 from ..errors import SingularityError
 from ..geometry import FiveBar
+from .checker import DEFAULT_TOLERANCES
 
-#: Default tolerance on the normalised distances to a singularity (sine of the angle).
-DEFAULT_SINGULARITY_TOL = 1e-3
+#: Default tolerance on the normalised distances to a singularity (sine of the angle): the
+#: geometry checker's, so every stage refuses the same points.
+DEFAULT_SINGULARITY_TOL = DEFAULT_TOLERANCES.type2
 
 
 @dataclass(frozen=True)
