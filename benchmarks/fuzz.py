@@ -13,7 +13,6 @@ from __future__ import annotations
 import argparse
 import collections
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -22,7 +21,12 @@ sys.path.insert(0, str(ROOT))
 
 from hypothesis import HealthCheck, given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
-from tests.robustness.harness import DEFECTS, run_case, toml_text  # noqa: E402
+from tests.robustness.harness import (  # noqa: E402
+    DEFECTS,
+    run_argv_case,
+    run_config_case,
+    toml_text,
+)
 from tests.robustness.strategies import COMMANDS, configs, kinematics_argv  # noqa: E402
 
 
@@ -55,30 +59,17 @@ def main() -> int:
               suppress_health_check=list(HealthCheck))
     @given(doc=configs(), command=COMMANDS)
     def fuzz_configs(doc: dict, command: str) -> None:
-        with tempfile.TemporaryDirectory() as tmp:
-            work = Path(tmp)
-            cfg = work / "case.toml"
-            text = toml_text(doc)
-            cfg.write_text(text)
-            out = work / ("out.xml" if command == "export" else "out.csv")
-            argv = [command, "mjcf"] if command == "export" else [command]
-            t0 = time.perf_counter()
-            outcome, detail = run_case([*argv, str(cfg), "--out", str(out)], work, out)
-            record(outcome, detail, f"{command} with\n{text}", time.perf_counter() - t0)
+        t0 = time.perf_counter()
+        outcome, detail = run_config_case(doc, command)
+        record(outcome, detail, f"{command} with\n{toml_text(doc)}", time.perf_counter() - t0)
 
     @settings(max_examples=args.cases - n_cfg, deadline=None, database=None,
               suppress_health_check=list(HealthCheck))
     @given(argv=kinematics_argv())
     def fuzz_argv(argv: list[str]) -> None:
-        with tempfile.TemporaryDirectory() as tmp:
-            work = Path(tmp)
-            out = None
-            if argv[0] == "workspace":
-                out = work / "ws.png"
-                argv = [*argv, "--out", str(out)]
-            t0 = time.perf_counter()
-            outcome, detail = run_case(argv, work, out)
-            record(outcome, detail, " ".join(argv), time.perf_counter() - t0)
+        t0 = time.perf_counter()
+        outcome, detail = run_argv_case(argv)
+        record(outcome, detail, " ".join(argv), time.perf_counter() - t0)
 
     import random
 

@@ -18,6 +18,7 @@ import io
 import math
 import re
 import signal
+import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -123,3 +124,25 @@ def run_case(argv: list[str], workdir: Path, out: Path | None,
     if re.search(r"\b(nan|inf|infinity)\b", std.getvalue(), re.IGNORECASE):
         return "nan", f"non-finite number printed: {std.getvalue()[:200]}"
     return "ok", ""
+
+
+def run_config_case(doc: dict[str, Any], command: str) -> tuple[str, str]:
+    """Write ``doc`` as a config in a fresh folder and run ``command`` on it."""
+    with tempfile.TemporaryDirectory() as tmp:
+        work = Path(tmp)
+        cfg = work / "case.toml"
+        cfg.write_text(toml_text(doc))
+        out = work / ("out.xml" if command == "export" else "out.csv")
+        argv = [command, "mjcf"] if command == "export" else [command]
+        return run_case([*argv, str(cfg), "--out", str(out)], work, out)
+
+
+def run_argv_case(argv: list[str]) -> tuple[str, str]:
+    """Run a kinematics command line in a fresh folder (a workspace map writes a PNG there)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        work = Path(tmp)
+        out = None
+        if argv[0] == "workspace":
+            out = work / "ws.png"
+            argv = [*argv, "--out", str(out)]
+        return run_case(argv, work, out)

@@ -12,7 +12,7 @@ from pathlib import Path
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from .harness import DEFECTS, run_case, toml_text
+from .harness import DEFECTS, run_argv_case, run_case, run_config_case, toml_text
 from .strategies import COMMANDS, configs, kinematics_argv
 
 SETTINGS = settings(max_examples=150, deadline=None, derandomize=True,
@@ -22,13 +22,7 @@ SETTINGS = settings(max_examples=150, deadline=None, derandomize=True,
 @SETTINGS
 @given(doc=configs(), command=COMMANDS)
 def test_random_configs_never_crash(doc, command):
-    with tempfile.TemporaryDirectory() as tmp:
-        work = Path(tmp)
-        cfg = work / "case.toml"
-        cfg.write_text(toml_text(doc))
-        out = work / ("out.xml" if command == "export" else "out.csv")
-        argv = [command, "mjcf"] if command == "export" else [command]
-        outcome, detail = run_case([*argv, str(cfg), "--out", str(out)], work, out)
+    outcome, detail = run_config_case(doc, command)
     assert outcome not in DEFECTS, f"{outcome}: {detail}\nconfig:\n{toml_text(doc)}"
     if outcome == "refused":
         # the one line names a config key, a table, a point, a time, a leg or the solver
@@ -39,13 +33,7 @@ def test_random_configs_never_crash(doc, command):
 @SETTINGS
 @given(argv=kinematics_argv())
 def test_random_command_lines_never_crash(argv):
-    with tempfile.TemporaryDirectory() as tmp:
-        work = Path(tmp)
-        out = None
-        if argv[0] == "workspace":
-            out = work / "ws.png"
-            argv = [*argv, "--out", str(out)]
-        outcome, detail = run_case(argv, work, out)
+    outcome, detail = run_argv_case(argv)
     assert outcome not in DEFECTS, f"{outcome}: {detail}\nargv: {argv}"
 
 
