@@ -10,7 +10,15 @@ from typing import Any
 import numpy as np
 
 from .._arrays import Array
-from ..dynamics import Inertia, Model, Reactions, inverse_dynamics, joint_reactions, kinetic_energy
+from ..dynamics import (
+    Inertia,
+    Model,
+    Reactions,
+    TorqueResult,
+    inverse_dynamics,
+    kinetic_energy,
+    trajectory_torques,
+)
 from ..dynamics.forward import forward_dynamics, torques_from_samples
 from ..dynamics.paper import (
     PaperModel,
@@ -111,11 +119,28 @@ class Analysis:
     law: Law
     trajectory: Trajectory
     model: Model
-    tau: Array
-    power: Array
-    energy: Array
-    reactions: Reactions
+    torques: TorqueResult
     paper: PaperComparison | None
+
+    @property
+    def tau(self) -> Array:
+        """Exact motor torques, shape (n, 2)."""
+        return self.torques.tau
+
+    @property
+    def power(self) -> Array:
+        """Motor powers ``tau_i qdot_i``, shape (n, 2)."""
+        return self.torques.power
+
+    @property
+    def energy(self) -> Array:
+        """The mechanism's kinetic energy, shape (n,)."""
+        return self.torques.kinetic_energy
+
+    @property
+    def reactions(self) -> Reactions:
+        """Passive-joint forces."""
+        return self.torques.reactions
 
     def reaction_magnitudes(self) -> dict[str, Array]:
         """Magnitudes of the passive-joint forces: at B and C (proximal on distal rod) and
@@ -142,17 +167,15 @@ def analyze(inputs: RunInputs, law: Law) -> Analysis:
     """
     tr = inputs.trajectory(law)
     model = Model(inputs.robot, inputs.inertia, tr.assembly, tol=inputs.tolerances.type2)
-    tau = inverse_dynamics(model, tr.q, tr.dq, tr.ddq, t=tr.t)
+    torques = trajectory_torques(model, tr.t, tr.q, tr.dq, tr.ddq)
+    tau = torques.tau
     if not np.isfinite(tau).all():
         i = int(np.flatnonzero(~np.isfinite(tau).all(axis=1))[0])
         raise NumericalError(f"the torque is not finite at {inputs.units.time_text(tr.t[i])}: "
                              "the parameters overflow double precision")
-    power = tau * tr.dq
-    energy = kinetic_energy(model, tr.q, tr.dq)
-    reactions = joint_reactions(model, tr.q, tr.dq, tr.ddq)
     applies = paper_model_limits(inputs.robot, inputs.inertia) is None
     paper = _paper(inputs, law, tr, tau) if applies else None
-    return Analysis(inputs, law, tr, model, tau, power, energy, reactions, paper)
+    return Analysis(inputs, law, tr, model, torques, paper)
 
 
 def _paper(sc: RunInputs, law: Law, tr: Trajectory, tau: Array) -> PaperComparison:

@@ -423,3 +423,34 @@ def state_dynamics(model: Model, q: Any, dq: Any) -> tuple[Array, Array]:
     m2 = _loads(model, pose, still, 0.0, 0.0, 0.0, 1.0, gravity=False, friction=False)
     M = np.array([[m1.tau1, m2.tau1], [m1.tau2, m2.tau2]])
     return M, np.array([h.tau1, h.tau2])
+
+
+@dataclass(frozen=True)
+class TorqueResult:
+    """The dynamics stage's result on a trajectory: exact motor torques, motor powers, the
+    mechanism's kinetic energy and the passive-joint forces.
+
+    Attributes
+    ----------
+    t : ndarray, shape (n,)
+    tau : ndarray, shape (n, 2)
+        Motor torques (gravity and friction included).
+    power : ndarray, shape (n, 2)
+        ``tau_i qdot_i``.
+    kinetic_energy : ndarray, shape (n,)
+    reactions : Reactions
+    """
+
+    t: Array
+    tau: Array
+    power: Array
+    kinetic_energy: Array
+    reactions: Reactions
+
+
+def trajectory_torques(model: Model, t: Array, q: Array, dq: Array, ddq: Array
+                       ) -> TorqueResult:
+    """The :class:`TorqueResult` of the samples ``q, dq, ddq`` (n, 2) at times ``t`` (n,)."""
+    tau = inverse_dynamics(model, q, dq, ddq, t=t)
+    return TorqueResult(np.asarray(t), tau, tau * np.asarray(dq), kinetic_energy(model, q, dq),
+                        joint_reactions(model, q, dq, ddq))

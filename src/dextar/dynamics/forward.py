@@ -17,17 +17,17 @@ TorqueFunction = Callable[[float, Array, Array], Array]
 
 
 @dataclass(frozen=True)
-class ForwardResult:
-    """Integrated motion.
+class SimResult:
+    """The result of a simulation stage (forward dynamics, a control loop): the motion, the
+    torques applied and the integrator's outcome, as ``scipy.optimize.OptimizeResult`` has it.
 
     Attributes
     ----------
     t : ndarray, shape (n,)
-    q, dq, ddq : ndarray, shape (n, 2)
+    q, dq : ndarray, shape (n, 2)
+        Joint angles and rates.
     tau : ndarray, shape (n, 2)
         The torques applied.
-    nfev : int
-        Right-hand-side evaluations.
     status : int
         The integrator's status (0: reached the end; a failure raises instead).
     message : str
@@ -37,16 +37,23 @@ class ForwardResult:
     t: Array
     q: Array
     dq: Array
-    ddq: Array
     tau: Array
-    nfev: int
+    status: int
     message: str
-    status: int = 0
 
     @property
     def success(self) -> bool:
         """True when the integration reached the last time."""
         return self.status == 0
+
+
+@dataclass(frozen=True, kw_only=True)
+class ForwardResult(SimResult):
+    """Forward dynamics: a :class:`SimResult` with the accelerations ``ddq`` (n, 2) and the
+    number of right-hand-side evaluations ``nfev``."""
+
+    ddq: Array
+    nfev: int
 
 
 def torques_from_samples(t: Array, tau: Array) -> TorqueFunction:
@@ -111,4 +118,5 @@ def forward_dynamics(model: Model, torque: TorqueFunction, q0: object, dq0: obje
     tau = np.array([torque(ti, qi, dqi) for ti, qi, dqi in zip(sol.t, q, dq, strict=True)])
     h = inverse_dynamics(model, q, dq, np.zeros_like(q), t=sol.t)
     ddq = np.linalg.solve(mass_matrix(model, q), (tau - h)[..., None])[..., 0]
-    return ForwardResult(sol.t, q, dq, ddq, tau, nfev, str(sol.message), int(sol.status))
+    return ForwardResult(t=sol.t, q=q, dq=dq, tau=tau, status=int(sol.status),
+                         message=str(sol.message), ddq=ddq, nfev=nfev)

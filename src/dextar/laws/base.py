@@ -26,7 +26,11 @@ def _positive(name: str, value: float) -> float:
 
 
 class Law(ABC):
-    """A law of motion ``s(t)``, ``t`` in ``[0, duration]``, ``s`` from 0 to ``distance``."""
+    """A law of motion ``s(t)``, ``t`` in ``[0, duration]``, ``s`` from 0 to ``distance``.
+
+    A law is the laws stage's result (:data:`LawResult`): besides evaluating it carries the
+    solver's ``status``, ``success`` and ``message`` (closed-form laws always succeed).
+    """
 
     distance: float
     duration: float
@@ -221,3 +225,8 @@ def _register() -> None:
 
 
 _register()
+
+
+#: The result type of the laws stage: the law itself, with ``status``, ``success`` and
+#: ``message`` (see :class:`Law`).
+LawResult = Law

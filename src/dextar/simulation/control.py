@@ -16,20 +16,21 @@ from scipy.interpolate import CubicHermiteSpline
 
 from .._arrays import Array
 from ..dynamics.exact import Model, state_dynamics
+from ..dynamics.forward import SimResult
 from ..errors import ConvergenceError, ParameterError, SingularityError
 from ..kinematics import direct_kinematics
 from ..trajectory import Trajectory
 
 
-@dataclass(frozen=True)
-class ControlResult:
-    """Tracking result on the trajectory's time grid.
+@dataclass(frozen=True, kw_only=True)
+class ControlResult(SimResult):
+    """Tracking: a :class:`~dextar.dynamics.forward.SimResult` on the trajectory's time grid
+    (``q, dq`` the plant's, ``tau`` the applied, saturated torques) with
 
     Attributes
     ----------
-    t : ndarray, shape (n,)
-    q, dq, tau : ndarray, shape (n, 2)
-        Plant angles, rates and the applied (saturated) torques.
+    P : ndarray, shape (n, 2)
+        The plant's end-effector.
     joint_error : ndarray, shape (n, 2)
         ``q_d - q`` (radians).
     task_error : ndarray, shape (n,)
@@ -38,28 +39,13 @@ class ControlResult:
         Samples where a motor torque was clipped at the limit.
     torque_limit : float or None
         The saturation limit (run torque unit).
-    status : int
-        The integrator's status (0: reached the end; a failure raises instead).
-    message : str
-        The integrator's message.
     """
 
-    t: Array
-    q: Array
-    dq: Array
-    tau: Array
     P: Array
     joint_error: Array
     task_error: Array
     saturated: Array
     torque_limit: float | None = None
-    status: int = 0
-    message: str = ""
-
-    @property
-    def success(self) -> bool:
-        """True when the integration reached the end of the trajectory."""
-        return self.status == 0
 
     def summary(self) -> dict[str, float]:
         """Tracking figures: task errors (run length unit), joint error (rad), saturation."""
@@ -135,6 +121,7 @@ def simulate_computed_torque(trajectory: Trajectory, controller: Model, plant: M
     taus, sat = zip(*(control(ti, qi, dqi) for ti, qi, dqi in zip(sol.t, q, dq, strict=True)),
                     strict=True)
     P = direct_kinematics(plant.robot, q, plant.assembly)
-    return ControlResult(sol.t, q, dq, np.array(taus), P, tr.q - q,
-                         np.linalg.norm(tr.P - P, axis=-1), np.array(sat), torque_limit,
-                         int(sol.status), str(sol.message))
+    return ControlResult(t=sol.t, q=q, dq=dq, tau=np.array(taus), status=int(sol.status),
+                         message=str(sol.message), P=P, joint_error=tr.q - q,
+                         task_error=np.linalg.norm(tr.P - P, axis=-1), saturated=np.array(sat),
+                         torque_limit=torque_limit)
