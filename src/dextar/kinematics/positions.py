@@ -26,8 +26,8 @@ def _leg_solve(
     k = 0.5 * (rho2 + (l * l - L * L))
     w2 = (l * l) * rho2 - k * k
     # rounding may leave w2 a hair below zero on the boundary (leg stretched): allow it
-    bad = ((w2 < -1e-12 * (l * l) * rho2) | (rho2 <= 1e-24 * (l + L) ** 2)
-           | ~np.isfinite(w2))  # a point so far that its squares overflow
+    # "not >=" is also true for NaN: a point so far that its squares overflow is out of reach
+    bad = ~(w2 >= -1e-12 * (l * l) * rho2) | (rho2 <= 1e-24 * (l + L) ** 2)
     w = np.sqrt(np.maximum(w2, 0.0))
     if sign > 0:  # s = +1: elbow to the right of pivot->P, so the perp term enters negated
         w = -w
@@ -147,8 +147,7 @@ def direct_kinematics(robot: FiveBar, q: object, assembly: str | int = "up") -> 
         k = 0.5 * (del2 + (L2 * L2 - L1 * L1))
         w2 = (L2 * L2) * del2 - k * k
         # rounding may leave w2 a hair below zero on the boundary (rods aligned): allow it
-        bad = ((w2 < -1e-12 * (L2 * L2) * del2) | (del2 <= 1e-24 * (L1 + L2) ** 2)
-               | ~np.isfinite(w2))
+        bad = ~(w2 >= -1e-12 * (L2 * L2) * del2) | (del2 <= 1e-24 * (L1 + L2) ** 2)
         if bad.any():
             j = int(np.flatnonzero(bad)[0])
             i = blk.start + j
