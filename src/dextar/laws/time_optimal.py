@@ -319,62 +319,105 @@ def _reachability(co: PathCoefficients, ds: float, tmax: Array, wmax: Array,
     with np.errstate(divide="ignore", invalid="ignore"):
         alpha = np.where(xonly, 0.0, -Gx / Gu)
         beta = np.where(xonly, 0.0, h / Gu)
-        # u <= alpha x + beta (uppers), u >= alpha x + beta (lowers); padding never binds
-        au, bu = np.where(up, alpha, 0.0), np.where(up, beta, np.inf)
-        al, bl = np.where(lo_, alpha, 0.0), np.where(lo_, beta, -np.inf)
+        # u <= alpha x + beta (uppers), u >= alpha x + beta (lowers), active rows first
+        au, bu = _compact(alpha, beta, up, np.inf)
+        al, bl = _compact(alpha, beta, lo_, -np.inf)
         # static x-interval: every lower below every upper, and the x-only rows
         c = al[:, None, :] - au[:, :, None]
         d = bu[:, :, None] - bl[:, None, :]
         hi_pairs = np.where(c > 0, d / c, np.inf)
         lo_pairs = np.where(c < 0, d / c, -np.inf)
-        x_hi = np.minimum(hi_pairs.min(axis=(1, 2)),
+        x_hi = np.minimum(hi_pairs.min(axis=(1, 2), initial=np.inf),
                           np.where(xonly & (Gx > 0), h / Gx, np.inf).min(axis=1))
-        x_lo = np.maximum(lo_pairs.max(axis=(1, 2)),
+        x_lo = np.maximum(lo_pairs.max(axis=(1, 2), initial=-np.inf),
                           np.where(xonly & (Gx < 0), h / Gx, -np.inf).max(axis=1))
         empty = ((c == 0) & (d < 0)).any(axis=(1, 2)) | (xonly & (Gx == 0) & (h < 0)).any(axis=1)
     x_lo = np.where(empty, np.inf, np.maximum(x_lo, 0.0))
     inv2 = 1.0 / (2 * ds)
-    AU, BU, AL, BL = au.tolist(), bu.tolist(), al.tolist(), bl.tolist()
+    # The controllability rows lo <= x + 2 ds u <= hi combine with the static rows into bounds
+    # on x linear in hi (lower rows) or lo (upper rows): x <= m hi + q or x >= m hi + q. The
+    # coefficients are precomputed for all stages at once; the pass only evaluates them.
+    act_l, act_u = np.isfinite(bl), np.isfinite(bu)  # the compacted rows that are real
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cl = al + inv2  # lower row vs u <= (hi - x) / (2 ds): cl x <= hi / (2 ds) - bl
+        m_l, q_l = inv2 / cl, -bl / cl
+        cu = -inv2 - au  # u >= (lo - x) / (2 ds) vs upper row: cu x <= bu - lo / (2 ds)
+        m_u, q_u = -inv2 / cu, bu / cu
+    LH = _lists(*_compact(m_l, q_l, act_l & (cl > 0), np.inf))  # x <= m hi + q
+    LL = _lists(*_compact(m_l, q_l, act_l & (cl < 0), -np.inf))  # x >= m hi + q
+    uh_m, uh_q = _compact(m_u, q_u, act_u & (cu > 0), np.inf)  # x <= m lo + q
+    ul_m, ul_q = _compact(m_u, q_u, act_u & (cu < 0), -np.inf)  # x >= m lo + q
+    UH, UL = _lists(uh_m, uh_q), _lists(ul_m, ul_q)
+    AU, BU = _lists(au, bu)  # u <= a x + b
+    AL, BL = _lists(al, bl)  # u >= a x + b
     XL, XH = x_lo.tolist(), x_hi.tolist()
+    # with lo = 0 (rest is reachable, the usual case) the upper rows' bounds are constants
+    XL0 = np.maximum(x_lo, np.max(ul_q, axis=1, initial=-np.inf)).tolist()
+    XH0 = np.minimum(x_hi, np.min(uh_q, axis=1, initial=np.inf)).tolist()
     K_lo, K_hi = [0.0] * (n + 1), [0.0] * (n + 1)
+    big = 1e300  # an unbounded hi stays finite, so that 0 * hi is 0
     for k in range(n - 1, -1, -1):
-        lo, hi = K_lo[k + 1], K_hi[k + 1]
-        xl, xh = XL[k], XH[k]
-        for a_, b_ in zip(AL[k], BL[k], strict=True):  # lower row vs u <= (hi - x) / (2 ds)
-            cc, dd = a_ + inv2, hi * inv2 - b_
-            if cc > 0:
-                xh = min(xh, dd / cc)
-            elif cc < 0:
-                xl = max(xl, dd / cc)
-            elif dd < 0:
-                xl = math.inf
-        for a_, b_ in zip(AU[k], BU[k], strict=True):  # u >= (lo - x) / (2 ds) vs upper row
-            cc, dd = -inv2 - a_, b_ - lo * inv2
-            if cc > 0:
-                xh = min(xh, dd / cc)
-            elif cc < 0:
-                xl = max(xl, dd / cc)
-            elif dd < 0:
-                xl = math.inf
+        lo, hi = K_lo[k + 1], min(K_hi[k + 1], big)
+        if lo == 0.0:
+            xl, xh = XL0[k], XH0[k]
+        else:
+            xl, xh = XL[k], XH[k]
+            for m_, q_ in zip(UH[0][k], UH[1][k], strict=True):
+                v = m_ * lo + q_
+                if v < xh:
+                    xh = v
+            for m_, q_ in zip(UL[0][k], UL[1][k], strict=True):
+                v = m_ * lo + q_
+                if v > xl:
+                    xl = v
+        for m_, q_ in zip(LH[0][k], LH[1][k], strict=True):
+            v = m_ * hi + q_
+            if v < xh:
+                xh = v
+        for m_, q_ in zip(LL[0][k], LL[1][k], strict=True):
+            v = m_ * hi + q_
+            if v > xl:
+                xl = v
         if xl > xh + 1e-12 * (1.0 + abs(xh)):
             raise _unreachable(co, k, tmax, units)
         K_lo[k], K_hi[k] = max(0.0, min(xl, xh)), max(0.0, xh)
     if K_lo[0] > 1e-12 * (1.0 + K_hi[0]):
         raise _unreachable(co, 0, tmax, units)
     x = [0.0] * (n + 1)
+    two_ds = 2 * ds
     for k in range(n):
         xk = x[k]
         u_hi = (K_hi[k + 1] - xk) * inv2
         u_lo = (K_lo[k + 1] - xk) * inv2
         for a_, b_ in zip(AU[k], BU[k], strict=True):
-            u_hi = min(u_hi, a_ * xk + b_)
+            v = a_ * xk + b_
+            if v < u_hi:
+                u_hi = v
         for a_, b_ in zip(AL[k], BL[k], strict=True):
-            u_lo = max(u_lo, a_ * xk + b_)
+            v = a_ * xk + b_
+            if v > u_lo:
+                u_lo = v
         if u_lo > u_hi + 1e-9 * (1.0 + abs(u_hi)):
             raise _unreachable(co, k, tmax, units)
-        x[k + 1] = min(max(xk + 2 * ds * u_hi, K_lo[k + 1]), K_hi[k + 1])
+        x[k + 1] = min(max(xk + two_ds * u_hi, K_lo[k + 1]), K_hi[k + 1])
     x[n] = 0.0
     return np.array(x)
+
+
+def _compact(m: Array, q: Array, active: Array, fill: float) -> tuple[Array, Array]:
+    """Per stage (row of the arrays), the active entries first, cut to the largest number of
+    active entries; padding ``(0, fill)`` never binds."""
+    order = np.argsort(~active, axis=1, kind="stable")
+    mm = np.take_along_axis(np.where(active, m, 0.0), order, axis=1)
+    qq = np.take_along_axis(np.where(active, q, fill), order, axis=1)
+    width = int(active.sum(axis=1).max()) if active.size else 0
+    return mm[:, :width], qq[:, :width]
+
+
+def _lists(m: Array, q: Array) -> tuple[list[list[float]], list[list[float]]]:
+    """The coefficients as Python lists, for the sequential passes (floats are faster there
+    than NumPy scalars)."""
+    return m.tolist(), q.tolist()
 
 
 def _unreachable(co: PathCoefficients, k: int, tmax: Array, units: Units | None
