@@ -40,7 +40,6 @@ at all, :class:`~dextar.errors.InfeasibleError` names the point, the motor and t
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from typing import Protocol
 
