@@ -118,3 +118,45 @@ def test_infeasible_names_point_arc_length_motor_and_torque(tmp_path, capsys):
                      r"at P = \(-?[\d.]+, [\d.]+\) mm \(arc length s = [\d.]+ mm\), above its "
                      r"limit 0\.05 N m", err), err
     assert not (tmp_path / "p.csv").exists()
+
+
+MOTORS = {"path": {"type": "line", "start": [-60.0, 95.0], "end": [60.0, 125.0]},
+          "inertia": {"effector_mass": 0.1, "proximal_mass": 0.03, "distal_mass": 0.02,
+                      "rotor_inertia": 2.0},
+          "friction": {"coulomb": 0.01, "viscous": 1e-4},
+          "gravity": {"vector": [0.0, -9810.0]},
+          "law": {"type": "time-optimal"},
+          "output": {"units": "si", "samples": 2001}}
+
+
+def test_motors_table_with_a_torque_speed_envelope_holds_on_the_output():
+    from dextar.config import scenario_from_dict
+
+    flat = scenario_from_dict({**MOTORS, "motors": {"peak_torque": 0.5,
+                                                     "max_speed_rpm": 150}})
+    knee = scenario_from_dict({**MOTORS, "motors": {"peak_torque": 0.5, "max_speed_rpm": 150,
+                                                     "knee_speed_rpm": 60}})
+    law_flat, law_knee = flat.law(), knee.law()
+    assert law_flat.success and law_knee.success
+    assert law_knee.duration > law_flat.duration * 1.001  # the envelope costs time
+    motors = knee.motors
+    dense = knee.trajectory(law_knee, samples=20001)
+    tau = inverse_dynamics(knee.model(dense.assembly), dense.q, dense.dq, dense.ddq)
+    torque_ratio, speed_ratio = motors.ratios(tau, dense.dq)
+    assert torque_ratio <= 1 + 1e-3 and speed_ratio <= 1 + 1e-3
+    assert torque_ratio > 0.99  # and the envelope is used: above the knee somewhere
+    assert (np.abs(dense.dq) > motors.knee_speed[0]).any()
+
+
+def test_motors_table_errors_named():
+    from dextar.config import scenario_from_dict
+    from dextar.errors import ConfigError
+
+    for motors, word in (({"rms_torque": 0.3}, r"\[motors\]\.peak_torque is required"),
+                         ({"peak_torque": 0.5, "knee_speed_rpm": 60},
+                          r"\[motors\]\.knee_speed_rpm needs max_speed_rpm"),
+                         ({"peak_torque": 0.5, "max_speed_rpm": 50, "knee_speed_rpm": 60},
+                          r"must be below max_speed_rpm"),
+                         ({"peak_torque": -1.0}, r"\[motors\]\.peak_torque must be positive")):
+        with pytest.raises(ConfigError, match=word):
+            scenario_from_dict({**MOTORS, "motors": motors})

@@ -13,6 +13,7 @@ Units of config keys (what a TOML file speaks) and their conversion:
 ``"mm/s^2"``   accelerations
 ``"deg"``      angles (to radians)
 ``"deg/s"``    angular speeds (to rad per run time unit)
+``"rpm"``      motor speeds (to rad per run time unit)
 ``"s"``        times
 ``"kg"``       masses
 ``"N m"``      torques
@@ -170,6 +171,7 @@ def _converter(unit: str, units: Units) -> Callable[[float], float]:
         "mm/s^2": units.acceleration,
         "deg": math.radians,
         "deg/s": lambda v: math.radians(v) * units.time_s,
+        "rpm": lambda v: 2 * math.pi / 60 * v * units.time_s,
         "s": units.time,
         "kg": units.mass,
         "N m": units.torque,

@@ -56,7 +56,10 @@ def law_summary(sc: RunInputs, law: Law, an: Analysis | None = None) -> dict[str
     if isinstance(law, TrapezoidalLaw):
         out.update(vmax=law.vmax, amax=law.amax, cruise_speed=law.cruise)
     if law.name == "time-optimal":
-        out.update(torque_limit_Nm=list(spec["torque_limit"]), grid=spec["grid"],
+        limit = getattr(law, "torque_limit", None)
+        out.update(torque_limit_Nm=list(spec["torque_limit"]) if spec.get("torque_limit")
+                   is not None else ([sc.units.torque_in_nm(v) for v in limit] if limit
+                                     else None), grid=spec["grid"],
                    max_torque_ratio_check_samples=getattr(law, "max_torque_ratio", None))
         if spec.get("speed_limit_deg_s") is not None:
             out["speed_limit_deg_s"] = list(spec["speed_limit_deg_s"])

@@ -13,6 +13,7 @@ from .tables import (
     GravityTable,
     InertiaTable,
     LawTable,
+    MotorsTable,
     OutputTable,
     PaperTable,
     PathTable,
@@ -24,6 +25,6 @@ from .tables import (
 from .toml import check_tables, load_toml
 
 __all__ = ["FIGURES", "TABLES", "ControlTable", "FrictionTable", "GravityTable",
-           "InertiaTable", "LawTable", "OutputTable", "PaperTable", "PathTable", "RobotTable",
+           "InertiaTable", "LawTable", "MotorsTable", "OutputTable", "PaperTable", "PathTable", "RobotTable",
            "Scenario", "Table", "TolerancesTable", "check_tables", "default_scenario",
            "load_scenario", "load_toml", "register_table", "scenario_from_dict"]

@@ -18,7 +18,7 @@ from ..dynamics import Inertia, Model, RobotAlongPath
 from ..errors import ConfigError, DextarError
 from ..geometry import FiveBar
 from ..kinematics.checker import Tolerances
-from ..laws import Law, LawRequest, law_type
+from ..laws import Law, LawRequest, MotorLimits, law_type
 from ..params import read_params
 from ..paths import Path
 from ..trajectory import Trajectory, check_path, sample_trajectory
@@ -30,6 +30,7 @@ from .tables import (
     GravityTable,
     InertiaTable,
     LawTable,
+    MotorsTable,
     OutputTable,
     PaperTable,
     PathTable,
@@ -150,6 +151,11 @@ class Scenario:
         inertia = self._get(InertiaTable)
         return t.run_values(self.units, inertia.effector_mass)
 
+    @property
+    def motors(self) -> MotorLimits | None:
+        """The motors' limits in run units (``[motors]``), or None."""
+        return self._get(MotorsTable).limits(self.units)
+
     def model(self, assembly: str | None = None) -> Model:
         """Robot and inertia assembled in ``assembly`` (default: the configured one)."""
         return Model(self.robot, self.inertia, assembly or self.assembly,
@@ -169,7 +175,7 @@ class Scenario:
         dynamics = (RobotAlongPath(self.model(), self.path, self.mode, self.units)
                     if lt.needs_dynamics else None)
         request = LawRequest(self.path, table.run_values(self.units), self.effector_mass,
-                             dynamics, self.units)
+                             dynamics, self.units, self.motors)
         return lt.build(request)
 
     def inputs(self) -> RunInputs:

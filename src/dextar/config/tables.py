@@ -21,7 +21,7 @@ from ..dynamics.friction import DEFAULT_COULOMB_SPEED_DEG_S
 from ..errors import ConfigError, DextarError
 from ..geometry import DEXTAR_MM, FiveBar, canonical_working_mode, parse_assembly_mode, preset
 from ..kinematics.checker import Tolerances
-from ..laws import LawType, law_type
+from ..laws import LawType, MotorLimits, law_type
 from ..params import Param, read_params, to_run_units
 from ..paths import Path, PathType, path_type
 from ..units import Units
@@ -386,6 +386,55 @@ class TolerancesTable(Table):
         return Tolerances(type1=self.type1, type2=self.type2)
 
 
+@dataclass(frozen=True)
+class MotorsTable(Table):
+    """``[motors]``: the motors at the joints (motor at A first; a number means both):
+    peak torque, continuous (RMS) rating, maximum speed and the knee of the torque-speed
+    envelope (full torque up to the knee, then linear to zero at the maximum speed)."""
+
+    NAME: ClassVar[str] = "motors"
+    PARAMS: ClassVar[dict[str, Param]] = {
+        "peak_torque": _pair("N m", "peak torques", None, positive=True),
+        "rms_torque": _pair("N m", "continuous (RMS) torque ratings", None, positive=True),
+        "max_speed_rpm": _pair("", "maximum speeds, rpm", None, positive=True),
+        "knee_speed_rpm": _pair("", "end of full torque, rpm (< max_speed_rpm)", None,
+                                positive=True),
+    }
+
+    peak_torque: tuple[float, float] | None = None
+    rms_torque: tuple[float, float] | None = None
+    max_speed_rpm: tuple[float, float] | None = None
+    knee_speed_rpm: tuple[float, float] | None = None
+
+    @classmethod
+    def from_toml(cls, raw: Mapping[str, object]) -> MotorsTable:
+        """Read ``[motors]``: ``peak_torque`` is required when the table is given; a knee
+        needs a maximum speed above it."""
+        t = cls(**read_params(cls.NAME, raw, cls.PARAMS))
+        if raw and t.peak_torque is None:
+            raise ConfigError("config key [motors].peak_torque is required")
+        if t.knee_speed_rpm is not None:
+            if t.max_speed_rpm is None:
+                raise ConfigError("config key [motors].knee_speed_rpm needs max_speed_rpm")
+            if any(k >= w for k, w in zip(t.knee_speed_rpm, t.max_speed_rpm, strict=True)):
+                raise ConfigError(f"config key [motors].knee_speed_rpm {list(t.knee_speed_rpm)} "
+                                  f"must be below max_speed_rpm {list(t.max_speed_rpm)}")
+        return t
+
+    def limits(self, units: Units) -> MotorLimits | None:
+        """The motors' limits in run units (None without a ``[motors]`` table)."""
+        if self.peak_torque is None:
+            return None
+        rad = 2 * math.pi / 60 * units.time_s
+
+        def pair(v: tuple[float, float] | None, scale: float) -> tuple[float, float]:
+            return (math.inf, math.inf) if v is None else (v[0] * scale, v[1] * scale)
+
+        return MotorLimits((units.torque(self.peak_torque[0]), units.torque(self.peak_torque[1])),
+                           pair(self.max_speed_rpm, rad),
+                           None if self.knee_speed_rpm is None else pair(self.knee_speed_rpm, rad))
+
+
 for _cls in (RobotTable, PathTable, LawTable, InertiaTable, FrictionTable, GravityTable,
-             ControlTable, PaperTable, OutputTable, TolerancesTable):
+             ControlTable, PaperTable, OutputTable, TolerancesTable, MotorsTable):
     register_table(_cls)

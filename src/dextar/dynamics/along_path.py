@@ -15,7 +15,12 @@ import numpy as np
 from .._arrays import Array
 from ..kinematics.checker import Tolerances
 from ..laws import Law, UniformLaw
-from ..laws.time_optimal import PathCoefficients, TimeOptimalLaw, solve_time_optimal_law
+from ..laws.time_optimal import (
+    MotorLimits,
+    PathCoefficients,
+    TimeOptimalLaw,
+    solve_time_optimal_law,
+)
 from ..paths import Path
 from ..trajectory import sample_trajectory
 from ..units import Units
@@ -48,23 +53,22 @@ class RobotAlongPath:
         return PathCoefficients(jp.t, jp.P, a, b, g, jp.dq, np.array(ine.coulomb, float),
                                 np.array(ine.viscous, float))
 
-    def ratios(self, law: Law, times: Array, torque_limit: Array,
-               speed_limit: Array) -> tuple[float, float]:
+    def ratios(self, law: Law, times: Array, motors: MotorLimits) -> tuple[float, float]:
         """Largest torque and speed ratios of ``law`` at ``times`` (exact model)."""
         tr = sample_trajectory(self.model.robot, self.path, law, mode=self.mode, times=times,
                                tolerances=Tolerances(0.0, 0.0))
         tau = inverse_dynamics(Model(self.model.robot, self.model.inertia, tr.assembly), tr.q,
                                tr.dq, tr.ddq)
-        return (float((np.abs(tau) / torque_limit).max()),
-                float((np.abs(tr.dq) / speed_limit).max()))
+        return motors.ratios(tau, tr.dq)
 
 
-def time_optimal_law(model: Model, path: Path, *, torque_limit: tuple[float, float],
-                     speed_limit: tuple[float, float] | None = None, mode: str = "+-",
-                     grid: int = 400, tol: float = 1e-3,
-                     units: Units | None = None) -> TimeOptimalLaw:
+def time_optimal_law(model: Model, path: Path, *,
+                     torque_limit: tuple[float, float] | None = None,
+                     speed_limit: tuple[float, float] | None = None,
+                     motors: MotorLimits | None = None, mode: str = "+-", grid: int = 400,
+                     tol: float = 1e-3, units: Units | None = None) -> TimeOptimalLaw:
     """The fastest rest-to-rest law along ``path`` for ``model`` within the motors' torque
     (and speed) limits; see :func:`dextar.laws.time_optimal.solve_time_optimal_law`."""
     return solve_time_optimal_law(RobotAlongPath(model, path, mode, units),
-                                  torque_limit=torque_limit, speed_limit=speed_limit, grid=grid,
-                                  tol=tol, units=units)
+                                  torque_limit=torque_limit, speed_limit=speed_limit,
+                                  motors=motors, grid=grid, tol=tol, units=units)

@@ -41,6 +41,8 @@ class LawRequest:
         laws planned under motor limits; None when the law does not need it.
     units : Units
         The run's units (for the words of an error).
+    motors : MotorLimits, optional
+        The motors' limits (``[motors]``), for laws planned under them.
     """
 
     path: Path
@@ -48,6 +50,7 @@ class LawRequest:
     mass: float
     dynamics: Any
     units: Units
+    motors: Any = None
 
 
 @dataclass(frozen=True)

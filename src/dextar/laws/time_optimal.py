@@ -40,8 +40,9 @@ at all, :class:`~dextar.errors.InfeasibleError` names the point, the motor and t
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -133,6 +134,56 @@ class PathCoefficients:
     viscous: Array
 
 
+@dataclass(frozen=True)
+class MotorLimits:
+    """The two motors' limits at the joints (run units): peak torque, maximum speed and,
+    optionally, a torque-speed envelope: full torque up to ``knee_speed``, then linearly
+    down to zero at ``max_speed``.
+
+    Attributes
+    ----------
+    peak_torque : (float, float)
+        Motor at A, motor at D.
+    max_speed : (float, float)
+        ``inf`` for none.
+    knee_speed : (float, float), optional
+        Below ``max_speed``; None for no envelope.
+    """
+
+    peak_torque: tuple[float, float]
+    max_speed: tuple[float, float] = (math.inf, math.inf)
+    knee_speed: tuple[float, float] | None = None
+
+    def __post_init__(self) -> None:
+        t, w = np.asarray(self.peak_torque, float), np.asarray(self.max_speed, float)
+        if t.shape != (2,) or not np.all(np.isfinite(t) & (t > 0)):
+            raise ParameterError(f"torque limits {self.peak_torque!r} must be two positive "
+                                 "numbers")
+        if w.shape != (2,) or not np.all(w > 0):
+            raise ParameterError(f"speed limits {self.max_speed!r} must be two positive numbers")
+        if self.knee_speed is not None:
+            k = np.asarray(self.knee_speed, float)
+            if k.shape != (2,) or not np.all((k > 0) & (k < w)):
+                raise ParameterError(f"knee speeds {self.knee_speed!r} must be positive and below "
+                                     f"the maximum speeds {self.max_speed!r}")
+
+    def available_torque(self, dq: Array) -> Array:
+        """The torque each motor can give at joint rates ``dq`` (..., 2), same shape."""
+        peak = np.asarray(self.peak_torque, float)
+        if self.knee_speed is None:
+            return np.broadcast_to(peak, np.shape(dq)).copy()
+        w, k = np.asarray(self.max_speed, float), np.asarray(self.knee_speed, float)
+        frac = np.clip((w - np.abs(dq)) / (w - k), 0.0, 1.0)
+        return np.asarray(peak * frac)
+
+    def ratios(self, tau: Array, dq: Array) -> tuple[float, float]:
+        """Largest ``|tau| / available torque`` and ``|qdot| / max speed`` over samples (n, 2)."""
+        avail = self.available_torque(dq)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            r = np.where(avail > 0, np.abs(tau) / avail, np.where(np.abs(tau) > 0, np.inf, 0.0))
+        return float(r.max()), float((np.abs(dq) / np.asarray(self.max_speed, float)).max())
+
+
 class PathDynamics(Protocol):
     """The robot along a path, as the time-optimal law needs it."""
 
@@ -140,15 +191,16 @@ class PathDynamics(Protocol):
         """The coefficients on ``segments + 1`` equally spaced arc lengths."""
         ...
 
-    def ratios(self, law: Law, times: Array, torque_limit: Array,
-               speed_limit: Array) -> tuple[float, float]:
-        """Largest ``|tau_i| / torque_limit_i`` and ``|qdot_i| / speed_limit_i`` of ``law``
-        at ``times`` (exact model with gravity and friction)."""
+    def ratios(self, law: Law, times: Array, motors: MotorLimits) -> tuple[float, float]:
+        """Largest torque and speed ratios of ``law`` at ``times`` against ``motors`` (exact
+        model with gravity and friction)."""
         ...
 
 
-def solve_time_optimal_law(dynamics: PathDynamics, *, torque_limit: tuple[float, float],
-                           speed_limit: tuple[float, float] | None = None, grid: int = 400,
+def solve_time_optimal_law(dynamics: PathDynamics, *,
+                           torque_limit: tuple[float, float] | None = None,
+                           speed_limit: tuple[float, float] | None = None,
+                           motors: MotorLimits | None = None, grid: int = 400,
                            tol: float = 1e-3, units: Units | None = None) -> TimeOptimalLaw:
     """The fastest rest-to-rest law along a path within motor torque and speed limits.
 
@@ -160,6 +212,8 @@ def solve_time_optimal_law(dynamics: PathDynamics, *, torque_limit: tuple[float,
         ``tau_max`` of the motors at A and D (run torque unit).
     speed_limit : (float, float), optional
         ``|qdot|`` limits of the motors (rad per run time unit).
+    motors : MotorLimits, optional
+        The limits with a torque-speed envelope (instead of the two above).
     grid : int
         Number of segments in arc length.
     tol : float
@@ -178,13 +232,16 @@ def solve_time_optimal_law(dynamics: PathDynamics, *, torque_limit: tuple[float,
         No motion within the limits exists: names the point (mm), the arc length, the motor
         and the torque needed against the limit.
     """
-    tmax = np.array([float(v) for v in np.broadcast_to(np.asarray(torque_limit, float), (2,))])
-    if not np.all(np.isfinite(tmax) & (tmax > 0)):
-        raise ParameterError(f"torque limits {torque_limit!r} must be two positive numbers")
-    wmax = np.full(2, np.inf) if speed_limit is None else np.array(
-        [float(v) for v in np.broadcast_to(np.asarray(speed_limit, float), (2,))])
-    if not np.all(wmax > 0):
-        raise ParameterError(f"speed limits {speed_limit!r} must be two positive numbers")
+    if motors is None:
+        if torque_limit is None:
+            raise ParameterError("a time-optimal law needs torque limits (or motors)")
+        t2 = np.broadcast_to(np.asarray(torque_limit, float), (2,))
+        w2 = np.broadcast_to(np.asarray(math.inf if speed_limit is None else speed_limit,
+                                        float), (2,))
+        motors = MotorLimits((float(t2[0]), float(t2[1])), (float(w2[0]), float(w2[1])))
+    tmax = np.asarray(motors.peak_torque, float)
+    wmax = np.asarray(motors.max_speed, float)
+    knee = None if motors.knee_speed is None else np.asarray(motors.knee_speed, float)
     if int(grid) < 10:
         raise ParameterError(f"grid = {grid} must be at least 10")
     if not (0 < tol < 1):
@@ -197,13 +254,14 @@ def solve_time_optimal_law(dynamics: PathDynamics, *, torque_limit: tuple[float,
     x0: Array | None = None  # tangent points of the viscous bound
     scale_t, scale_w = 1.0, 1.0
     law: TimeOptimalLaw | None = None
-    has_viscous = bool(np.any(co.viscous > 0))
+    has_viscous = bool(np.any(co.viscous > 0)) or knee is not None  # needs a tangent point
     for solve in range(1, MAX_SOLVES + 1):
-        x = _reachability(co, ds, tmax * scale_t, wmax * scale_w, x0, units)
+        x = _reachability(co, ds, tmax * scale_t, wmax * scale_w, x0, units,
+                          None if knee is None else knee * scale_w)
         law = _law(length, co.s, x, tmax, wmax, solve)
         dts = np.diff(law.knots_t)
         times = (law.knots_t[:-1, None] + dts[:, None] * CHECK_FRACTIONS[None, :]).reshape(-1)
-        tr_ratio, sp_ratio = dynamics.ratios(law, times, tmax, wmax)
+        tr_ratio, sp_ratio = dynamics.ratios(law, times, motors)
         law = _with(law, tr_ratio, sp_ratio, 0, "")
         tangent_moved = has_viscous and (x0 is None or np.abs(np.sqrt(x) - np.sqrt(x0)).max()
                                          > 1e-6 * np.sqrt(x).max())
@@ -290,17 +348,39 @@ def _friction_bounds(co: PathCoefficients, x0: Array | None
 
 
 def _rows(co: PathCoefficients, ds: float, tmax: Array, wmax: Array,
-          x0: Array | None) -> tuple[Array, Array, Array]:
-    """Static rows ``Gu u + Gx x <= h`` of every stage, arrays (N, m)."""
+          x0: Array | None, knee: Array | None = None) -> tuple[Array, Array, Array]:
+    """Static rows ``Gu u + Gx x <= h`` of every stage, arrays (N, m).
+
+    With a torque-speed envelope (``knee``) and a tangent point ``x0``, each motor also has
+    ``|tau| + sigma |q'| sqrt(x) <= T + sigma knee`` (``sigma = T / (wmax - knee)``), with
+    ``sqrt(x)`` bounded above by its tangent at ``max(x0, x_knee)``: conservative, and exact at
+    the tangent point."""
     phi_lo, psi_lo, phi_hi, psi_hi = _friction_bounds(co, x0)
+    n1 = len(co.s)
     with np.errstate(divide="ignore"):
         xmax = np.min(np.where(co.dq_ds != 0, (wmax / np.abs(co.dq_ds)) ** 2, np.inf), axis=1)
     # rows at each point over (u, X), X the squared speed at that point
-    pu = np.concatenate([co.a, -co.a, np.zeros((len(xmax), 2))], axis=1)
-    px = np.concatenate([co.b + psi_hi, -(co.b + psi_lo), np.ones((len(xmax), 1)),
-                         -np.ones((len(xmax), 1))], axis=1)
-    ph = np.concatenate([tmax - co.g - phi_hi, tmax + co.g + phi_lo, xmax[:, None],
-                         np.zeros((len(xmax), 1))], axis=1)
+    pu = [co.a, -co.a, np.zeros((n1, 2))]
+    px = [co.b + psi_hi, -(co.b + psi_lo), np.ones((n1, 1)), -np.ones((n1, 1))]
+    ph = [tmax - co.g - phi_hi, tmax + co.g + phi_lo, xmax[:, None], np.zeros((n1, 1))]
+    if knee is not None and x0 is not None:
+        sigma = tmax / (wmax - knee)
+        qabs = np.abs(co.dq_ds)
+        with np.errstate(divide="ignore"):
+            xk = np.where(qabs > 0, (knee / qabs) ** 2, np.inf)
+        r = np.sqrt(np.minimum(np.maximum(x0[:, None], xk), 1e300))
+        slope = np.where(qabs > 0, sigma * qabs / (2 * r), 0.0)
+        offset = np.where(qabs > 0, sigma * qabs * r / 2, 0.0)
+        cap = tmax + sigma * knee - offset
+        pu += [co.a, -co.a]
+        px += [co.b + psi_hi + slope, -(co.b + psi_lo) + slope]
+        ph += [cap - co.g - phi_hi, cap + co.g + phi_lo]
+    pu_, px_, ph_ = (np.concatenate(v, axis=1) for v in (pu, px, ph))
+    return _stage_rows(pu_, px_, ph_, ds)
+
+
+def _stage_rows(pu: Array, px: Array, ph: Array, ds: float) -> tuple[Array, Array, Array]:
+    """The rows of each stage from the rows at its two points (interpolation scheme)."""
     # stage k: rows at point k with X = x, rows at point k + 1 with X = x + 2 ds u
     Gu = np.concatenate([pu[:-1], pu[1:] + 2 * ds * px[1:]], axis=1)
     Gx = np.concatenate([px[:-1], px[1:]], axis=1)
@@ -309,9 +389,9 @@ def _rows(co: PathCoefficients, ds: float, tmax: Array, wmax: Array,
 
 
 def _reachability(co: PathCoefficients, ds: float, tmax: Array, wmax: Array,
-                  x0: Array | None, units: Units | None) -> Array:
+                  x0: Array | None, units: Units | None, knee: Array | None = None) -> Array:
     """Squared speeds ``x`` at the grid points of the fastest admissible motion."""
-    Gu, Gx, h = _rows(co, ds, tmax, wmax, x0)
+    Gu, Gx, h = _rows(co, ds, tmax, wmax, x0, knee)
     n = Gu.shape[0]
     tiny = 1e-12 * (np.abs(Gu) + 2 * ds * np.abs(Gx))
     up, lo_, xonly = Gu > tiny, Gu < -tiny, np.abs(Gu) <= tiny
@@ -451,21 +531,34 @@ def _law(S: float, s: Array, x: Array, tmax: Array, wmax: Array,
 
 
 
+def _build(r: Any) -> TimeOptimalLaw:
+    """The registered builder: limits from ``[law]`` when given, else from ``[motors]``."""
+    from ..errors import ConfigError
+
+    p = r.params
+    motors = r.motors
+    if p.get("torque_limit") is not None:
+        motors = MotorLimits(tuple(p["torque_limit"]),
+                             tuple(p.get("speed_limit_deg_s") or (math.inf, math.inf)))
+    elif motors is None:
+        raise ConfigError("config key [law].torque_limit is required for a time-optimal law "
+                          "(or a [motors] table with peak_torque)")
+    return solve_time_optimal_law(r.dynamics, motors=motors, grid=p["grid"], units=r.units)
+
+
 def _register() -> None:
-    from ..params import REQUIRED, Param
+    from ..params import Param
     from .registry import LawType, register_law
 
     register_law(LawType(
         "time-optimal",
-        {"torque_limit": Param("pair", "N m", REQUIRED, "motor torque limits [A, D]",
-                               positive=True),
+        {"torque_limit": Param("pair", "N m", None, "motor torque limits [A, D] (default: "
+                               "[motors])", positive=True),
          "speed_limit_deg_s": Param("pair", "deg/s", None, "motor speed limits [A, D]",
                                     positive=True),
          "grid": Param("integer", "", 400, "segments in arc length", minimum=10,
                        maximum=100_000)},
-        lambda r: solve_time_optimal_law(r.dynamics, torque_limit=r.params["torque_limit"],
-                                         speed_limit=r.params.get("speed_limit_deg_s"),
-                                         grid=r.params["grid"], units=r.units),
+        _build,
         "the fastest rest-to-rest motion within the motors' torque and speed limits (TOPP-RA)",
         needs_dynamics=True))
 
