@@ -27,7 +27,6 @@ import numpy as np
 from .._arrays import Array
 from ..dynamics.exact import Model
 from ..kinematics import direct_kinematics, elbows, task_velocity
-from .files import write_text
 
 #: Constraint softness: as stiff as MuJoCo allows (impedance 0.9999).
 SOLREF = "0.0005 1"
@@ -105,12 +104,6 @@ def to_mjcf(model: Model, *, name: str = "dextar",
   </actuator>
 {key}</mujoco>
 """
-
-
-def write_mjcf(model: Model, path: str, *,
-               start: tuple[Array, Array] | None = None) -> None:
-    """Write :func:`to_mjcf` atomically to ``path``."""
-    write_text(path, to_mjcf(model, start=start))
 
 
 def mujoco_state(model: Model, q: Array, dq: Array) -> tuple[Array, Array]:
