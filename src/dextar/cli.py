@@ -51,7 +51,7 @@ def _print(args: argparse.Namespace, res: Any) -> int:
         sys.stderr.write(w + "\n")
     if not getattr(args, "quiet", False) or args.json:
         _emit(args, res.payload, res.text)
-    return 0
+    return int(res.code)
 
 
 def _cmd_ik(args: argparse.Namespace) -> int:
@@ -193,6 +193,10 @@ def _cmd_export(args: argparse.Namespace) -> int:
     return _print(args, jobs.export_mjcf(args.config, args.out))
 
 
+def _cmd_program(args: argparse.Namespace) -> int:
+    return _print(args, jobs.program(args.config, args.out, force=args.force))
+
+
 def _cmd_run(args: argparse.Namespace) -> int:
     return _print(args, jobs.run(args.config, args.out, force=args.force, quiet=args.quiet))
 
@@ -240,6 +244,15 @@ def _register_stages(sub: Any) -> None:
     cfg(sp)
     sp.add_argument("--out", required=True, help="XML file (- for stdout)")
     sp.set_defaults(func=_cmd_export)
+
+    sp = sub.add_parser("program", help="plan a robot program under the motors: setpoints "
+                        "and sizing (exit 1 when a motor limit is exceeded)")
+    sp.add_argument("config", help="TOML task file with [program], [[move]] and [motors]")
+    sp.add_argument("--json", action="store_true", help="print one JSON object")
+    sp.add_argument("--out", required=True, help="output directory")
+    sp.add_argument("--force", action="store_true", help="write into an existing directory")
+    sp.add_argument("--quiet", action="store_true", help="no summary output")
+    sp.set_defaults(func=_cmd_program)
 
     sp = sub.add_parser("run", help="reproduce the paper end to end and write a report")
     cfg(sp)

@@ -28,6 +28,7 @@ class JobResult:
     text: str
     warnings: list[str] = field(default_factory=list)
     data: str | None = None
+    code: int = 0
 
 
 def shown(path: str | Path, name: str | None = None) -> str:
@@ -94,7 +95,7 @@ def robot_table(path: str | None) -> RobotTable:
     if path is None:
         return RobotTable()
     doc = load_toml(path)
-    check_tables(doc, set(TABLES))
+    check_tables({k: v for k, v in doc.items() if k != "move"}, set(TABLES))
     return RobotTable.from_toml(doc.get("robot", {}))
 
 
@@ -299,3 +300,66 @@ def run(config: str | None, out: str, *, force: bool = False,
     lines += [f"  {c['verdict']:>11}: {c['claim']} ({c['value']:.3g})"
               for c in s.get("claims", [])]
     return JobResult(s, "\n".join(lines), warnings)
+
+
+def program(config: str, out: str, *, force: bool = False) -> JobResult:
+    """Plan a robot program (``[program]``, ``[[move]]``, ``[motors]``) and write its
+    setpoints and sizing to ``out``; exit code 1 when it exceeds a motor limit."""
+    from .config.program import ProgramTable
+    from .config.tables import FrictionTable, GravityTable, InertiaTable, MotorsTable
+    from .output.outdir import OutputDir
+    from .output.tables import csv_text
+    from .program import plan_program, sizing
+    from .units import SI
+
+    sc = load_scenario(config)
+    prog = sc.table("program")
+    assert isinstance(prog, ProgramTable)
+    if prog.start is None:
+        raise ConfigError("config key [program].start is required (the start point, at rest)")
+    robot = sc.robot_mm.scaled(1e-3)
+    inertia_t, motors_t = sc.table("inertia"), sc.table("motors")
+    assert isinstance(inertia_t, InertiaTable) and isinstance(motors_t, MotorsTable)
+    friction_t, gravity_t = sc.table("friction"), sc.table("gravity")
+    assert isinstance(friction_t, FrictionTable) and isinstance(gravity_t, GravityTable)
+    inertia = inertia_t.build(SI, sc.robot_mm, friction_t, gravity_t)
+    res = plan_program(robot, inertia, sc.moves, start=prog.start,
+                       working_mode=prog.working_mode or sc.mode, assembly=sc.assembly,
+                       motors=motors_t.limits(SI), rms_limit=motors_t.rms_torque,
+                       servo_rate_hz=prog.servo_rate_hz, grid=prog.grid,
+                       tolerances=sc.tolerances)
+    motors, violations = sizing(res)
+    cols = {"t_s": res.t, "move": res.move_index.astype(float), "x_mm": res.P[:, 0] * 1e3,
+            "y_mm": res.P[:, 1] * 1e3, "phi_rad": res.q[:, 0], "psi_rad": res.q[:, 1],
+            "dphi_rad_s": res.dq[:, 0], "dpsi_rad_s": res.dq[:, 1],
+            "ddphi_rad_s2": res.ddq[:, 0], "ddpsi_rad_s2": res.ddq[:, 1],
+            "tau1_Nm": res.tau[:, 0], "tau2_Nm": res.tau[:, 1]}
+    summary: dict[str, Any] = {
+        "status": "exceeds" if violations else "fits", "cycle_time_s": res.cycle_time_s,
+        "servo_rate_hz": prog.servo_rate_hz, "config": config,
+        "moves": [{"index": pm.move.index, "type": pm.move.type,
+                   "law": pm.law.name if pm.law else None,
+                   "law_status": pm.law.status if pm.law else 0,
+                   "law_message": pm.law.message if pm.law else "holding still",
+                   "start_s": pm.start_s, "duration_s": pm.duration_s,
+                   "min_type1_distance": pm.min_type1_distance,
+                   "min_type2_distance": pm.min_type2_distance} for pm in res.moves],
+        "motors": motors, "violations": violations,
+        "units": "SI: s, rad, N m, W, J; positions in mm in setpoints.csv"}
+    with OutputDir(out, force=force) as od:
+        od.write_text("setpoints.csv", csv_text(cols))
+        od.write_text("summary.json", json.dumps(summary, indent=2, allow_nan=False) + "\n")
+    lines = [f"program: cycle time {res.cycle_time_s:.6g} s, {len(res.moves)} moves; "
+             f"{summary['status']} the motors",
+             *(f"  {pm.move.name}: {pm.law.name if pm.law else 'dwell'} {pm.duration_s:.4g} s "
+               f"from {pm.start_s:.4g} s" for pm in res.moves),
+             *(f"  motor {m['motor']}: peak {m['peak_torque_Nm']:.4g} N m, RMS "
+               f"{m['rms_torque_Nm']:.4g} N m, peak speed {m['peak_speed_rad_s']:.4g} rad/s"
+               for m in motors),
+             f"wrote {shown(out, 'setpoints.csv')} ({res.t.size} setpoints at "
+             f"{prog.servo_rate_hz:g} Hz) and {shown(out, 'summary.json')}"]
+    warnings = [f"dextar program: motor {v['motor']} {v['quantity']} {v['value']:.4g} above its "
+                f"limit {v['limit']:.4g}" + (f" at t = {v['t_s']:.4g} s in move {v['move']}"
+                                             if v["t_s"] is not None else "")
+                for v in violations]
+    return JobResult(summary, "\n".join(lines), warnings, code=1 if violations else 0)

@@ -84,8 +84,14 @@ def _is_number(v: object) -> bool:
     return isinstance(v, (int, float)) and not isinstance(v, bool)
 
 
+def _where(table: str, key: str) -> str:
+    """``config key [table].key`` (a table name already in brackets, ``[[move]] 2 (arc)``,
+    is used as it is)."""
+    return f"config key {table}.{key}" if table.startswith("[") else f"config key [{table}].{key}"
+
+
 def _check_number(table: str, key: str, p: Param, v: object) -> float:
-    where = f"config key [{table}].{key}"
+    where = _where(table, key)
     if not _is_number(v):
         raise ConfigError(f"{where} must be a number, got {type(v).__name__} {v!r}")
     x = float(cast(float, v))  # a number, checked above
@@ -103,7 +109,7 @@ def _check_number(table: str, key: str, p: Param, v: object) -> float:
 def read_value(table: str, key: str, p: Param, v: object) -> Any:
     """Check one value against its declaration; numbers come back as floats, points as
     tuples. Raises :class:`ConfigError` naming ``[table].key``."""
-    where = f"config key [{table}].{key}"
+    where = _where(table, key)
     if p.kind == "number":
         return _check_number(table, key, p, v)
     if p.kind == "integer":
@@ -150,14 +156,14 @@ def read_params(table: str, raw: Mapping[str, object], params: Mapping[str, Para
     config units."""
     for key in raw:
         if key not in params and key not in ignore:
-            raise ConfigError(f"config key [{table}].{key} is not known; known keys: "
+            raise ConfigError(f"{_where(table, key)} is not known; known keys: "
                               f"{', '.join([*ignore, *params])}")
     out: dict[str, Any] = {}
     for key, p in params.items():
         if key in raw:
             out[key] = read_value(table, key, p, raw[key])
         elif p.required:
-            raise ConfigError(f"config key [{table}].{key} is required")
+            raise ConfigError(f"{_where(table, key)} is required")
         elif p.default is not None:
             out[key] = p.default
     return out

@@ -40,7 +40,7 @@ class Trajectory:
     """
 
     robot: FiveBar
-    path: Path
+    path: Path | JointLine
     law: Law
     mode: str
     assembly: str
@@ -181,3 +181,89 @@ class _Words:
 
     def length(self, x: float) -> str:
         return f"{x:.6g}" if self.units is None else f"{self.units.mm(x):.6g} mm"
+
+
+@dataclass(frozen=True)
+class JointLine:
+    """A straight line in joint space from ``q0`` to ``q1`` (each (2,), rad), parametrised by
+    its length ``s`` in radians: ``q(s) = q0 + s u``, ``u = (q1 - q0) / |q1 - q0|``."""
+
+    q0: tuple[float, float]
+    q1: tuple[float, float]
+
+    def __post_init__(self) -> None:
+        a, b = np.asarray(self.q0, float), np.asarray(self.q1, float)
+        if a.shape != (2,) or b.shape != (2,) or not (np.isfinite(a).all() and
+                                                      np.isfinite(b).all()):
+            raise ParameterError("a joint line needs two finite joint positions (phi, psi)")
+        if np.allclose(a, b, rtol=0.0, atol=1e-12):
+            raise ParameterError("a joint line needs two different joint positions")
+
+    @property
+    def length(self) -> float:
+        """``|q1 - q0|`` (rad)."""
+        return float(np.hypot(self.q1[0] - self.q0[0], self.q1[1] - self.q0[1]))
+
+    @property
+    def direction(self) -> Array:
+        """The unit direction ``u``, shape (2,)."""
+        return np.asarray((np.asarray(self.q1, float) - np.asarray(self.q0, float)) / self.length)
+
+    def at(self, s: Array) -> Array:
+        """Joint positions at lengths ``s`` (n,), shape (n, 2)."""
+        return np.asarray(np.asarray(self.q0, float) + np.asarray(s, float)[:, None]
+                          * self.direction)
+
+
+def sample_joint_trajectory(robot: FiveBar, line: JointLine, law: Law, *, assembly: str = "up",
+                            times: Array | None = None, samples: int = 1001,
+                            tolerances: Tolerances = DEFAULT_TOLERANCES,
+                            units: Units | None = None) -> Trajectory:
+    """Sample ``law`` along a joint-space line (a joint move: it may cross serial
+    singularities, which is how the working mode changes; it must not come near or cross a
+    parallel one, nor change assembly mode).
+
+    Raises
+    ------
+    SingularityError
+        The line meets a parallel singularity; names the time and the joint angles.
+    """
+    from .geometry import parse_assembly_mode
+    from .kinematics import direct_kinematics, task_acceleration, working_mode
+
+    if not np.isclose(law.distance, line.length, rtol=1e-9, atol=0.0):
+        raise ParameterError(f"the law covers {law.distance:.9g} but the joint line is "
+                             f"{line.length:.9g} rad long")
+    t = law.times(samples) if times is None else np.asarray(times, dtype=float)
+    s, ds, dds, _ = law.evaluate(t)
+    u = line.direction
+    q = line.at(s)
+    dq, ddq = ds[:, None] * u, dds[:, None] * u
+    words = _Words(units)
+    sigma = parse_assembly_mode(assembly)
+    from .errors import AssemblyError, SingularityError
+
+    def where(i: int) -> str:
+        return (f"at {words.time(t[i])} (sample {i}), q = ({np.degrees(q[i, 0]):.6g}, "
+                f"{np.degrees(q[i, 1]):.6g}) deg")
+
+    from .kinematics import elbows
+
+    B, C = elbows(robot, q)
+    gap = np.linalg.norm(B - C, axis=-1)
+    bad = (gap > robot.L1 + robot.L2) | (gap < abs(robot.L1 - robot.L2))
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise SingularityError(f"{where(i)}: the joint line leaves the robot's assembly (the "
+                               f"distal rods cannot meet: |B - C| = {words.length(gap[i])})")
+    try:
+        P = direct_kinematics(robot, q, sigma)
+    except AssemblyError as exc:
+        raise SingularityError(f"the joint line leaves the assembly: {exc}") from None
+
+    check_poses(robot, q, P, tolerances=tolerances, type1=False, where=where, point=words.point)
+    dP, ddP = task_acceleration(robot, q, P, dq, ddq, tol=0.0)
+    m = working_mode(robot, q[:1], P[:1])[0]  # at the start (the move may change it)
+    mode = working_mode_name((int(m[0]), int(m[1])))
+    return Trajectory(robot, line, law, mode, assembly_mode_name(sigma), t, s, ds, dds, s, ds,
+                      dds, P, dP, ddP, q, dq, ddq)

@@ -96,3 +96,10 @@ def test_invalid_paths():
         Spline(((0, 0), (0, 0), (1, 1)))
     with pytest.raises(ParameterError, match="outside"):
         Arc(1.0).derivatives(np.array([4.0]))
+
+
+def test_nearly_coincident_spline_waypoints_refused():
+    """A waypoint 1e-12 from the next makes a kink of unbounded curvature (the fuzz found an
+    optimal law taking minutes on it): refused by name."""
+    with pytest.raises(ParameterError, match="waypoints 1 and 2 coincide"):
+        Spline(((0.0, 1.0), (0.5, 1.2), (0.5 + 1e-12, 1.2), (1.0, 1.0)))

@@ -21,8 +21,10 @@ from ..kinematics.checker import Tolerances
 from ..laws import Law, LawRequest, MotorLimits, law_type
 from ..params import read_params
 from ..paths import Path
+from ..program import Move
 from ..trajectory import Trajectory, check_path, sample_trajectory
 from ..units import Units
+from .program import ProgramTable, read_moves
 from .tables import (
     TABLES,
     ControlTable,
@@ -49,6 +51,7 @@ class Scenario:
 
     tables: Mapping[str, Table]
     source: str = "defaults (the paper's example)"
+    moves: tuple[Move, ...] = ()
 
     def table(self, name: str) -> Any:
         """The parsed table ``[name]``."""
@@ -196,9 +199,11 @@ class Scenario:
 def scenario_from_dict(doc: Mapping[str, Any]) -> Scenario:
     """A :class:`Scenario` from a parsed config (tables as in ``examples/paper.toml``); every
     table is validated at this boundary, errors naming ``[table].key``."""
-    check_tables(doc, set(TABLES))
+    check_tables({k: v for k, v in doc.items() if k != "move"}, set(TABLES) | {"move"})
     tables = {name: cls.from_toml(doc.get(name, {})) for name, cls in TABLES.items()}
-    sc = Scenario(tables)
+    program = tables["program"]
+    assert isinstance(program, ProgramTable)
+    sc = Scenario(tables, moves=tuple(read_moves(doc.get("move"), program)))
     try:  # build the run's objects now: a bad value fails here, named by its table
         _ = (sc.units, sc.robot, sc.path, sc.inertia)
     except ConfigError:

@@ -1,6 +1,6 @@
 """Dynamics: inertial parameters, exact inverse and forward dynamics, the paper's model."""
 
-from .along_path import RobotAlongPath, time_optimal_law
+from .along_path import RobotAlongJointLine, RobotAlongPath, time_optimal_law
 from .exact import (
     Model,
     Reactions,
@@ -18,4 +18,4 @@ from .inertia import Inertia, Rod, paper_inertia
 
 __all__ = ["Inertia", "Model", "Reactions", "Rod", "bias_forces", "gravity_torques",
            "inverse_dynamics", "joint_reactions", "kinetic_energy", "mass_matrix",
-           "paper_inertia", "state_dynamics", "TorqueResult", "trajectory_torques", "RobotAlongPath", "time_optimal_law"]
+           "paper_inertia", "state_dynamics", "TorqueResult", "trajectory_torques", "RobotAlongJointLine", "RobotAlongPath", "time_optimal_law"]

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._arrays import Array
+from ..kinematics import direct_kinematics
 from ..kinematics.checker import Tolerances
 from ..laws import Law, UniformLaw
 from ..laws.time_optimal import (
@@ -22,9 +23,9 @@ from ..laws.time_optimal import (
     solve_time_optimal_law,
 )
 from ..paths import Path
-from ..trajectory import sample_trajectory
+from ..trajectory import JointLine, sample_trajectory
 from ..units import Units
-from .exact import Model, gravity_torques, inverse_dynamics, mass_matrix
+from .exact import Model, bias_forces, gravity_torques, inverse_dynamics, mass_matrix
 
 
 @dataclass(frozen=True)
@@ -72,3 +73,35 @@ def time_optimal_law(model: Model, path: Path, *,
     return solve_time_optimal_law(RobotAlongPath(model, path, mode, units),
                                   torque_limit=torque_limit, speed_limit=speed_limit,
                                   motors=motors, grid=grid, tol=tol, units=units)
+
+
+@dataclass(frozen=True)
+class RobotAlongJointLine:
+    """A robot model following a straight line in joint space (a joint move): ``q' = u``
+    constant, ``q'' = 0``; implements :class:`~dextar.laws.time_optimal.PathDynamics`."""
+
+    model: Model
+    line: JointLine
+    units: Units | None = None
+
+    def coefficients(self, segments: int) -> PathCoefficients:
+        """The path dynamics on ``segments + 1`` equally spaced joint-space lengths."""
+        s = np.linspace(0.0, self.line.length, segments + 1)
+        q = self.line.at(s)
+        u = np.broadcast_to(self.line.direction, q.shape).copy()
+        robot, ine = self.model.robot, self.model.inertia
+        quiet = Model(robot, ine.frictionless(), self.model.assembly, tol=0.0)
+        a = np.einsum("nij,nj->ni", mass_matrix(quiet, q), u)
+        b = bias_forces(quiet, q, u)
+        g = gravity_torques(Model(robot, ine, self.model.assembly, tol=0.0), q)
+        P = direct_kinematics(robot, q, self.model.assembly)
+        return PathCoefficients(s, P, a, b, g, u, np.array(ine.coulomb, float),
+                                np.array(ine.viscous, float))
+
+    def ratios(self, law: Law, times: Array, motors: MotorLimits) -> tuple[float, float]:
+        """Largest torque and speed ratios of ``law`` at ``times`` (exact model)."""
+        s, ds, dds, _ = law.evaluate(times)
+        u = self.line.direction
+        q, dq, ddq = self.line.at(s), ds[:, None] * u, dds[:, None] * u
+        model = Model(self.model.robot, self.model.inertia, self.model.assembly, tol=0.0)
+        return motors.ratios(inverse_dynamics(model, q, dq, ddq), dq)

@@ -28,6 +28,7 @@ as the next guess. Failure raises :class:`ConvergenceError`: never a silent wron
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from functools import lru_cache
@@ -79,6 +80,11 @@ def line_solution(G: float, tau: Array) -> Array:
 
 #: ``sigma(tau, k)``: the k-th derivative of the normalised law at normalised times.
 SigmaFn = Callable[[Array, int], Array]
+
+
+#: Wall-clock budget of the continuation on paths of varying curvature (s): a path whose
+#: curvature is so wild that it takes longer gets a ConvergenceError, not a hang.
+TIME_BUDGET_S = 20.0
 
 
 @dataclass(frozen=True)
@@ -277,7 +283,12 @@ def _solve_local(path: Path, S: float, G: float, tol: float
     res: Any = None
     guess = line_solution(G, mesh)
     lam, step, solves = 0.0, 1.0, 0
+    started = time.perf_counter()
     while lam < 1.0:
+        if time.perf_counter() - started > TIME_BUDGET_S:
+            return None, np.inf, 0, solves, (
+                f"collocation with mesh refinement and continuation in curvature (stopped at "
+                f"{lam:.3g} of the curvature after {TIME_BUDGET_S:g} s)")
         target = min(1.0, lam + step)
         trial = solve_bvp(make(target), bc, mesh, guess, tol=tol if target == 1.0 else 1e-5,
                           max_nodes=50_000)

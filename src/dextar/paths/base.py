@@ -122,7 +122,9 @@ class Path(ABC):
 
 @dataclass(frozen=True)
 class Arc(Path):
-    """Circular arc ``r(p) = c + R (cos p, sin p)``, ``p`` the polar angle in radians.
+    """Circular arc about ``center``: polar angle ``p`` from ``p0`` to ``p1`` counter-clockwise,
+    ``r(p) = c + R (cos p, sin p)``; with ``clockwise`` the polar angle is ``-p`` (so ``p`` still
+    increases along the motion).
 
     The paper's semicircle is ``Arc(center=(0, 0), radius=R, p0=0, p1=pi)``.
     """
@@ -131,6 +133,7 @@ class Arc(Path):
     p0: float = 0.0
     p1: float = math.pi
     center: tuple[float, float] = (0.0, 0.0)
+    clockwise: bool = False
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.radius) and self.radius > 0):
@@ -144,17 +147,17 @@ class Arc(Path):
 
     @property
     def constant_curvature(self) -> float:  # type: ignore[override]  # a property, not a field
-        """``1 / radius``."""
-        return 1.0 / self.radius
+        """Signed curvature ``+-1 / radius``."""
+        return (-1.0 if self.clockwise else 1.0) / self.radius
 
     def derivatives(self, p: object) -> tuple[Array, Array, Array, Array]:
-        """``r, r', r'', r'''`` at ``p`` (shape (...,)), each of shape (..., 2)."""
+        """The position and its first three derivatives at ``p``, each of shape (..., 2)."""
         p = self._check_parameter(p)
-        R = self.radius
-        c, s = np.cos(p), np.sin(p)
+        R, sg = self.radius, (-1.0 if self.clockwise else 1.0)
+        c, s = np.cos(sg * p), np.sin(sg * p)
         r = np.stack([self.center[0] + R * c, self.center[1] + R * s], axis=-1)
-        return (r, np.stack([-R * s, R * c], -1), np.stack([-R * c, -R * s], -1),
-                np.stack([R * s, -R * c], -1))
+        return (r, np.stack([-sg * R * s, sg * R * c], -1), np.stack([-R * c, -R * s], -1),
+                np.stack([sg * R * s, -sg * R * c], -1))
 
     @property
     def length(self) -> float:
@@ -229,9 +232,11 @@ class Spline(Path):
         if not np.isfinite(w).all():
             raise ParameterError("spline waypoints must be finite")
         chord = np.linalg.norm(np.diff(w, axis=0), axis=1)
-        if (chord <= 0).any():
-            i = int(np.flatnonzero(chord <= 0)[0])
-            raise ParameterError(f"spline waypoints {i} and {i + 1} coincide")
+        tiny = chord <= 1e-6 * chord.sum()  # a kink of unbounded curvature, not a path
+        if tiny.any():
+            i = int(np.flatnonzero(tiny)[0])
+            raise ParameterError(f"spline waypoints {i} and {i + 1} coincide (they are "
+                                 f"{chord[i]:.3g} apart, under 1e-6 of the path's length)")
 
     @cached_property
     def _knots(self) -> Array:

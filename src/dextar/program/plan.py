@@ -1,0 +1,508 @@
+"""Planning a robot program: a sequence of moves, each with its law, under the motors' limits;
+the setpoints at the servo rate, the cycle time and the motor sizing.
+
+A program starts at rest at ``start`` in a working mode. Its moves:
+
+* ``line`` to a point, ``arc`` through ``via`` to a point (or about a ``center`` in a
+  ``direction``): task-space paths in the current working mode, checked by the geometry
+  checker (reach, both singularity types);
+* ``dwell`` for a time: holding still, gravity still loads the motors;
+* ``joint`` to a point in a (new) working mode, or to joint angles: a straight line in joint
+  space, which may cross serial singularities (how a working mode changes) but not a parallel
+  one.
+
+Each move is rest to rest (corner blends are not planned yet: ``blend > 0`` is refused by the
+config). Its law is ``time-optimal`` (the fastest within the motors) or a fixed-shape law
+(``uniform``, ``min-jerk``, ``trapezoid``, ``optimal``) with a duration in seconds or
+``"fit"``: the shortest duration for which the law stays within the motors (bisection).
+The computation is in SI units (m, kg, s, N m).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .._arrays import Array
+from ..dynamics import Inertia, Model, RobotAlongJointLine, RobotAlongPath, inverse_dynamics
+from ..errors import ConfigError, DextarError, ParameterError
+from ..geometry import FiveBar, canonical_working_mode
+from ..kinematics import direct_kinematics, inverse_kinematics, singularity_distances
+from ..kinematics.checker import DEFAULT_TOLERANCES, Tolerances
+from ..laws import Law, LawRequest, MotorLimits, law_type
+from ..laws.time_optimal import solve_time_optimal_law
+from ..params import to_run_units
+from ..paths import Arc, Line, Path
+from ..trajectory import (
+    JointLine,
+    Trajectory,
+    check_path,
+    sample_joint_trajectory,
+    sample_trajectory,
+)
+from ..units import SI
+
+#: Move types.
+MOVE_TYPES = ("line", "arc", "dwell", "joint")
+
+
+@dataclass(frozen=True)
+class Move:
+    """One move as configured (lengths in mm, angles in degrees, times in s).
+
+    Attributes
+    ----------
+    index : int
+        0-based position in the program.
+    type : str
+        ``line``, ``arc``, ``dwell`` or ``joint``.
+    to : (float, float), optional
+        Target point (mm).
+    via, center : (float, float), optional
+        An arc's intermediate point, or its centre (mm).
+    direction : str
+        ``ccw`` or ``cw`` for an arc given by its centre.
+    time : float
+        A dwell's duration (s).
+    to_deg : (float, float), optional
+        A joint move's target angles (deg).
+    working_mode : str, optional
+        A joint move's target working mode.
+    law : str
+        The move's law.
+    duration : float or "fit", optional
+        A fixed-shape law's duration (s) or ``"fit"``.
+    params : mapping
+        The law's other keys (config units).
+    """
+
+    index: int
+    type: str
+    to: tuple[float, float] | None = None
+    via: tuple[float, float] | None = None
+    center: tuple[float, float] | None = None
+    direction: str = "ccw"
+    time: float = 0.0
+    to_deg: tuple[float, float] | None = None
+    working_mode: str | None = None
+    law: str = "time-optimal"
+    duration: float | str | None = None
+    params: Mapping[str, Any] = field(default_factory=dict)
+
+    @property
+    def name(self) -> str:
+        """``move 2 (arc)``."""
+        return f"move {self.index} ({self.type})"
+
+
+@dataclass(frozen=True)
+class PlannedMove:
+    """A move with its law and where it sits in the cycle.
+
+    Attributes
+    ----------
+    move : Move
+    law : Law, optional
+        None for a dwell.
+    start_s, duration_s : float
+    q0, q1 : ndarray, shape (2,)
+        Joint angles at its start and end.
+    sample : callable
+        ``sample(local times) -> Trajectory``-like arrays ``(P, q, dq, ddq)``.
+    min_type1_distance, min_type2_distance : float
+        Smallest normalised distances to the singularities along the move.
+    """
+
+    move: Move
+    law: Law | None
+    start_s: float
+    duration_s: float
+    q0: Array
+    q1: Array
+    sample: Callable[[Array], tuple[Array, Array, Array, Array]]
+    min_type1_distance: float
+    min_type2_distance: float
+
+
+@dataclass(frozen=True)
+class ProgramResult:
+    """A planned program: the moves, the setpoints at the servo rate and the motor sizing.
+
+    Attributes
+    ----------
+    moves : list of PlannedMove
+    cycle_time_s : float
+    t : ndarray, shape (n,)
+        Setpoint times (s), ``1 / servo_rate_hz`` apart, from 0 to the first tick at or after
+        the cycle time (the robot holds its final pose after the cycle).
+    move_index : ndarray of int, shape (n,)
+    P : ndarray, shape (n, 2)
+        End-effector (m).
+    q, dq, ddq : ndarray, shape (n, 2)
+        Joint angles (rad), rates (rad/s), accelerations (rad/s^2).
+    tau : ndarray, shape (n, 2)
+        Feedforward torques of the exact model (N m).
+    motors : MotorLimits, optional
+    rms_limit : (float, float), optional
+        The motors' continuous ratings (N m).
+    """
+
+    moves: list[PlannedMove]
+    cycle_time_s: float
+    t: Array
+    move_index: Array
+    P: Array
+    q: Array
+    dq: Array
+    ddq: Array
+    tau: Array
+    motors: MotorLimits | None
+    rms_limit: tuple[float, float] | None = None
+
+
+def plan_program(robot: FiveBar, inertia: Inertia, moves: Sequence[Move], *,
+                 start: tuple[float, float], working_mode: str, assembly: str = "up",
+                 motors: MotorLimits | None = None,
+                 rms_limit: tuple[float, float] | None = None, servo_rate_hz: float = 1000.0,
+                 grid: int = 400, tolerances: Tolerances = DEFAULT_TOLERANCES) -> ProgramResult:
+    """Plan the moves from rest at ``start`` (mm) in ``working_mode``.
+
+    Parameters
+    ----------
+    robot : FiveBar
+        The geometry in metres (SI).
+    inertia : Inertia
+        Masses, friction and gravity in SI.
+    moves : sequence of Move
+    start : (float, float)
+        The start point (mm).
+    working_mode, assembly : str
+    motors : MotorLimits, optional
+        Joint-side limits in SI; required by the time-optimal law and by ``"fit"``.
+    rms_limit : (float, float), optional
+        Continuous ratings (N m) for the sizing.
+    servo_rate_hz : float
+        Setpoint rate.
+    grid : int
+        Time-optimal grid (segments per move).
+    tolerances : Tolerances
+
+    Returns
+    -------
+    ProgramResult
+
+    Raises
+    ------
+    ConfigError
+        A move that cannot be planned, naming the move and the cause.
+    """
+    if not moves:
+        raise ConfigError("the program has no move: add [[move]] tables")
+    if not (math.isfinite(servo_rate_hz) and servo_rate_hz > 0):
+        raise ParameterError(f"servo rate {servo_rate_hz!r} must be positive")
+    mode = canonical_working_mode(working_mode)
+    P0 = np.array([SI.length(start[0]), SI.length(start[1])])
+    try:
+        q0 = inverse_kinematics(robot, P0, mode)
+    except DextarError as exc:
+        raise ConfigError(f"[program].start: {exc}") from None
+    planned: list[PlannedMove] = []
+    t0 = 0.0
+    for mv in moves:
+        try:
+            pm, P0, q0, mode = _plan_move(robot, inertia, mv, P0, q0, mode, assembly, motors,
+                                          grid, tolerances, t0)
+        except ConfigError as exc:
+            raise ConfigError(f"{mv.name}: {exc}") from None
+        except DextarError as exc:
+            raise ConfigError(f"{mv.name}: {exc}") from None
+        planned.append(pm)
+        t0 += pm.duration_s
+    return _setpoints(robot, inertia, assembly, planned, t0, motors, rms_limit, servo_rate_hz)
+
+
+def _target(mv: Move) -> Array:
+    if mv.to is None:
+        raise ConfigError(f"key 'to' is required for a {mv.type} move")
+    return np.array([SI.length(mv.to[0]), SI.length(mv.to[1])])
+
+
+def _arc(mv: Move, P0: Array) -> Path:
+    """The arc of a move from ``P0``: through ``via`` to ``to``, or about ``center``."""
+    P1 = _target(mv)
+    if mv.via is not None:
+        V = np.array([SI.length(mv.via[0]), SI.length(mv.via[1])])
+        a, b = V - P0, P1 - P0
+        den = 2.0 * (a[0] * b[1] - a[1] * b[0])
+        scale = max(float(np.linalg.norm(a)), float(np.linalg.norm(b)), 1e-300)
+        if abs(den) <= 1e-9 * scale**2:
+            raise ConfigError("the start, 'via' and 'to' points are collinear: no circle passes "
+                              "through them")
+        cx = (b[1] * (a @ a) - a[1] * (b @ b)) / den
+        cy = (a[0] * (b @ b) - b[0] * (a @ a)) / den
+        C = P0 + np.array([cx, cy])
+        cw = den < 0  # the via point is on the clockwise side
+    elif mv.center is not None:
+        C = np.array([SI.length(mv.center[0]), SI.length(mv.center[1])])
+        cw = mv.direction == "cw"
+        r0, r1 = np.linalg.norm(P0 - C), np.linalg.norm(P1 - C)
+        if abs(r0 - r1) > 1e-6 * max(r0, r1):
+            raise ConfigError(f"'to' is {r1 * 1e3:.6g} mm from the centre but the start is "
+                              f"{r0 * 1e3:.6g} mm from it: not on one circle")
+    else:
+        raise ConfigError("an arc needs 'via' or 'center'")
+    R = float(np.linalg.norm(P0 - C))
+    a0 = math.atan2(P0[1] - C[1], P0[0] - C[0])
+    a1 = math.atan2(P1[1] - C[1], P1[0] - C[0])
+    if cw:
+        a0, a1 = -a0, -a1
+    sweep = (a1 - a0) % (2 * math.pi)
+    if sweep <= 1e-12:
+        sweep = 2 * math.pi
+    return Arc(R, a0, a0 + sweep, center=(float(C[0]), float(C[1])), clockwise=cw)
+
+
+def _law(mv: Move, length: float, dynamics: Any, motors: MotorLimits | None,
+         grid: int, sample: Callable[[Law], tuple[Array, Array]], mass: float,
+         path: Path | None) -> Law:
+    """The move's law: time-optimal, a fixed-shape law with its duration, or ``"fit"``."""
+    if mv.law == "time-optimal":
+        if motors is None:
+            raise ConfigError("the time-optimal law needs a [motors] table")
+        return solve_time_optimal_law(dynamics, motors=motors, grid=grid, units=SI)
+    kind = law_type(mv.law)
+    if kind.needs_dynamics:
+        raise ConfigError(f"law {mv.law!r} is not available in a program")
+    params = dict(mv.params)
+
+    def build(duration: float) -> Law:
+        values = {k: v for k, v in params.items() if v is not None}
+        if "duration" in kind.params and not (kind.name == "trapezoid" and mv.duration is None):
+            values["duration"] = duration
+        run = to_run_units(values, kind.params, SI)
+        req = LawRequest(path if path is not None else _Length(length), run, mass, None, SI)
+        return kind.build(req)
+
+    if mv.duration != "fit":
+        if isinstance(mv.duration, (int, float)):
+            return build(float(mv.duration))
+        return build(float(params.get("duration") or 1.0))
+    if motors is None:
+        raise ConfigError("duration = \"fit\" needs a [motors] table")
+    if "duration" not in kind.params:
+        raise ConfigError(f"law {mv.law!r} has no duration to fit")
+
+    def ratio(T: float) -> float:
+        tau, dq = sample(build(T))
+        tr, sp = motors.ratios(tau, dq)
+        return max(tr, sp)
+
+    hi = 0.05
+    while ratio(hi) > 1.0:
+        hi *= 2.0
+        if hi > 1e4:
+            raise ConfigError("no duration up to 10^4 s keeps the law within the motors")
+    lo = hi / 2.0
+    if ratio(lo) <= 1.0:  # even the first try fits: come down
+        while lo > 1e-4 and ratio(lo) <= 1.0:
+            hi, lo = lo, lo / 2.0
+    for _ in range(40):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if ratio(mid) > 1.0 else (lo, mid)
+        if hi - lo <= 1e-6 * hi:
+            break
+    return build(hi)
+
+
+@dataclass(frozen=True)
+class _Length(Path):
+    """A stand-in path of a given length (joint moves: laws only need the length)."""
+
+    total: float
+    p0: float = 0.0
+    p1: float = 1.0
+    constant_curvature: float = 0.0
+
+    def derivatives(self, p: object) -> tuple[Array, Array, Array, Array]:
+        """A straight segment of the length."""
+        p = self._check_parameter(p)
+        z = np.zeros(np.shape(p) + (2,))
+        r = z.copy()
+        r[..., 0] = p * self.total
+        d = z.copy()
+        d[..., 0] = self.total
+        return r, d, z, z.copy()
+
+    @property
+    def length(self) -> float:
+        """The length."""
+        return self.total
+
+
+def _plan_move(robot: FiveBar, inertia: Inertia, mv: Move, P0: Array, q0: Array, mode: str,
+               assembly: str, motors: MotorLimits | None, grid: int, tol: Tolerances,
+               start_s: float) -> tuple[PlannedMove, Array, Array, str]:
+    model = Model(robot, inertia, assembly, tol=tol.type2)
+    mass = inertia.point_mass
+    if mv.type == "dwell":
+        if not mv.time > 0:
+            raise ConfigError(f"'time' must be positive, got {mv.time!r}")
+        qq = q0.copy()
+
+        def hold(t: Array) -> tuple[Array, Array, Array, Array]:
+            n = len(t)
+            return (np.tile(P0, (n, 1)), np.tile(qq, (n, 1)), np.zeros((n, 2)),
+                    np.zeros((n, 2)))
+
+        if motors is not None:  # holding still against gravity must be within the motors
+            from ..dynamics import gravity_torques
+
+            g = gravity_torques(Model(robot, inertia, assembly, tol=0.0), q0)
+            ratio = np.abs(g) / np.asarray(motors.peak_torque)
+            if ratio.max() > 1.0:
+                i = int(np.argmax(ratio))
+                raise ConfigError(f"the motor at {'AD'[i]} needs {abs(g[i]):.4g} N m to hold "
+                                  f"the robot still at {SI.point_text(P0)}, above its peak "
+                                  f"torque {motors.peak_torque[i]:.4g} N m")
+        d1, d2 = singularity_distances(robot, q0, P0)
+        return (PlannedMove(mv, None, start_s, float(mv.time), q0, q0, hold, float(d1),
+                            float(d2)), P0, q0, mode)
+    if mv.type in ("line", "arc"):
+        path: Path = Line(tuple(P0), tuple(_target(mv))) if mv.type == "line" else _arc(mv, P0)
+        check_path(robot, path, mode=mode, tolerances=tol, units=SI)
+
+        def traj(law: Law, times: Array | None = None) -> Trajectory:
+            return sample_trajectory(robot, path, law, mode=mode, times=times,
+                                     samples=401, tolerances=tol, units=SI)
+
+        def sample_law(law: Law) -> tuple[Array, Array]:
+            tr = traj(law)
+            return inverse_dynamics(model, tr.q, tr.dq, tr.ddq), tr.dq
+
+        law = _law(mv, path.length, RobotAlongPath(model, path, mode, SI), motors, grid,
+                   sample_law, mass, path)
+        tr = traj(law)
+        d1, d2 = singularity_distances(robot, tr.q, tr.P)
+
+        def sample(t: Array) -> tuple[Array, Array, Array, Array]:
+            s = traj(law, np.clip(t, 0.0, law.duration))
+            return s.P, s.q, s.dq, s.ddq
+
+        # keep the angles continuous with the previous move (unwrap by whole turns)
+        shift = np.round((q0 - tr.q[0]) / (2 * np.pi)) * 2 * np.pi
+
+        def shifted(t: Array) -> tuple[Array, Array, Array, Array]:
+            P, q, dq, ddq = sample(t)
+            return P, q + shift, dq, ddq
+
+        P1 = tr.P[-1]
+        return (PlannedMove(mv, law, start_s, law.duration, q0, tr.q[-1] + shift, shifted,
+                            float(d1.min()), float(d2.min())), P1, tr.q[-1] + shift, mode)
+    if mv.type == "joint":
+        new_mode = canonical_working_mode(mv.working_mode or mode)
+        if mv.to_deg is not None:
+            q1 = np.radians(np.asarray(mv.to_deg, float))
+        else:
+            q1 = inverse_kinematics(robot, _target(mv), new_mode)
+            q1 = q1 + np.round((q0 - q1) / (2 * np.pi)) * 2 * np.pi  # the nearest turn
+        line = JointLine((float(q0[0]), float(q0[1])), (float(q1[0]), float(q1[1])))
+
+        def jtraj(law: Law, times: Array | None = None) -> Trajectory:
+            return sample_joint_trajectory(robot, line, law, assembly=assembly, times=times,
+                                           samples=401, tolerances=tol, units=SI)
+
+        def jsample_law(law: Law) -> tuple[Array, Array]:
+            tr = jtraj(law)
+            return inverse_dynamics(model, tr.q, tr.dq, tr.ddq), tr.dq
+
+        law = _law(mv, line.length, RobotAlongJointLine(model, line, SI), motors, grid,
+                   jsample_law, mass, None)
+        tr = jtraj(law)
+        d1, d2 = singularity_distances(robot, tr.q, tr.P)
+        P1 = direct_kinematics(robot, q1, assembly)
+
+        def jsample(t: Array) -> tuple[Array, Array, Array, Array]:
+            s = jtraj(law, np.clip(t, 0.0, law.duration))
+            return s.P, s.q, s.dq, s.ddq
+
+        m1 = _mode_at(robot, q1, P1, new_mode)
+        return (PlannedMove(mv, law, start_s, law.duration, q0, q1, jsample, float(d1.min()),
+                            float(d2.min())), P1, q1, m1)
+    raise ConfigError(f"unknown move type {mv.type!r}; known: {', '.join(MOVE_TYPES)}")
+
+
+def _mode_at(robot: FiveBar, q: Array, P: Array, fallback: str) -> str:
+    from ..kinematics import working_mode
+
+    m = working_mode(robot, q, P)
+    if 0 in m:
+        return fallback
+    return ("+" if m[0] > 0 else "-") + ("+" if m[1] > 0 else "-")
+
+
+def _setpoints(robot: FiveBar, inertia: Inertia, assembly: str, planned: list[PlannedMove],
+               cycle: float, motors: MotorLimits | None, rms_limit: tuple[float, float] | None,
+               rate: float) -> ProgramResult:
+    n = int(math.ceil(cycle * rate - 1e-9)) + 1
+    t = np.arange(n) / rate
+    starts = np.array([pm.start_s for pm in planned])
+    idx = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(planned) - 1)
+    P, q, dq, ddq = (np.empty((n, 2)) for _ in range(4))
+    for k, pm in enumerate(planned):
+        sel = np.flatnonzero(idx == k)
+        if sel.size:
+            P[sel], q[sel], dq[sel], ddq[sel] = pm.sample(t[sel] - pm.start_s)
+    past = t > cycle  # after the cycle: hold the final pose
+    if past.any():
+        dq[past] = 0.0
+        ddq[past] = 0.0
+    model = Model(robot, inertia, assembly, tol=0.0)
+    tau = inverse_dynamics(model, q, dq, ddq)
+    return ProgramResult(planned, cycle, t, idx, P, q, dq, ddq, tau, motors, rms_limit)
+
+
+def sizing(res: ProgramResult) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
+    """Per motor: peak and RMS torque, peak speed, peak power, energy (with their ratios to
+    the limits), and the violations (each: motor, quantity, value, limit, move, time)."""
+    t, tau, dq = res.t, res.tau, res.dq
+    power = tau * dq
+    dt = np.diff(t)
+    motors_out, violations = [], []
+    for i, name in enumerate(("A", "D")):
+        pos = np.maximum(power[:, i], 0.0)
+        energy = float(np.sum(0.5 * (pos[1:] + pos[:-1]) * dt))
+        peak_tau = float(np.abs(tau[:, i]).max())
+        rms = float(math.sqrt(np.sum(0.5 * (tau[1:, i] ** 2 + tau[:-1, i] ** 2) * dt)
+                              / max(t[-1], 1e-300)))
+        entry: dict[str, Any] = {
+            "motor": name, "peak_torque_Nm": peak_tau, "rms_torque_Nm": rms,
+            "peak_speed_rad_s": float(np.abs(dq[:, i]).max()),
+            "peak_power_W": float(np.abs(power[:, i]).max()), "energy_J": energy}
+        if res.motors is not None:
+            m = res.motors
+            avail = m.available_torque(dq)[:, i]
+            ratio = np.abs(tau[:, i]) / np.maximum(avail, 1e-300)
+            entry["peak_torque_ratio"] = float(ratio.max())
+            entry["peak_speed_ratio"] = float(np.abs(dq[:, i]).max() / m.max_speed[i])
+            k = int(np.argmax(ratio))
+            if ratio[k] > 1.0 + 1e-3:
+                violations.append({"motor": name, "quantity": "torque", "value": float(
+                    abs(tau[k, i])), "limit": float(avail[k]), "move": int(res.move_index[k]),
+                    "t_s": float(t[k])})
+            k = int(np.argmax(np.abs(dq[:, i])))
+            if abs(dq[k, i]) > m.max_speed[i] * (1 + 1e-3):
+                violations.append({"motor": name, "quantity": "speed", "value": float(
+                    abs(dq[k, i])), "limit": float(m.max_speed[i]),
+                    "move": int(res.move_index[k]), "t_s": float(t[k])})
+        if res.rms_limit is not None:
+            entry["rms_torque_ratio"] = rms / res.rms_limit[i]
+            if rms > res.rms_limit[i] * (1 + 1e-3):
+                violations.append({"motor": name, "quantity": "rms_torque", "value": rms,
+                                   "limit": float(res.rms_limit[i]), "move": None,
+                                   "t_s": None})
+        motors_out.append(entry)
+    return motors_out, violations

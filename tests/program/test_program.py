@@ -1,0 +1,174 @@
+"""Robot programs: the examples plan within the motors, the setpoints are consistent (finite
+differences, sizing, a PD loop on our forward dynamics tracks them), mode changes cross a
+serial singularity, and bad programs are refused by name."""
+
+import csv
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from dextar.cli import main
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+COLUMNS = ["t_s", "move", "x_mm", "y_mm", "phi_rad", "psi_rad", "dphi_rad_s", "dpsi_rad_s",
+           "ddphi_rad_s2", "ddpsi_rad_s2", "tau1_Nm", "tau2_Nm"]
+
+
+def read(path):
+    with open(path) as fh:
+        rows = list(csv.reader(fh))
+    return rows[0], np.array(rows[1:], float)
+
+
+@pytest.fixture(scope="module")
+def pick_place(tmp_path_factory):
+    out = tmp_path_factory.mktemp("pp") / "out"
+    assert main(["program", str(EXAMPLES / "pick_place.toml"), "--out", str(out),
+                 "--quiet"]) == 0
+    head, data = read(out / "setpoints.csv")
+    return dict(zip(head, data.T, strict=True)), json.loads((out / "summary.json").read_text())
+
+
+def test_setpoints_columns_and_time_grid(pick_place):
+    cols, s = pick_place
+    assert list(cols) == COLUMNS
+    t = cols["t_s"]
+    assert t[0] == 0.0 and np.allclose(np.diff(t), 1e-3) and t[-1] >= s["cycle_time_s"]
+    assert t[-1] - s["cycle_time_s"] < 1e-3
+    assert s["status"] == "fits" and len(s["moves"]) == 8 and s["violations"] == []
+    starts = [m["start_s"] for m in s["moves"]]
+    assert starts == sorted(starts) and s["moves"][0]["start_s"] == 0.0
+    assert sum(m["duration_s"] for m in s["moves"]) == pytest.approx(s["cycle_time_s"])
+
+
+def test_rates_are_the_derivatives_of_the_angles(pick_place):
+    cols, _ = pick_place
+    t = cols["t_s"]
+    for q, dq in (("phi_rad", "dphi_rad_s"), ("psi_rad", "dpsi_rad_s")):
+        fd = np.gradient(cols[q], t)
+        scale = np.abs(cols[dq]).max()
+        # away from the instants where the acceleration jumps (time-optimal knots, move ends)
+        assert np.median(np.abs(fd - cols[dq])) < 1e-3 * scale
+        assert np.quantile(np.abs(fd - cols[dq]), 0.99) < 2e-2 * scale
+
+
+def test_sizing_recomputed_from_the_setpoints(pick_place):
+    cols, s = pick_place
+    t = cols["t_s"]
+    for i, m in enumerate(s["motors"]):
+        tau, dq = cols[f"tau{i + 1}_Nm"], cols[("dphi_rad_s", "dpsi_rad_s")[i]]
+        assert m["peak_torque_Nm"] == pytest.approx(np.abs(tau).max())
+        rms = np.sqrt(np.trapezoid(tau**2, t) / t[-1])
+        assert m["rms_torque_Nm"] == pytest.approx(rms, rel=1e-9)
+        assert m["peak_speed_rad_s"] == pytest.approx(np.abs(dq).max())
+        assert m["energy_J"] == pytest.approx(np.trapezoid(np.maximum(tau * dq, 0), t), rel=1e-9)
+        assert m["peak_torque_ratio"] <= 1 + 1e-3 and m["peak_speed_ratio"] <= 1 + 1e-3
+
+
+def test_dwell_holds_still_against_gravity(pick_place):
+    cols, s = pick_place
+    dwell = s["moves"][1]
+    sel = (cols["t_s"] > dwell["start_s"] + 1e-3) & (cols["t_s"] < dwell["start_s"]
+                                                    + dwell["duration_s"] - 1e-3)
+    assert sel.sum() > 150
+    assert np.abs(cols["dphi_rad_s"][sel]).max() == 0.0
+    assert np.ptp(cols["tau1_Nm"][sel]) < 1e-12 and abs(cols["tau1_Nm"][sel][0]) > 1e-3
+
+
+def test_pd_loop_on_our_forward_dynamics_tracks_the_setpoints(tmp_path):
+    from dextar.config import load_scenario
+    from dextar.config.tables import FrictionTable, GravityTable, InertiaTable
+    from dextar.dynamics import Model
+    from dextar.dynamics.forward import forward_dynamics
+    from dextar.units import SI
+
+    out = tmp_path / "mc"
+    cfg = EXAMPLES / "mode_change.toml"
+    assert main(["program", str(cfg), "--out", str(out), "--quiet"]) == 0
+    head, data = read(out / "setpoints.csv")
+    c = dict(zip(head, data.T, strict=True))
+    sc = load_scenario(str(cfg))
+    ine = sc._get(InertiaTable).build(SI, sc.robot_mm, sc._get(FrictionTable),
+                                      sc._get(GravityTable))
+    model = Model(sc.robot_mm.scaled(1e-3), ine, "up", tol=0.0)
+    t = c["t_s"]
+    q_sp = np.stack([c["phi_rad"], c["psi_rad"]], -1)
+    dq_sp = np.stack([c["dphi_rad_s"], c["dpsi_rad_s"]], -1)
+    tau_sp = np.stack([c["tau1_Nm"], c["tau2_Nm"]], -1)
+    kp, kd = 2000.0, 60.0  # N m/rad, N m s/rad: a stiff position loop
+
+    def torque(time, q, dq):
+        # the drive interpolates between the 1 kHz setpoints (feedforward and references)
+        k = min(int(time * 1000.0), len(t) - 2)
+        f = (time - t[k]) / (t[k + 1] - t[k])
+        qs, dqs = q_sp[k] + f * (q_sp[k + 1] - q_sp[k]), dq_sp[k] + f * (dq_sp[k + 1] - dq_sp[k])
+        ff = tau_sp[k] + f * (tau_sp[k + 1] - tau_sp[k])
+        return ff + kp * (qs - q) + kd * (dqs - dq)
+
+    res = forward_dynamics(model, torque, q_sp[0], dq_sp[0], t, rtol=1e-8, atol=1e-10,
+                           max_step=1e-3)
+    assert res.success
+    assert np.abs(res.q - q_sp).max() < 1e-3
+
+
+def test_mode_change_crosses_a_serial_singularity_smoothly(tmp_path):
+    out = tmp_path / "mc"
+    assert main(["program", str(EXAMPLES / "mode_change.toml"), "--out", str(out),
+                 "--quiet"]) == 0
+    s = json.loads((out / "summary.json").read_text())
+    joint = s["moves"][1]
+    assert joint["type"] == "joint" and joint["min_type1_distance"] < 0.02
+    assert joint["min_type2_distance"] > 0.1
+    _, data = read(out / "setpoints.csv")
+    assert np.isfinite(data).all() and np.abs(np.diff(data[:, 4:6], axis=0)).max() < 0.05
+
+
+PROGRAM = ('[motors]\npeak_torque = 0.5\nmax_speed_rpm = 120\n[gravity]\nvector = [0.0, -9810.0]\n'
+           '[inertia]\neffector_mass = 0.08\nproximal_mass = 0.03\ndistal_mass = 0.02\n'
+           '[program]\nstart = [0.0, 100.0]\n')
+
+
+@pytest.mark.parametrize("moves, words", [
+    ('[[move]]\ntype = "line"\nto = [0.0, 300.0]\n', "move 0 (line): the path leaves the "
+     "workspace"),
+    ('[[move]]\ntype = "arc"\nvia = [10.0, 100.0]\nto = [20.0, 100.0]\n',
+     "move 0 (arc): the start, 'via' and 'to' points are collinear"),
+    ('[[move]]\ntype = "jump"\n', "[[move]] 0 (jump).type must be one of line, arc, dwell, "
+     "joint"),
+    ('', "the program has no move"),
+    ('[[move]]\ntype = "line"\nto = [10.0, 110.0]\nblend = 5.0\n', "corner blends are not "
+     "planned yet"),
+    ('[[move]]\ntype = "joint"\nto_deg = [0.0, 180.0]\nlaw = "min-jerk"\n',
+     "move 0 (joint): at t = "),
+])
+def test_bad_programs_named(tmp_path, capsys, moves, words):
+    cfg = tmp_path / "p.toml"
+    cfg.write_text(PROGRAM + moves)
+    code = main(["program", str(cfg), "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert code == 2 and words in err and err.count("\n") == 1, err
+    assert not (tmp_path / "o" / "setpoints.csv").exists()
+
+
+def test_dwell_beyond_the_motors_is_refused(tmp_path, capsys):
+    cfg = tmp_path / "p.toml"
+    cfg.write_text(PROGRAM.replace("peak_torque = 0.5", "peak_torque = 0.01")
+                   + '[[move]]\ntype = "dwell"\ntime = 0.5\n')
+    assert main(["program", str(cfg), "--out", str(tmp_path / "o")]) == 2
+    assert "move 0 (dwell): the motor at" in capsys.readouterr().err
+
+
+def test_a_program_that_exceeds_the_motors_exits_1_with_its_files(tmp_path, capsys):
+    cfg = tmp_path / "p.toml"
+    cfg.write_text(PROGRAM + '[[move]]\ntype = "line"\nto = [30.0, 120.0]\nlaw = "min-jerk"\n'
+                   'duration = 0.01\n')
+    out = tmp_path / "o"
+    assert main(["program", str(cfg), "--out", str(out), "--json"]) == 1
+    io = capsys.readouterr()
+    s = json.loads(io.out)
+    assert s["status"] == "exceeds" and s["violations"][0]["move"] == 0
+    assert {"motor", "quantity", "value", "limit", "move", "t_s"} <= set(s["violations"][0])
+    assert "above its limit" in io.err
+    assert (out / "setpoints.csv").exists() and (out / "summary.json").exists()
