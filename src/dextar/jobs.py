@@ -302,7 +302,7 @@ def run(config: str | None, out: str, *, force: bool = False,
     return JobResult(s, "\n".join(lines), warnings)
 
 
-def program(config: str, out: str, *, force: bool = False) -> JobResult:
+def program(config: str, out: str, *, force: bool = False, figures: bool = True) -> JobResult:
     """Plan a robot program (``[program]``, ``[[move]]``, ``[motors]``) and write its
     setpoints and sizing to ``out``; exit code 1 when it exceeds a motor limit."""
     from .config.program import ProgramTable
@@ -348,6 +348,24 @@ def program(config: str, out: str, *, force: bool = False) -> JobResult:
         "units": "SI: s, rad, N m, W, J; positions in mm in setpoints.csv"}
     with OutputDir(out, force=force) as od:
         od.write_text("setpoints.csv", csv_text(cols))
+        if figures:
+            from .output.figures import png_bytes, svg_bytes
+            from .output.program_figures import (
+                motion_figure,
+                moves_figure,
+                operating_points_figure,
+                program_report,
+            )
+
+            pngs: dict[str, bytes] = {}
+            for name, fig in (("moves", moves_figure(res, sc.robot_mm,
+                                                     prog.working_mode or sc.mode)),
+                              ("motion", motion_figure(res)),
+                              ("operating_points", operating_points_figure(res, motors))):
+                pngs[name] = png_bytes(fig)
+                od.write_bytes(f"{name}.png", pngs[name])
+                od.write_bytes(f"{name}.svg", svg_bytes(fig))
+            od.write_text("report.html", program_report(summary, pngs))
         od.write_text("summary.json", json.dumps(summary, indent=2, allow_nan=False) + "\n")
     lines = [f"program: cycle time {res.cycle_time_s:.6g} s, {len(res.moves)} moves; "
              f"{summary['status']} the motors",

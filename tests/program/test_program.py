@@ -31,6 +31,30 @@ def pick_place(tmp_path_factory):
     return dict(zip(head, data.T, strict=True)), json.loads((out / "summary.json").read_text())
 
 
+def test_figures_and_report_are_written(tmp_path):
+    from html.parser import HTMLParser
+
+    out = tmp_path / "pp"
+    assert main(["program", str(EXAMPLES / "pick_place.toml"), "--out", str(out),
+                 "--quiet"]) == 0
+    for name in ("moves", "motion", "operating_points"):
+        assert (out / f"{name}.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+        assert (out / f"{name}.svg").read_text().rstrip().endswith("</svg>")
+
+    class Imgs(HTMLParser):
+        def __init__(self):
+            super().__init__()
+            self.n = 0
+
+        def handle_starttag(self, tag, attrs):
+            self.n += tag == "img"
+
+    p = Imgs()
+    report = (out / "report.html").read_text()
+    p.feed(report)
+    assert p.n == 3 and "fits the motors" in report and "Motor sizing" in report
+
+
 def test_setpoints_columns_and_time_grid(pick_place):
     cols, s = pick_place
     assert list(cols) == COLUMNS

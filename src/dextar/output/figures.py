@@ -235,7 +235,8 @@ def plot_workspace(
         fig = ax.figure
     r = ws.robot
     dex = np.ma.masked_where(~ws.reachable, ws.dexterity)
-    im = ax.pcolormesh(ws.x, ws.y, dex, shading="auto", cmap="viridis", vmin=0, vmax=1)
+    im = ax.pcolormesh(ws.x, ws.y, dex, shading="auto", cmap="viridis", vmin=0, vmax=1,
+                       rasterized=True)  # a raster inside vector output: small and fast
     fig.colorbar(im, ax=ax, label="dexterity (inverse condition number of J)")
     t2 = np.ma.masked_where(~ws.reachable, ws.type2)
     if np.any(t2 > 0) and np.any(t2 < 0):
