@@ -337,13 +337,17 @@ def program(config: str, out: str, *, force: bool = False, figures: bool = True)
     summary: dict[str, Any] = {
         "status": "exceeds" if violations else "fits", "cycle_time_s": res.cycle_time_s,
         "servo_rate_hz": prog.servo_rate_hz, "config": config,
-        "moves": [{"index": pm.move.index, "type": pm.move.type,
+        "moves": [{"index": idx, "type": sc.moves[idx].type,
                    "law": pm.law.name if pm.law else None,
                    "law_status": pm.law.status if pm.law else 0,
                    "law_message": pm.law.message if pm.law else "holding still",
-                   "start_s": pm.start_s, "duration_s": pm.duration_s,
+                   "start_s": start, "duration_s": dur,
+                   "blended_with_next": bool(pm.members) and idx != pm.members[-1][0],
                    "min_type1_distance": pm.min_type1_distance,
-                   "min_type2_distance": pm.min_type2_distance} for pm in res.moves],
+                   "min_type2_distance": pm.min_type2_distance}
+                  for pm in res.moves
+                  for idx, start, dur in (pm.members or ((pm.move.index, pm.start_s,
+                                                          pm.duration_s),))],
         "motors": motors, "violations": violations,
         "units": "SI: s, rad, N m, W, J; positions in mm in setpoints.csv"}
     with OutputDir(out, force=force) as od:
@@ -367,10 +371,12 @@ def program(config: str, out: str, *, force: bool = False, figures: bool = True)
                 od.write_bytes(f"{name}.svg", svg_bytes(fig))
             od.write_text("report.html", program_report(summary, pngs))
         od.write_text("summary.json", json.dumps(summary, indent=2, allow_nan=False) + "\n")
-    lines = [f"program: cycle time {res.cycle_time_s:.6g} s, {len(res.moves)} moves; "
+    lines = [f"program: cycle time {res.cycle_time_s:.6g} s, {len(summary['moves'])} moves; "
              f"{summary['status']} the motors",
-             *(f"  {pm.move.name}: {pm.law.name if pm.law else 'dwell'} {pm.duration_s:.4g} s "
-               f"from {pm.start_s:.4g} s" for pm in res.moves),
+             *(f"  move {m['index']} ({m['type']}): {m['law'] or 'dwell'} {m['duration_s']:.4g} s "
+               f"from {m['start_s']:.4g} s" + (", blended into the next"
+                                               if m["blended_with_next"] else "")
+               for m in summary["moves"]),
              *(f"  motor {m['motor']}: peak {m['peak_torque_Nm']:.4g} N m, RMS "
                f"{m['rms_torque_Nm']:.4g} N m, peak speed {m['peak_speed_rad_s']:.4g} rad/s"
                for m in motors),

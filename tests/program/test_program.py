@@ -162,8 +162,9 @@ PROGRAM = ('[motors]\npeak_torque = 0.5\nmax_speed_rpm = 120\n[gravity]\nvector 
     ('[[move]]\ntype = "jump"\n', "[[move]] 0 (jump).type must be one of line, arc, dwell, "
      "joint"),
     ('', "the program has no move"),
-    ('[[move]]\ntype = "line"\nto = [10.0, 110.0]\nblend = 5.0\n', "corner blends are not "
-     "planned yet"),
+    ('[[move]]\ntype = "line"\nto = [10.0, 110.0]\nblend = 5.0\n[[move]]\ntype = "line"\n'
+     'to = [0.0, 100.0]\n', "move 0 (line) (blended with moves 1-1): blend: the path turns "
+     "back"),
     ('[[move]]\ntype = "joint"\nto_deg = [0.0, 180.0]\nlaw = "min-jerk"\n',
      "move 0 (joint): at t = "),
 ])
@@ -196,3 +197,76 @@ def test_a_program_that_exceeds_the_motors_exits_1_with_its_files(tmp_path, caps
     assert {"motor", "quantity", "value", "limit", "move", "t_s"} <= set(s["violations"][0])
     assert "above its limit" in io.err
     assert (out / "setpoints.csv").exists() and (out / "summary.json").exists()
+
+
+def test_blended_corners_do_not_stop(pick_place):
+    cols, s = pick_place
+    up, over, down = s["moves"][2], s["moves"][3], s["moves"][4]
+    assert up["blended_with_next"] and over["blended_with_next"]
+    assert not down["blended_with_next"]
+    for corner in (over["start_s"], down["start_s"]):  # where the blends hand over
+        k = int(np.argmin(np.abs(cols["t_s"] - corner)))
+        speed = np.hypot(np.gradient(cols["x_mm"], cols["t_s"]), np.gradient(cols["y_mm"],
+                                                                             cols["t_s"]))
+        assert speed[k] > 50.0  # mm/s: moving through the corner
+    # position and velocity continuous across the chain (no jump between setpoints)
+    sel = (cols["t_s"] >= up["start_s"]) & (cols["t_s"] <= down["start_s"] + down["duration_s"])
+    dx = np.diff(cols["x_mm"][sel])
+    dv = np.diff(cols["dphi_rad_s"][sel])
+    amax = np.abs(cols["ddphi_rad_s2"][sel]).max()
+    assert np.abs(dx).max() < 1.0 and np.abs(dv).max() <= 1.01 * amax * 1e-3
+    # the move column follows the pieces of the chain
+    moves = cols["move"][sel]
+    assert set(np.unique(moves)) == {2.0, 3.0, 4.0} and np.all(np.diff(moves) >= 0)
+
+
+def test_a_blend_rounds_the_corner_within_its_radius():
+    from dextar.paths import Arc, Line
+    from dextar.paths.composite import blended
+
+    a, b = Line((-40.0, 110.0), (-40.0, 90.0)), Line((-40.0, 90.0), (0.0, 90.0))
+    path, owner = blended([a, b], [5.0])
+    assert owner == [0, 0, 1]
+    blend = path.pieces[1].position(np.linspace(0, 1, 201))
+    assert np.linalg.norm(blend - np.array([-40.0, 90.0]), axis=1).max() <= 5.0 + 1e-9
+    s = np.linspace(0, path.length, 4001)
+    p = path.parameter_at(s)
+    _, r1, _, _ = path.derivatives(p)
+    tangent = r1 / np.linalg.norm(r1, axis=1)[:, None]
+    kappa = path.curvature(p)[0]
+    assert np.abs(np.diff(tangent, axis=0)).max() < 0.01  # G1
+    for sj in path._starts[1:-1]:  # G2: the curvature has no jump at the joins
+        k_before, k_after = path.curvature(path.parameter_at([sj - 1e-7, sj + 1e-7]))[0]
+        assert abs(k_before - k_after) < 1e-4 * np.abs(kappa).max()
+    np.testing.assert_allclose(path.arc_length(p), s, atol=1e-9)
+    # into an arc too, and a reversal is refused
+    c = Arc(20.0, 0.0, np.pi / 2, center=(-20.0, 90.0))
+    blended([Line((-0.0, 60.0), (0.0, 90.0)), c], [4.0])
+    with pytest.raises(Exception, match="turns back"):
+        blended([a, Line((-40.0, 90.0), (-40.0, 100.0))], [5.0])
+    with pytest.raises(Exception, match="do not fit"):
+        blended([a, b], [25.0])
+
+
+def test_a_chain_takes_the_law_of_its_first_move(tmp_path, capsys):
+    cfg = tmp_path / "p.toml"
+    cfg.write_text(PROGRAM + '[[move]]\ntype = "line"\nto = [20.0, 110.0]\nblend = 3.0\n'
+                   '[[move]]\ntype = "line"\nto = [20.0, 130.0]\nlaw = "min-jerk"\n')
+    assert main(["program", str(cfg), "--out", str(tmp_path / "o")]) == 2
+    assert "blend makes it one motion" in capsys.readouterr().err
+
+
+def test_the_readme_program_plans_within_the_motors(tmp_path):
+    """The README's task file (a tight blended turn, time-optimal under a steep torque-speed
+    envelope) plans, and its setpoints stay within the motors (a missed torque peak between
+    the law's check samples once made it exceed by 16 %)."""
+    import re
+
+    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
+    cfg = tmp_path / "readme.toml"
+    cfg.write_text(re.search(r"```toml\n(\[motors\].*?)```", readme, re.S).group(1))
+    out = tmp_path / "o"
+    assert main(["program", str(cfg), "--out", str(out), "--quiet"]) == 0
+    s = json.loads((out / "summary.json").read_text())
+    assert s["status"] == "fits" and s["moves"][0]["blended_with_next"]
+    assert all(m["peak_torque_ratio"] <= 1 + 1e-3 for m in s["motors"])

@@ -42,7 +42,7 @@ class ProgramTable(Table):
 
     @classmethod
     def from_toml(cls, raw: Mapping[str, object]) -> ProgramTable:
-        """Read ``[program]`` (blends are refused until they are planned)."""
+        """Read ``[program]``."""
         t = cls(**read_params(cls.NAME, raw, cls.PARAMS))
         law_type(t.law)
         if t.working_mode is not None:
@@ -50,9 +50,6 @@ class ProgramTable(Table):
                 canonical_working_mode(t.working_mode)
             except DextarError as exc:
                 raise ConfigError(f"config key [program].working_mode: {exc}") from None
-        if t.blend > 0:
-            raise ConfigError("config key [program].blend: corner blends are not planned yet; "
-                              "use blend = 0 (every move then starts and ends at rest)")
         return t
 
 
@@ -115,9 +112,6 @@ def _read_move(i: int, raw: Mapping[str, Any], program: ProgramTable) -> Move:
             raise ConfigError(f"config key {label}.duration: the {lt.name} law has no duration")
     elif "duration" in lt.params:
         params["duration"] = lt.params["duration"].default
-    if (geo.get("blend") or 0.0) > 0:
-        raise ConfigError(f"config key {label}.blend: corner blends are not planned yet; use "
-                          "blend = 0")
     t = geo["type"]
     need = {"line": ("to",), "arc": ("to",), "dwell": ("time",), "joint": ()}[t]
     for key in need:
@@ -136,4 +130,5 @@ def _read_move(i: int, raw: Mapping[str, Any], program: ProgramTable) -> Move:
     return Move(i, t, to=geo.get("to"), via=geo.get("via"), center=geo.get("center"),
                 direction=geo.get("direction", "ccw"), time=float(geo.get("time") or 0.0),
                 to_deg=geo.get("to_deg"), working_mode=geo.get("working_mode"),
-                law=lt.name, duration=duration, params=params)
+                law=lt.name, duration=duration, params=params,
+                blend=float(geo["blend"]) if geo.get("blend") is not None else program.blend)

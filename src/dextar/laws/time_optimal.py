@@ -29,7 +29,7 @@ at each grid point (a two-variable linear programme solved exactly by Fourier-Mo
 elimination of ``u``, the static rows precomputed for all points at once), then a forward pass
 takes the largest admissible acceleration from rest.
 
-Output check and margin: the law is then sampled densely (both ends and three interior points
+Output check and margin: the law is then sampled densely (both ends and seven interior points
 of every segment) through the exact model with friction; if a torque exceeds its limit by
 more than ``tol`` (default 1e-3) or a speed its limit, the limits are tightened by the excess
 and the problem solved again (a few iterations at most). The law reports ``status`` (0: the
@@ -54,8 +54,8 @@ from .base import Law
 #: Greatest number of solves (friction tangent updates and limit margins).
 MAX_SOLVES = 8
 #: Where the output check samples each segment (fractions of its duration): both ends
-#: (the acceleration jumps at the knots) and three interior points.
-CHECK_FRACTIONS = np.array([1e-9, 0.25, 0.5, 0.75, 1.0 - 1e-9])
+#: (the acceleration jumps at the knots) and seven interior points.
+CHECK_FRACTIONS = np.concatenate([[1e-9], np.linspace(0.125, 0.875, 7), [1.0 - 1e-9]])
 
 
 @dataclass(frozen=True)

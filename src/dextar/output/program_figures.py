@@ -23,13 +23,11 @@ def moves_figure(res: ProgramResult, robot_mm: FiveBar, mode: str) -> Figure:
     ws = workspace_map(robot_mm, mode, resolution=241)
     fig: Figure = plot_workspace(ws, path=res.P * 1e3, unit="mm")
     ax = fig.axes[0]
-    for pm in res.moves:
-        sel = res.move_index == pm.move.index
-        if sel.any():
-            P = res.P[sel] * 1e3
-            x, y = P[len(P) // 2]
-            ax.annotate(str(pm.move.index), (x, y), fontsize=8, color="white",
-                        bbox={"boxstyle": "circle,pad=0.2", "fc": "black", "alpha": 0.7})
+    for index in np.unique(res.move_index):
+        P = res.P[res.move_index == index] * 1e3
+        x, y = P[len(P) // 2]
+        ax.annotate(str(int(index)), (x, y), fontsize=8, color="white",
+                    bbox={"boxstyle": "circle,pad=0.2", "fc": "black", "alpha": 0.7})
     ax.set_title(f"Program: {len(res.moves)} moves, cycle {res.cycle_time_s:.3f} s "
                  f"(working mode at the start: {mode})", fontsize=10)
     return fig
@@ -54,9 +52,10 @@ def motion_figure(res: ProgramResult) -> Figure:
             avail = m.available_torque(res.dq)[:, i]
             axes[2].plot(t, avail, color=style, ls="--", lw=0.8)
             axes[2].plot(t, -avail, color=style, ls="--", lw=0.8)
+    changes = t[1:][np.diff(res.move_index) != 0]  # where the next move starts
     for ax in axes:
-        for pm in res.moves[1:]:
-            ax.axvline(pm.start_s, color="grey", ls=":", lw=0.8)
+        for tc in changes:
+            ax.axvline(tc, color="grey", ls=":", lw=0.8)
         ax.grid(alpha=0.3)
     axes[0].set_ylabel("angle [deg]")
     axes[1].set_ylabel("speed [rad/s]")

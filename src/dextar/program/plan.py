@@ -11,8 +11,10 @@ A program starts at rest at ``start`` in a working mode. Its moves:
   space, which may cross serial singularities (how a working mode changes) but not a parallel
   one.
 
-Each move is rest to rest (corner blends are not planned yet: ``blend > 0`` is refused by the
-config). Its law is ``time-optimal`` (the fastest within the motors) or a fixed-shape law
+Path moves joined by a blend (``blend > 0`` mm) are one motion: each corner is replaced by a
+quintic of continuous curvature that stays within ``blend`` of the corner
+(:mod:`dextar.paths.composite`), and the law of the first move of the chain runs over the
+whole of it, without stopping at the corners. Other moves start and end at rest. A law is ``time-optimal`` (the fastest within the motors) or a fixed-shape law
 (``uniform``, ``min-jerk``, ``trapezoid``, ``optimal``) with a duration in seconds or
 ``"fit"``: the shortest duration for which the law stays within the motors (bisection).
 The computation is in SI units (m, kg, s, N m).
@@ -78,6 +80,8 @@ class Move:
         A fixed-shape law's duration (s) or ``"fit"``.
     params : mapping
         The law's other keys (config units).
+    blend : float
+        Radius (mm) of the blend that rounds the corner to the next move (0: stop there).
     """
 
     index: int
@@ -92,6 +96,7 @@ class Move:
     law: str = "time-optimal"
     duration: float | str | None = None
     params: Mapping[str, Any] = field(default_factory=dict)
+    blend: float = 0.0
 
     @property
     def name(self) -> str:
@@ -115,6 +120,10 @@ class PlannedMove:
         ``sample(local times) -> Trajectory``-like arrays ``(P, q, dq, ddq)``.
     min_type1_distance, min_type2_distance : float
         Smallest normalised distances to the singularities along the move.
+    owner : callable, optional
+        For a blended chain of moves (one motion): the move index at each local time.
+    members : tuple of (index, start_s, duration_s)
+        For a blended chain: where each of its moves sits in the cycle.
     """
 
     move: Move
@@ -126,6 +135,8 @@ class PlannedMove:
     sample: Callable[[Array], tuple[Array, Array, Array, Array]]
     min_type1_distance: float
     min_type2_distance: float
+    owner: Callable[[Array], Array] | None = None
+    members: tuple[tuple[int, float, float], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -212,17 +223,99 @@ def plan_program(robot: FiveBar, inertia: Inertia, moves: Sequence[Move], *,
         raise ConfigError(f"[program].start: {exc}") from None
     planned: list[PlannedMove] = []
     t0 = 0.0
-    for mv in moves:
+    for group in _chains(moves):
+        mv = group[0]
         try:
-            pm, P0, q0, mode = _plan_move(robot, inertia, mv, P0, q0, mode, assembly, motors,
-                                          grid, tolerances, t0)
-        except ConfigError as exc:
-            raise ConfigError(f"{mv.name}: {exc}") from None
+            if len(group) == 1:
+                pm, P0, q0, mode = _plan_move(robot, inertia, mv, P0, q0, mode, assembly,
+                                              motors, grid, tolerances, t0)
+            else:
+                pm, P0, q0 = _plan_chain(robot, inertia, group, P0, q0, mode, assembly,
+                                         motors, grid, tolerances, t0)
         except DextarError as exc:
-            raise ConfigError(f"{mv.name}: {exc}") from None
+            names = mv.name if len(group) == 1 else (f"{mv.name} (blended with moves "
+                                                      f"{group[1].index}-{group[-1].index})")
+            raise ConfigError(f"{names}: {exc}") from None
         planned.append(pm)
         t0 += pm.duration_s
     return _setpoints(robot, inertia, assembly, planned, t0, motors, rms_limit, servo_rate_hz)
+
+
+def _chains(moves: Sequence[Move]) -> list[list[Move]]:
+    """Runs of path moves joined by blends (one motion each); every other move alone."""
+    groups: list[list[Move]] = []
+    for mv in moves:
+        prev = groups[-1][-1] if groups else None
+        if (prev is not None and prev.blend > 0 and prev.type in ("line", "arc")
+                and mv.type in ("line", "arc")):
+            groups[-1].append(mv)
+        else:
+            groups.append([mv])
+    return groups
+
+
+def _plan_chain(robot: FiveBar, inertia: Inertia, group: list[Move], P0: Array, q0: Array,
+                mode: str, assembly: str, motors: MotorLimits | None, grid: int,
+                tol: Tolerances, start_s: float) -> tuple[PlannedMove, Array, Array]:
+    """Moves joined by blends: one path with G2 corners, one law, no stop at the corners."""
+    from ..paths.composite import blended
+
+    first = group[0]
+    for mv in group[1:]:
+        if mv.law != first.law or (mv.duration is not None and mv.duration != first.duration):
+            raise ConfigError(f"{mv.name} sets law {mv.law!r} (duration {mv.duration!r}) but a "
+                              f"blend makes it one motion with {first.name}, whose law "
+                              f"{first.law!r} (duration {first.duration!r}) it takes: set them "
+                              "in the first move of the chain only")
+    pieces: list[Path] = []
+    P = P0
+    for mv in group:
+        piece: Path = Line(tuple(P), tuple(_target(mv))) if mv.type == "line" else _arc(mv, P)
+        pieces.append(piece)
+        P = _target(mv)
+    try:
+        path, owner = blended(pieces, [SI.length(mv.blend) for mv in group[:-1]])
+    except ParameterError as exc:
+        raise ConfigError(f"blend: {exc}") from None
+    model = Model(robot, inertia, assembly, tol=tol.type2)
+    check_path(robot, path, mode=mode, tolerances=tol, units=SI)
+
+    def traj(law: Law, times: Array | None = None) -> Trajectory:
+        return sample_trajectory(robot, path, law, mode=mode, times=times, samples=801,
+                                 tolerances=tol, units=SI)
+
+    def sample_law(law: Law) -> tuple[Array, Array]:
+        tr = traj(law)
+        return inverse_dynamics(model, tr.q, tr.dq, tr.ddq), tr.dq
+
+    # resolve each blend with at least 40 segments of the time-optimal grid
+    shortest = min(piece.length for piece in path.pieces)
+    fine = min(max(grid, int(math.ceil(40 * path.length / shortest))), 8000)
+    law = _law(first, path.length, RobotAlongPath(model, path, mode, SI), motors, fine,
+               sample_law, inertia.point_mass, path)
+    tr = traj(law)
+    d1, d2 = singularity_distances(robot, tr.q, tr.P)
+    shift = np.round((q0 - tr.q[0]) / (2 * np.pi)) * 2 * np.pi
+    owners = np.array([group[o].index for o in owner])
+
+    def sample(t: Array) -> tuple[Array, Array, Array, Array]:
+        st = traj(law, np.clip(t, 0.0, law.duration))
+        return st.P, st.q + shift, st.dq, st.ddq
+
+    def owner_of(t: Array) -> Array:
+        s_ = law.evaluate(np.clip(t, 0.0, law.duration))[0]
+        return np.asarray(owners[path.piece_at(s_)])
+
+    # when each move starts: the time its first piece starts (s(t) increases)
+    tt = np.linspace(0.0, law.duration, 4001)
+    ss = law.evaluate(tt)[0]
+    starts_s = [float(path._starts[owner.index(k)]) for k in range(len(group))]
+    t_at = [float(np.interp(v, ss, tt)) for v in starts_s] + [law.duration]
+    members = tuple((mv.index, start_s + t_at[k], t_at[k + 1] - t_at[k])
+                    for k, mv in enumerate(group))
+    pm = PlannedMove(first, law, start_s, law.duration, q0, tr.q[-1] + shift, sample,
+                     float(d1.min()), float(d2.min()), owner_of, members)
+    return pm, tr.P[-1], tr.q[-1] + shift
 
 
 def _target(mv: Move) -> Array:
@@ -452,17 +545,20 @@ def _setpoints(robot: FiveBar, inertia: Inertia, assembly: str, planned: list[Pl
     starts = np.array([pm.start_s for pm in planned])
     idx = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, len(planned) - 1)
     P, q, dq, ddq = (np.empty((n, 2)) for _ in range(4))
+    move = np.array([pm.move.index for pm in planned])[idx]
     for k, pm in enumerate(planned):
         sel = np.flatnonzero(idx == k)
         if sel.size:
             P[sel], q[sel], dq[sel], ddq[sel] = pm.sample(t[sel] - pm.start_s)
+            if pm.owner is not None:
+                move[sel] = pm.owner(t[sel] - pm.start_s)
     past = t > cycle  # after the cycle: hold the final pose
     if past.any():
         dq[past] = 0.0
         ddq[past] = 0.0
     model = Model(robot, inertia, assembly, tol=0.0)
     tau = inverse_dynamics(model, q, dq, ddq)
-    return ProgramResult(planned, cycle, t, idx, P, q, dq, ddq, tau, motors, rms_limit)
+    return ProgramResult(planned, cycle, t, move, P, q, dq, ddq, tau, motors, rms_limit)
 
 
 def sizing(res: ProgramResult) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:

@@ -1,0 +1,225 @@
+"""Paths made of pieces, and corner blends of continuous curvature.
+
+:class:`Quintic` is a quintic Hermite curve; :func:`blend_corner` builds the one that replaces
+a corner between two pieces: it leaves the incoming piece ``radius`` before the corner and
+joins the outgoing one ``radius`` after it, matching position, tangent and curvature at both
+ends (so the path is G2: the curvature is continuous, and a law along it never stops at the
+corner). :class:`Composite` chains pieces; its parameter runs over ``[0, n]``, piece ``k``
+covering ``[k, k + 1]``, and its arc length is the sum of the pieces' own.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+
+from .._arrays import Array
+from ..errors import ParameterError
+from .base import Arc, Line, Path
+
+# quintic Hermite basis (rows: p0, v0, a0, a1, v1, p1) as power-series coefficients in u
+_H = np.array([
+    [1, 0, 0, -10, 15, -6],
+    [0, 1, 0, -6, 8, -3],
+    [0, 0, 0.5, -1.5, 1.5, -0.5],
+    [0, 0, 0, 0.5, -1, 0.5],
+    [0, 0, 0, -4, 7, -3],
+    [0, 0, 0, 10, -15, 6],
+], dtype=float)
+
+
+@dataclass(frozen=True)
+class Quintic(Path):
+    """The quintic Hermite curve with the given end positions, first and second derivatives
+    (with respect to its parameter ``u`` in [0, 1]), each a point (x, y)."""
+
+    p0_: tuple[float, float]
+    v0: tuple[float, float]
+    a0: tuple[float, float]
+    p1_: tuple[float, float]
+    v1: tuple[float, float]
+    a1: tuple[float, float]
+    p0: float = field(default=0.0, init=False)
+    p1: float = field(default=1.0, init=False)
+
+    @cached_property
+    def _coef(self) -> Array:
+        """Power-series coefficients, shape (6, 2) (constant term first)."""
+        rows = np.array([self.p0_, self.v0, self.a0, self.a1, self.v1, self.p1_], float)
+        return np.asarray(_H.T @ rows)
+
+    def derivatives(self, p: object) -> tuple[Array, Array, Array, Array]:
+        """The position and its first three derivatives at ``p``, each of shape (..., 2)."""
+        u = self._check_parameter(p)
+        c = self._coef
+        out = []
+        for k in range(4):
+            ck = np.polynomial.polynomial.polyder(c, k) if k else c
+            out.append(np.stack([np.polynomial.polynomial.polyval(u, ck[:, j])
+                                 for j in range(2)], axis=-1))
+        return out[0], out[1], out[2], out[3]
+
+
+def _end_state(piece: Path, at_end: bool) -> tuple[Array, Array, float]:
+    """Position, unit tangent and signed curvature at an end of a piece."""
+    p = piece.p1 if at_end else piece.p0
+    r, r1, _, _ = piece.derivatives(np.array([p]))
+    t = r1[0] / np.linalg.norm(r1[0])
+    kappa = float(piece.curvature(np.array([p]))[0][0])
+    return r[0], t, kappa
+
+
+def trim(piece: Path, start: float, end: float) -> Path:
+    """``piece`` without ``start`` of arc length at its start and ``end`` at its end."""
+    if start + end >= piece.length:
+        raise ParameterError(f"blends of {start:.6g} and {end:.6g} do not fit a piece of "
+                             f"length {piece.length:.6g}")
+    if isinstance(piece, Line):
+        a, b = np.asarray(piece.start, float), np.asarray(piece.end, float)
+        u = (b - a) / piece.length
+        return Line(tuple(a + start * u), tuple(b - end * u))
+    if isinstance(piece, Arc):
+        return Arc(piece.radius, piece.p0 + start / piece.radius, piece.p1 - end / piece.radius,
+                   center=piece.center, clockwise=piece.clockwise)
+    raise ParameterError(f"cannot trim a {type(piece).__name__}")
+
+
+def blend_corner(incoming: Path, outgoing: Path, radius: float) -> tuple[Path, Path, Quintic]:
+    """Replace the corner between ``incoming`` (ending at it) and ``outgoing`` (starting at it)
+    by a G2 quintic that leaves ``incoming`` ``radius`` before the corner and joins
+    ``outgoing`` ``radius`` after it.
+
+    Returns the trimmed incoming piece, the trimmed outgoing piece and the blend.
+
+    Raises
+    ------
+    ParameterError
+        For a reversal (the path turns back on itself) or a blend longer than a piece.
+    """
+    if not (math.isfinite(radius) and radius > 0):
+        raise ParameterError(f"blend {radius!r} must be positive")
+    _, t_in, _ = _end_state(incoming, True)
+    _, t_out, _ = _end_state(outgoing, False)
+    turn = math.degrees(math.acos(float(np.clip(t_in @ t_out, -1.0, 1.0))))
+    if turn > 170.0:
+        raise ParameterError(f"the path turns back by {turn:.1f} deg at the corner: a blend "
+                             "cannot round a reversal (use blend = 0)")
+    inc = trim(incoming, 0.0, radius)
+    out = trim(outgoing, radius, 0.0)
+    P0, T0, k0 = _end_state(inc, True)
+    P1, T1, k1 = _end_state(out, False)
+    lam = float(np.linalg.norm(P1 - P0))
+    n0, n1 = np.array([-T0[1], T0[0]]), np.array([-T1[1], T1[0]])
+    q = Quintic(tuple(P0), tuple(lam * T0), tuple(lam * lam * k0 * n0), tuple(P1),
+                tuple(lam * T1), tuple(lam * lam * k1 * n1))
+    return inc, out, q
+
+
+@dataclass(frozen=True)
+class Composite(Path):
+    """Pieces joined end to end; parameter ``k + f`` is the fraction ``f`` of piece ``k``."""
+
+    pieces: tuple[Path, ...]
+    p0: float = field(default=0.0, init=False)
+
+    def __post_init__(self) -> None:
+        if not self.pieces:
+            raise ParameterError("a composite path needs pieces")
+
+    @property
+    def p1(self) -> float:  # type: ignore[override]  # derived from the pieces
+        """The number of pieces."""
+        return float(len(self.pieces))
+
+    @cached_property
+    def _lengths(self) -> Array:
+        return np.array([p.length for p in self.pieces])
+
+    @cached_property
+    def _starts(self) -> Array:
+        """Arc length at the start of each piece, shape (n + 1,)."""
+        return np.concatenate([[0.0], np.cumsum(self._lengths)])
+
+    @property
+    def length(self) -> float:
+        """Sum of the pieces' lengths."""
+        return float(self._starts[-1])
+
+    def _split(self, p: Array) -> tuple[Array, Array]:
+        k = np.clip(np.floor(p).astype(int), 0, len(self.pieces) - 1)
+        return k, p - k
+
+    def derivatives(self, p: object) -> tuple[Array, Array, Array, Array]:
+        """The position and its first three derivatives at ``p``, each of shape (..., 2)."""
+        p = np.asarray(self._check_parameter(p), float)
+        flat = p.reshape(-1)
+        k, f = self._split(flat)
+        out = [np.empty((flat.size, 2)) for _ in range(4)]
+        for j, piece in enumerate(self.pieces):
+            sel = np.flatnonzero(k == j)
+            if sel.size:
+                span = piece.p1 - piece.p0
+                vals = piece.derivatives(piece.p0 + f[sel] * span)
+                for order in range(4):
+                    out[order][sel] = vals[order] * span**order
+        shape = p.shape + (2,)
+        return (out[0].reshape(shape), out[1].reshape(shape), out[2].reshape(shape),
+                out[3].reshape(shape))
+
+    def arc_length(self, p: object) -> Array:
+        """Arc length from the start: the pieces before plus the part of this one."""
+        p = np.asarray(self._check_parameter(p), float)
+        flat = p.reshape(-1)
+        k, f = self._split(flat)
+        s = np.empty(flat.size)
+        for j, piece in enumerate(self.pieces):
+            sel = np.flatnonzero(k == j)
+            if sel.size:
+                s[sel] = self._starts[j] + piece.arc_length(piece.p0 + f[sel] * (piece.p1
+                                                                                  - piece.p0))
+        return s.reshape(p.shape)
+
+    def parameter_at(self, s: object) -> Array:
+        """The parameter at arc length ``s``."""
+        sv = np.clip(np.asarray(s, float), 0.0, self.length)
+        flat = sv.reshape(-1)
+        k = np.clip(np.searchsorted(self._starts, flat, side="right") - 1, 0,
+                    len(self.pieces) - 1)
+        p = np.empty(flat.size)
+        for j, piece in enumerate(self.pieces):
+            sel = np.flatnonzero(k == j)
+            if sel.size:
+                local = piece.parameter_at(flat[sel] - self._starts[j])
+                p[sel] = j + (local - piece.p0) / (piece.p1 - piece.p0)
+        return p.reshape(sv.shape)
+
+    def piece_at(self, s: Array) -> Array:
+        """Index of the piece at each arc length ``s``."""
+        return np.clip(np.searchsorted(self._starts, np.asarray(s, float), side="right") - 1,
+                       0, len(self.pieces) - 1)
+
+
+def blended(pieces: Sequence[Path], blends: Sequence[float]) -> tuple[Composite, list[int]]:
+    """Chain ``pieces`` (each ending where the next starts), rounding corner ``k`` (between
+    pieces ``k`` and ``k + 1``) with a blend of radius ``blends[k]``.
+
+    Returns the composite path and, for each of its pieces, the index of the input piece it
+    belongs to (a blend belongs to the piece it leaves).
+    """
+    if len(blends) != len(pieces) - 1:
+        raise ParameterError("one blend per corner")
+    cur = list(pieces)
+    out: list[Path] = []
+    owner: list[int] = []
+    for k in range(len(cur) - 1):
+        inc, nxt, q = blend_corner(cur[k], cur[k + 1], blends[k])
+        out += [inc, q]
+        owner += [k, k]
+        cur[k + 1] = nxt
+    out.append(cur[-1])
+    owner.append(len(cur) - 1)
+    return Composite(tuple(out)), owner
