@@ -326,7 +326,7 @@ def program(config: str, out: str, *, force: bool = False, figures: bool = True)
     res = plan_program(robot, inertia, sc.moves, start=prog.start,
                        working_mode=prog.working_mode or sc.mode, assembly=sc.assembly,
                        motors=motors_t.limits(SI), rms_limit=motors_t.rms_torque,
-                       servo_rate_hz=prog.servo_rate_hz, grid=prog.grid,
+                       servo_rate_hz=sc.output.servo_rate_hz, grid=prog.grid,
                        tolerances=sc.tolerances)
     motors, violations = sizing(res)
     cols = {"t_s": res.t, "move": res.move_index.astype(float), "x_mm": res.P[:, 0] * 1e3,
@@ -336,7 +336,7 @@ def program(config: str, out: str, *, force: bool = False, figures: bool = True)
             "tau1_Nm": res.tau[:, 0], "tau2_Nm": res.tau[:, 1]}
     summary: dict[str, Any] = {
         "status": "exceeds" if violations else "fits", "cycle_time_s": res.cycle_time_s,
-        "servo_rate_hz": prog.servo_rate_hz, "config": config,
+        "servo_rate_hz": sc.output.servo_rate_hz, "config": config,
         "moves": [{"index": idx, "type": sc.moves[idx].type,
                    "law": pm.law.name if pm.law else None,
                    "law_status": pm.law.status if pm.law else 0,
@@ -381,7 +381,7 @@ def program(config: str, out: str, *, force: bool = False, figures: bool = True)
                f"{m['rms_torque_Nm']:.4g} N m, peak speed {m['peak_speed_rad_s']:.4g} rad/s"
                for m in motors),
              f"wrote {shown(out, 'setpoints.csv')} ({res.t.size} setpoints at "
-             f"{prog.servo_rate_hz:g} Hz) and {shown(out, 'summary.json')}"]
+             f"{sc.output.servo_rate_hz:g} Hz) and {shown(out, 'summary.json')}"]
     warnings = [f"dextar program: motor {v['motor']} {v['quantity']} {v['value']:.4g} above its "
                 f"limit {v['limit']:.4g}" + (f" at t = {v['t_s']:.4g} s in move {v['move']}"
                                              if v["t_s"] is not None else "")

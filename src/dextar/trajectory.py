@@ -254,8 +254,10 @@ def sample_joint_trajectory(robot: FiveBar, line: JointLine, law: Law, *, assemb
     bad = (gap > robot.L1 + robot.L2) | (gap < abs(robot.L1 - robot.L2))
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
-        raise SingularityError(f"{where(i)}: the joint line leaves the robot's assembly (the "
-                               f"distal rods cannot meet: |B - C| = {words.length(gap[i])})")
+        raise SingularityError(f"{where(i)}: the joint line crosses a parallel (type 2) "
+                               f"singularity: the distal rods stretch into line and cannot meet "
+                               f"beyond it (|B - C| = {words.length(gap[i])}); with the assembly "
+                               "mode fixed, joint space ends there")
     try:
         P = direct_kinematics(robot, q, sigma)
     except AssemblyError as exc:

@@ -167,6 +167,8 @@ PROGRAM = ('[motors]\npeak_torque = 0.5\nmax_speed_rpm = 120\n[gravity]\nvector 
      "back"),
     ('[[move]]\ntype = "joint"\nto_deg = [0.0, 180.0]\nlaw = "min-jerk"\n',
      "move 0 (joint): at t = "),
+    ('[[move]]\ntype = "joint"\nto_deg = [0.0, 180.0]\nlaw = "min-jerk"\n',
+     "crosses a parallel (type 2) singularity"),
 ])
 def test_bad_programs_named(tmp_path, capsys, moves, words):
     cfg = tmp_path / "p.toml"

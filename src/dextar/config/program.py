@@ -27,8 +27,6 @@ class ProgramTable(Table):
                               "[robot].working_mode)"),
         "law": Param("text", "", "time-optimal", "default law of every move"),
         "blend": Param("number", "", 0.0, "default corner blend radius, mm", minimum=0.0),
-        "servo_rate_hz": Param("number", "", 1000.0, "setpoint rate, Hz", positive=True,
-                               maximum=100_000.0),
         "grid": Param("integer", "", 400, "time-optimal segments per move", minimum=10,
                       maximum=100_000),
     }
@@ -37,7 +35,6 @@ class ProgramTable(Table):
     working_mode: str | None = None
     law: str = "time-optimal"
     blend: float = 0.0
-    servo_rate_hz: float = 1000.0
     grid: int = 400
 
     @classmethod

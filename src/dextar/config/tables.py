@@ -341,12 +341,15 @@ class OutputTable(Table):
         "figures": Param("text", "", None, "figures to draw"),  # a list: read below
         "animation_frames": Param("integer", "", 41, "frames of the animation", minimum=2,
                                   maximum=1000),
+        "servo_rate_hz": Param("number", "", 1000.0, "setpoint rate of a program, Hz",
+                               positive=True, maximum=100_000.0),
     }
 
     units: str = "paper"
     samples: int = 1001
     figures: tuple[str, ...] = FIGURES
     animation_frames: int = 41
+    servo_rate_hz: float = 1000.0
 
     @classmethod
     def from_toml(cls, raw: Mapping[str, object]) -> OutputTable:
