@@ -3,7 +3,8 @@
 Run: python benchmarks/fuzz.py --cases 10000 [--seed 0]
 
 Each case is classified by ``tests/robustness/harness.py``: ``ok`` (exit 0, finite outputs),
-``refused`` (exit 2, one line on stderr) or a defect (traceback, nan, hang, partial,
+``exceeds`` (a program planned beyond its motors: exit 1, its files written), ``refused``
+(exit 2, one line on stderr) or a defect (traceback, nan, hang, partial,
 bad-exit). Prints the counts, the slowest case and the first few defects; exits 1 if there
 is any defect.
 """
@@ -25,9 +26,15 @@ from tests.robustness.harness import (  # noqa: E402
     DEFECTS,
     run_argv_case,
     run_config_case,
+    run_program_case,
     toml_text,
 )
-from tests.robustness.strategies import COMMANDS, configs, kinematics_argv  # noqa: E402
+from tests.robustness.strategies import (  # noqa: E402
+    COMMANDS,
+    configs,
+    kinematics_argv,
+    programs,
+)
 
 
 def main() -> int:
@@ -53,7 +60,8 @@ def main() -> int:
         if done % 500 == 0:
             print(f"  {done} cases, {dict(counts)}", file=sys.stderr, flush=True)
 
-    n_cfg = int(args.cases * 0.8)
+    n_prog = int(args.cases * 0.1)
+    n_cfg = int(args.cases * 0.7)
 
     @settings(max_examples=n_cfg, deadline=None, database=None, derandomize=False,
               suppress_health_check=list(HealthCheck))
@@ -63,7 +71,15 @@ def main() -> int:
         outcome, detail = run_config_case(doc, command)
         record(outcome, detail, f"{command} with\n{toml_text(doc)}", time.perf_counter() - t0)
 
-    @settings(max_examples=args.cases - n_cfg, deadline=None, database=None,
+    @settings(max_examples=n_prog, deadline=None, database=None,
+              suppress_health_check=list(HealthCheck))
+    @given(doc=programs())
+    def fuzz_programs(doc: dict) -> None:
+        t0 = time.perf_counter()
+        outcome, detail = run_program_case(doc)
+        record(outcome, detail, f"program with\n{toml_text(doc)}", time.perf_counter() - t0)
+
+    @settings(max_examples=args.cases - n_cfg - n_prog, deadline=None, database=None,
               suppress_health_check=list(HealthCheck))
     @given(argv=kinematics_argv())
     def fuzz_argv(argv: list[str]) -> None:
@@ -75,11 +91,12 @@ def main() -> int:
 
     random.seed(args.seed)
     st.random_module()
+    fuzz_programs()
     fuzz_configs()
     fuzz_argv()
     total = sum(counts.values())
     print(f"{total} cases in {time.perf_counter() - t_start:.0f} s: " + ", ".join(
-        f"{k} {counts.get(k, 0)}" for k in ("ok", "refused", *DEFECTS)))
+        f"{k} {counts.get(k, 0)}" for k in ("ok", "exceeds", "refused", *DEFECTS)))
     print(f"tracebacks {counts.get('traceback', 0)}, NaN outputs {counts.get('nan', 0)}, "
           f"hangs {counts.get('hang', 0)}, partial files {counts.get('partial', 0)}")
     print(f"slowest case {slowest[0]:.2f} s: {slowest[1][:300]}")

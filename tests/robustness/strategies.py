@@ -170,3 +170,50 @@ def kinematics_argv(draw: st.DrawFn) -> list[str]:
     if draw(st.booleans()):
         argv.append("--json")
     return argv
+
+
+@st.composite
+def programs(draw: st.DrawFn) -> dict[str, Any]:
+    """A task file: motors, a start and a few moves of every type (sometimes bad values)."""
+    clean = draw(st.booleans())
+    pt = point(clean=clean)
+    motors = {"peak_torque": draw(pair(0.05, 5.0, clean))}
+    if draw(st.booleans()):
+        motors["max_speed_rpm"] = draw(number(10, 600, clean))
+        if draw(st.booleans()):
+            motors["knee_speed_rpm"] = draw(number(1, 300, clean))
+    moves = []
+    for _ in range(draw(st.integers(0, 4))):
+        kind = draw(st.sampled_from(["line", "arc", "dwell", "joint", "line", "arc"]
+                                    + ([] if clean else ["jump"])))
+        mv: dict[str, Any] = {"type": kind}
+        if kind in ("line", "arc"):
+            mv["to"] = draw(pt)
+            if kind == "arc":
+                if draw(st.booleans()):
+                    mv["via"] = draw(pt)
+                else:
+                    mv["center"] = draw(pt)
+                    mv["direction"] = draw(st.sampled_from(["ccw", "cw"]))
+            if draw(st.booleans()):
+                mv["blend"] = draw(number(0, 10, clean))
+        elif kind == "dwell":
+            mv["time"] = draw(number(0.01, 1, clean))
+        elif kind == "joint":
+            if draw(st.booleans()):
+                mv["to"] = draw(pt)
+                mv["working_mode"] = draw(st.sampled_from(["+-", "++", "-+", "--"]))
+            else:
+                mv["to_deg"] = [draw(number(-180, 360, clean)), draw(number(-180, 360, clean))]
+        if draw(st.booleans()):
+            law = draw(st.sampled_from(["min-jerk", "trapezoid", "optimal", "uniform"]))
+            mv["law"] = law
+            if law == "trapezoid":
+                mv["vmax"], mv["amax"] = draw(number(10, 1e4, clean)), draw(number(10, 1e5, clean))
+            mv["duration"] = draw(st.one_of(st.just("fit"), number(0.01, 3, clean)))
+        moves.append(mv)
+    doc: dict[str, Any] = {"motors": motors, "gravity": {"vector": [0.0, -9810.0]},
+                           "inertia": {"effector_mass": 0.08, "proximal_mass": 0.03,
+                                       "distal_mass": 0.02},
+                           "program": {"start": draw(pt)}, "move": moves}
+    return doc

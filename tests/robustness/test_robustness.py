@@ -12,8 +12,15 @@ from pathlib import Path
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from .harness import DEFECTS, run_argv_case, run_case, run_config_case, toml_text
-from .strategies import COMMANDS, configs, kinematics_argv
+from .harness import (
+    DEFECTS,
+    run_argv_case,
+    run_case,
+    run_config_case,
+    run_program_case,
+    toml_text,
+)
+from .strategies import COMMANDS, configs, kinematics_argv, programs
 
 SETTINGS = settings(max_examples=150, deadline=None, derandomize=True,
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
@@ -47,3 +54,11 @@ def test_arbitrary_bytes_as_config(text):
         out = work / "out.csv"
         outcome, detail = run_case(["plan", str(cfg), "--out", str(out)], work, out)
     assert outcome not in DEFECTS, f"{outcome}: {detail}\ntext: {text!r}"
+
+
+@settings(max_examples=40, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@given(doc=programs())
+def test_random_programs_never_crash(doc):
+    outcome, detail = run_program_case(doc)
+    assert outcome not in DEFECTS, f"{outcome}: {detail}\ntask:\n{toml_text(doc)}"
