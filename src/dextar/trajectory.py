@@ -92,7 +92,7 @@ def path_motion(path: Path, law: Law, t: Array) -> tuple[Array, ...]:
 def sample_trajectory(robot: FiveBar, path: Path, law: Law, *, mode: str = "+-",
                       samples: int = 1001, times: Array | None = None,
                       tolerances: Tolerances = DEFAULT_TOLERANCES,
-                      units: Units | None = None) -> Trajectory:
+                      units: Units | None = None, checked: bool = True) -> Trajectory:
     """Sample ``law`` along ``path`` and map it to joint space in working mode ``mode``.
 
     Parameters
@@ -111,6 +111,9 @@ def sample_trajectory(robot: FiveBar, path: Path, law: Law, *, mode: str = "+-",
         The geometry checker's tolerances on the way.
     units : Units, optional
         The run's units, only to state points in mm and times in seconds in an error.
+    checked : bool
+        Run the geometry checker on the samples (False only for re-sampling a path that was
+        checked already, as the time-optimal law's output check does).
 
     Returns
     -------
@@ -134,10 +137,13 @@ def sample_trajectory(robot: FiveBar, path: Path, law: Law, *, mode: str = "+-",
     def where(i: int) -> str:
         return f"at {words.time(t[i])} (sample {i})"
 
-    check_reach(robot, P, lambda i: f"the path leaves the workspace {where(i)}", words.point,
-                words.length)
+    if checked:
+        check_reach(robot, P, lambda i: f"the path leaves the workspace {where(i)}",
+                    words.point, words.length)
     q = inverse_kinematics(robot, P, mode, unwrap=True)
-    check_poses(robot, q, P, tolerances=tolerances, where=where, point=words.point, mode=mode)
+    if checked:
+        check_poses(robot, q, P, tolerances=tolerances, where=where, point=words.point,
+                    mode=mode)
     dq = joint_velocity(robot, q, P, dP, tol=0.0)
     ddq = joint_acceleration(robot, q, P, dq, dP, ddP, tol=0.0)
     sig = assembly_mode(robot, q, P)

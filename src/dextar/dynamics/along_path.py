@@ -14,7 +14,6 @@ import numpy as np
 
 from .._arrays import Array
 from ..kinematics import direct_kinematics
-from ..kinematics.checker import Tolerances
 from ..laws import Law, UniformLaw
 from ..laws.time_optimal import (
     MotorLimits,
@@ -57,7 +56,7 @@ class RobotAlongPath:
     def ratios(self, law: Law, times: Array, motors: MotorLimits) -> tuple[float, float]:
         """Largest torque and speed ratios of ``law`` at ``times`` (exact model)."""
         tr = sample_trajectory(self.model.robot, self.path, law, mode=self.mode, times=times,
-                               tolerances=Tolerances(0.0, 0.0))
+                               checked=False)  # the path was checked by coefficients()
         tau = inverse_dynamics(Model(self.model.robot, self.model.inertia, tr.assembly), tr.q,
                                tr.dq, tr.ddq)
         return motors.ratios(tau, tr.dq)
