@@ -201,6 +201,18 @@ def _cmd_run(args: argparse.Namespace) -> int:
     return _print(args, jobs.run(args.config, args.out, force=args.force, quiet=args.quiet))
 
 
+def _cmd_excite(args: argparse.Namespace) -> int:
+    return _print(args, jobs.excite(args.config, args.out, duration=args.duration,
+                                    harmonics=args.harmonics, base_hz=args.base_hz,
+                                    seed=args.seed))
+
+
+def _cmd_identify(args: argparse.Namespace) -> int:
+    return _print(args, jobs.identify(args.data, args.out, config=args.config,
+                                      validate=args.validate, cutoff_hz=args.cutoff_hz,
+                                      force=args.force))
+
+
 def _registries_help() -> str:
     """The registered config tables, path types and laws (read when the parser is built, so
     a type registered by a plug-in is listed too)."""
@@ -253,6 +265,33 @@ def _register_stages(sub: Any) -> None:
     sp.add_argument("--force", action="store_true", help="write into an existing directory")
     sp.add_argument("--quiet", action="store_true", help="no summary output")
     sp.set_defaults(func=_cmd_program)
+
+    sp = sub.add_parser("excite", help="an exciting trajectory for identification (a Fourier "
+                        "series per motor, regressor condition number minimised) to CSV")
+    sp.add_argument("config", help="TOML config: the robot, its prior masses, [motors]")
+    sp.add_argument("--json", action="store_true", help="print one JSON object")
+    sp.add_argument("--out", required=True, help="CSV file (- for stdout)")
+    sp.add_argument("--duration", type=float, default=20.0,
+                    help="seconds, rounded up to whole periods (default 20)")
+    sp.add_argument("--harmonics", type=int, default=5, help="harmonics per motor (default 5)")
+    sp.add_argument("--base-hz", type=float, default=0.2,
+                    help="base frequency, Hz (default 0.2: a 5 s period)")
+    sp.add_argument("--seed", type=int, default=0, help="seed of the optimiser's starts")
+    sp.set_defaults(func=_cmd_excite)
+
+    sp = sub.add_parser("identify", help="identify the base parameters from measured motion "
+                        "and write a config with them")
+    sp.add_argument("data", help="CSV with t_s, phi_rad, psi_rad, tau1_Nm, tau2_Nm (SI)")
+    sp.add_argument("--config", help="TOML config: the robot and the prior masses")
+    sp.add_argument("--validate", metavar="DATA2.csv",
+                    help="data not used in the fit: predicted against measured torques")
+    sp.add_argument("--cutoff-hz", type=float, default=None,
+                    help="low-pass cut-off, Hz (default: from the data's bandwidth)")
+    sp.add_argument("--json", action="store_true", help="print one JSON object")
+    sp.add_argument("--out", required=True, help="output directory")
+    sp.add_argument("--force", action="store_true", help="write into an existing directory")
+    sp.add_argument("--quiet", action="store_true", help="no summary output")
+    sp.set_defaults(func=_cmd_identify)
 
     sp = sub.add_parser("run", help="reproduce the paper end to end and write a report")
     cfg(sp)

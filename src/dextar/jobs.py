@@ -9,7 +9,7 @@ import json
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -17,6 +17,9 @@ from .config import RobotTable, Scenario, check_tables, load_scenario, load_toml
 from .config.tables import TABLES
 from .errors import ConfigError
 from .laws import Law
+
+if TYPE_CHECKING:
+    from .dynamics import Model
 
 
 @dataclass(frozen=True)
@@ -306,7 +309,7 @@ def program(config: str, out: str, *, force: bool = False, figures: bool = True)
     """Plan a robot program (``[program]``, ``[[move]]``, ``[motors]``) and write its
     setpoints and sizing to ``out``; exit code 1 when it exceeds a motor limit."""
     from .config.program import ProgramTable
-    from .config.tables import FrictionTable, GravityTable, InertiaTable, MotorsTable
+    from .config.tables import MotorsTable
     from .output.outdir import OutputDir
     from .output.tables import csv_text
     from .program import plan_program, sizing
@@ -317,12 +320,10 @@ def program(config: str, out: str, *, force: bool = False, figures: bool = True)
     assert isinstance(prog, ProgramTable)
     if prog.start is None:
         raise ConfigError("config key [program].start is required (the start point, at rest)")
-    robot = sc.robot_mm.scaled(1e-3)
-    inertia_t, motors_t = sc.table("inertia"), sc.table("motors")
-    assert isinstance(inertia_t, InertiaTable) and isinstance(motors_t, MotorsTable)
-    friction_t, gravity_t = sc.table("friction"), sc.table("gravity")
-    assert isinstance(friction_t, FrictionTable) and isinstance(gravity_t, GravityTable)
-    inertia = inertia_t.build(SI, sc.robot_mm, friction_t, gravity_t)
+    model = si_model(sc)
+    robot, inertia = model.robot, model.inertia
+    motors_t = sc.table("motors")
+    assert isinstance(motors_t, MotorsTable)
     res = plan_program(robot, inertia, sc.moves, start=prog.start,
                        working_mode=prog.working_mode or sc.mode, assembly=sc.assembly,
                        motors=motors_t.limits(SI), rms_limit=motors_t.rms_torque,
@@ -387,3 +388,161 @@ def program(config: str, out: str, *, force: bool = False, figures: bool = True)
                                              if v["t_s"] is not None else "")
                 for v in violations]
     return JobResult(summary, "\n".join(lines), warnings, code=1 if violations else 0)
+
+
+# ----------------------------------------------------------------------------- identification
+def si_model(sc: Scenario) -> Model:
+    """The scenario's robot and inertia in SI (m, kg, s), whatever its ``[output].units``:
+    the unit system of programs and identification."""
+    from .config.tables import FrictionTable, GravityTable, InertiaTable
+    from .dynamics import Model
+    from .units import SI
+
+    inertia_t, friction_t, gravity_t = (sc.table(n) for n in ("inertia", "friction", "gravity"))
+    assert isinstance(inertia_t, InertiaTable) and isinstance(friction_t, FrictionTable)
+    assert isinstance(gravity_t, GravityTable)
+    inertia = inertia_t.build(SI, sc.robot_mm, friction_t, gravity_t)
+    return Model(sc.robot_mm.scaled(1e-3), inertia, sc.assembly, tol=sc.tolerances.type2)
+
+
+def excite(config: str, out: str, *, duration: float = 20.0, harmonics: int = 5,
+           base_hz: float = 0.2, seed: int = 0) -> JobResult:
+    """Design an exciting trajectory for the config's robot and write it as CSV at
+    ``[output].servo_rate_hz`` with the torques the config's model predicts."""
+    from .config.tables import MotorsTable
+    from .dynamics import inverse_dynamics
+    from .identification.excite import design_excitation
+    from .output.tables import csv_text
+    from .units import SI
+
+    target = out_file(out, ".csv")
+    sc = load_scenario(config)
+    model = si_model(sc)
+    motors_t = sc.table("motors")
+    assert isinstance(motors_t, MotorsTable)
+    res = design_excitation(model, sc.mode, harmonics=harmonics, base_hz=base_hz,
+                            duration=duration, motors=motors_t.limits(SI), seed=seed)
+    rate = sc.output.servo_rate_hz
+    n = int(round(res.duration * rate)) + 1
+    t = np.arange(n) / rate
+    q, dq, ddq = res.trajectory.evaluate(t)
+    tau = inverse_dynamics(model, q, dq, ddq, t=t)
+    cols = {"t_s": t, "phi_rad": q[:, 0], "psi_rad": q[:, 1], "dphi_rad_s": dq[:, 0],
+            "dpsi_rad_s": dq[:, 1], "ddphi_rad_s2": ddq[:, 0], "ddpsi_rad_s2": ddq[:, 1],
+            "tau1_Nm": tau[:, 0], "tau2_Nm": tau[:, 1]}
+    where, data = _write(target, csv_text(cols))
+    payload = {"condition_number": res.condition_number, "duration_s": res.duration,
+               "periods": res.periods, "period_s": res.trajectory.period,
+               "harmonics": harmonics, "base_hz": base_hz, "samples": n, "rate_hz": rate,
+               "rest_pose_deg": [float(v) for v in np.degrees(res.trajectory.q0)],
+               "min_type1_distance": res.min_type1_distance,
+               "min_type2_distance": res.min_type2_distance,
+               "peak_torque_Nm": [float(v) for v in res.peak_torque],
+               "peak_speed_rad_s": [float(v) for v in res.peak_speed],
+               "status": res.status, "message": res.message, "out": where}
+    text = (f"exciting trajectory: condition number {res.condition_number:.4g} (base "
+            f"regressor, unit-norm columns); {res.periods} period(s) of {res.trajectory.period:g} "
+            f"s, {harmonics} harmonics; peak torques {res.peak_torque[0]:.4g}, "
+            f"{res.peak_torque[1]:.4g} N m; min singularity distances type 1 "
+            f"{res.min_type1_distance:.3g}, type 2 {res.min_type2_distance:.3g}; wrote {where} "
+            f"({n} samples at {rate:g} Hz)")
+    warnings = [] if res.status == 0 else [f"dextar excite: warning: {res.message}"]
+    return JobResult(payload, text, warnings, data=data)
+
+
+def identify(data_path: str, out: str, *, config: str | None = None,
+             validate: str | None = None, cutoff_hz: float | None = None,
+             force: bool = False, figures: bool = True) -> JobResult:
+    """Identify the base parameters from measured motion and write ``identified.toml``,
+    ``parameters.csv``, ``summary.json``, ``fit.png`` and ``report.html`` in ``out``."""
+    from .dynamics.regressor import NAMES, standard_parameters
+    from .identification.data import read_motion_csv
+    from .identification.fit import check_working_mode, condition
+    from .identification.fit import identify as fit
+    from .output.identification import (
+        fit_figure,
+        identification_report,
+        identified_toml,
+        parameters_csv,
+    )
+    from .output.outdir import OutputDir
+
+    if cutoff_hz is not None and not (np.isfinite(cutoff_hz) and cutoff_hz > 0):
+        raise ConfigError(f"--cutoff-hz {cutoff_hz!r} must be a positive number")
+    sc = load_scenario(config)
+    model = si_model(sc)
+    data = read_motion_csv(data_path)
+    vdata = read_motion_csv(validate) if validate else None
+    res = fit(data, model, mode=sc.mode, cutoff_hz=cutoff_hz)
+    c = condition(data, model, cutoff_hz=res.cutoff_hz)
+    Yb = res.base.columns(c.Y)
+    summary: dict[str, Any] = {
+        "status": ("identified" if res.status == 0 else "poorly conditioned" if res.status == 1
+                   else "not physically consistent"),
+        "message": res.message, "method": res.method, "data": data_path,
+        "config": config or "defaults", "n_samples": res.n_samples, "n_used": res.n_used,
+        "sample_rate_hz": data.rate_hz, "cutoff_hz": res.cutoff_hz,
+        "condition_number": res.condition_number,
+        "rms_residual_Nm": [float(v) for v in res.rms_residual],
+        "base_parameters": [{"name": n, "meaning": m, "unit": u, "value": float(v),
+                             "std": float(s)}
+                            for n, m, u, v, s in zip(res.base.names, res.base.meanings,
+                                                     res.base.units, res.beta, res.std,
+                                                     strict=True)],
+        "unidentifiable": [NAMES[j] for j in res.base.unidentifiable],
+        "physically_consistent": res.consistent, "warnings": list(res.warnings),
+        "units": "SI: s, rad, N m; base parameters in the unit of their column"}
+    panels = [("identification data", c.t, c.tau, Yb @ res.beta)]
+    if vdata is not None:
+        check_working_mode(vdata, model, sc.mode)
+        vc = condition(vdata, model, cutoff_hz=res.cutoff_hz)
+        pred = vc.Y @ res.theta
+        prior = vc.Y @ standard_parameters(model.inertia)
+        summary["validation_data"] = validate
+        summary["validation_rms_error_Nm"] = [float(v) for v in
+                                              np.sqrt(((pred - vc.tau) ** 2).mean(axis=0))]
+        summary["validation_rms_error_prior_Nm"] = [float(v) for v in np.sqrt(
+            ((prior - vc.tau) ** 2).mean(axis=0))]
+        summary["validation_rms_torque_Nm"] = [float(v) for v in
+                                               np.sqrt((vc.tau ** 2).mean(axis=0))]
+        panels.append(("validation data", vc.t, vc.tau, pred))
+    friction_t, gravity_t = sc.table("friction"), sc.table("gravity")
+    extra: dict[str, Any] = {}
+    if config is not None:
+        raw = load_toml(config)
+        extra = {k: raw[k] for k in ("motors", "tolerances") if k in raw}
+    toml_text = identified_toml(
+        sc.robot_mm, sc.mode, sc.assembly, res.inertia,
+        coulomb_speed_deg_s=friction_t.coulomb_speed_deg_s, gravity_mm_s2=gravity_t.vector,
+        extra=extra,
+        comment=(f"identified by dextar from {data_path} ({res.method}, condition number "
+                 f"{res.condition_number:.4g})\nbase parameters reproduced exactly; the split "
+                 "between rods, rotor and payload that the torques cannot see follows "
+                 f"{config or 'the defaults'}"))
+    csv_rows = parameters_csv(res)
+    with OutputDir(out, force=force) as od:
+        od.write_text("identified.toml", toml_text)
+        od.write_text("parameters.csv", csv_rows)
+        if figures:
+            from .output.figures import png_bytes
+
+            png = png_bytes(fit_figure(panels))
+            od.write_bytes("fit.png", png)
+            od.write_text("report.html", identification_report(summary, csv_rows,
+                                                               {"fit": png}))
+        od.write_text("summary.json", json.dumps(summary, indent=2, allow_nan=False) + "\n")
+    lines = [f"identified {res.base.size} base parameters from {res.n_samples} samples "
+             f"({res.n_used} used after filtering at {res.cutoff_hz:.3g} Hz): {res.method}, "
+             f"condition number {res.condition_number:.4g}, RMS residual "
+             f"{res.rms_residual[0]:.4g}, {res.rms_residual[1]:.4g} N m",
+             *(f"  {n:<7} = {v: .6g} +- {s:.2g} {u}  ({m})" for n, m, u, v, s in
+               zip(res.base.names, res.base.meanings, res.base.units, res.beta, res.std,
+                   strict=True))]
+    if vdata is not None:
+        e, ep = summary["validation_rms_error_Nm"], summary["validation_rms_error_prior_Nm"]
+        lines.append(f"validation on {validate}: RMS error {e[0]:.4g}, {e[1]:.4g} N m "
+                     f"(prior model {ep[0]:.4g}, {ep[1]:.4g} N m)")
+    lines.append(f"wrote {shown(out, 'identified.toml')}, parameters.csv, summary.json"
+                 + (", fit.png, report.html" if figures else ""))
+    warnings = [f"dextar identify: warning: {w}" for w in res.warnings]
+    return JobResult(summary, "\n".join(lines), warnings)

@@ -4,7 +4,6 @@ its envelope (the plot a drive engineer sizes motors with)."""
 
 from __future__ import annotations
 
-import base64
 import html
 from typing import Any
 
@@ -15,6 +14,7 @@ from ..geometry import FiveBar
 from ..kinematics import workspace_map
 from ..program import ProgramResult
 from .figures import plot_workspace
+from .html_page import figures, page
 
 
 def moves_figure(res: ProgramResult, robot_mm: FiveBar, mode: str) -> Figure:
@@ -121,13 +121,8 @@ def program_report(summary: dict[str, Any], pngs: dict[str, bytes]) -> str:
                    f"{v['limit']:.4g}" + (f" at t = {v['t_s']:.4g} s in move {v['move']}"
                                           if v["t_s"] is not None else "") + "</li>"
                    for v in summary["violations"]) or "<li>none</li>"
-    figs = "".join(f"<figure><img alt='{esc(k)}' src='data:image/png;base64,"
-                   f"{base64.b64encode(v).decode('ascii')}'></figure>" for k, v in pngs.items())
-    return (
-        "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>dextar program"
-        "</title><style>body{font-family:sans-serif;max-width:960px;margin:2em auto}"
-        "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:3px 8px;"
-        "font-size:14px}img{max-width:100%}</style></head><body>"
+    return page(
+        f"dextar program {summary['config']}",
         f"<h1>Program {esc(str(summary['config']))}: {esc(summary['status'])} the motors</h1>"
         f"<p>Cycle time {summary['cycle_time_s']:.4f} s; setpoints at "
         f"{summary['servo_rate_hz']:g} Hz. Units: {esc(summary['units'])}.</p>"
@@ -135,4 +130,4 @@ def program_report(summary: dict[str, Any], pngs: dict[str, bytes]) -> str:
         "<th>duration [s]</th><th>min type-1 distance</th><th>min type-2 distance</th></tr>"
         f"{rows}</table><h2>Motor sizing</h2><table><tr><th></th><th>motor A</th>"
         f"<th>motor D</th></tr>{sizing}</table><h2>Violations</h2><ul>{viol}</ul>"
-        f"<h2>Figures</h2>{figs}</body></html>\n")
+        f"<h2>Figures</h2>{figures(pngs)}")

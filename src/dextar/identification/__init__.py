@@ -1,0 +1,1 @@
+"""Identification of the real robot's parameters from measured motion."""
