@@ -277,6 +277,7 @@ def _register_stages(sub: Any) -> None:
     sp.add_argument("--base-hz", type=float, default=0.2,
                     help="base frequency, Hz (default 0.2: a 5 s period)")
     sp.add_argument("--seed", type=int, default=0, help="seed of the optimiser's starts")
+    sp.add_argument("--quiet", action="store_true", help="no summary output")
     sp.set_defaults(func=_cmd_excite)
 
     sp = sub.add_parser("identify", help="identify the base parameters from measured motion "

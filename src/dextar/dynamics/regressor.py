@@ -128,10 +128,10 @@ def regressor(model: Model, q: object, dq: object, ddq: object, *,
     c1, s1, c2, s2 = o["c1"], o["s1"], o["c2"], o["s2"]
 
     def TB(Fx: Array, Fy: Array) -> Array:
-        return l1 * (c1 * Fy - s1 * Fx)
+        return np.asarray(l1 * (c1 * Fy - s1 * Fx))
 
     def TC(Fx: Array, Fy: Array) -> Array:
-        return l2 * (c2 * Fy - s2 * Fx)
+        return np.asarray(l2 * (c2 * Fy - s2 * Fx))
 
     col = INDEX
     # proximal rods and rotors

@@ -93,7 +93,7 @@ class BaseParameters:
 
     def of(self, theta: Array) -> Array:
         """Base parameters ``beta`` (n_base,) of standard parameters ``theta`` (15,)."""
-        return self.K @ np.asarray(theta, float)
+        return np.asarray(self.K @ np.asarray(theta, float))
 
     def columns(self, Y: Array) -> Array:
         """The base regressor ``Y_b`` (..., 2, n_base) of a full regressor (..., 2, 15)."""

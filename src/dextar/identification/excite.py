@@ -161,6 +161,13 @@ def _feasibility(model: Model, q: Array) -> tuple[Array, Array, Array] | None:
     return d.type1, d.type2, d.type2_signed
 
 
+def _within(model: Model, motors: MotorLimits, q: Array, dq: Array, ddq: Array) -> bool:
+    """True when the motion needs no more than the motors give (torque and speed)."""
+    tau = inverse_dynamics(model, q, dq, ddq)
+    return bool((np.abs(tau) <= motors.available_torque(dq)).all()
+                and (np.abs(dq) <= np.asarray(motors.max_speed)).all())
+
+
 def design_excitation(model: Model, mode: str, *, harmonics: int = 5, base_hz: float = 0.2,
                       duration: float = 20.0, motors: MotorLimits | None = None,
                       seed: int = 0, starts: int = 3, q0: Array | None = None,
@@ -258,16 +265,26 @@ def design_excitation(model: Model, mode: str, *, harmonics: int = 5, base_hz: f
     if best is None:
         raise ParameterError("no feasible exciting trajectory: the rest pose is too close to a "
                              "singularity or the motors are too weak to hold it")
-    tr = FourierTrajectory.from_free(q0, best[1], n, base_hz)
-    tt = np.linspace(0.0, tr.period, 20 * m, endpoint=False)
-    q, dq, ddq = tr.evaluate(tt)
-    f = _feasibility(model, q)
-    assert f is not None
+    # the optimiser saw a coarse grid: check a fine one, shrinking the motion about the rest
+    # pose until every sample is within the margins and the motors
+    tt = np.linspace(0.0, 1.0 / base_hz, 40 * m, endpoint=False)
+    x = best[1]
+    for _ in range(200):
+        tr = FourierTrajectory.from_free(q0, x, n, base_hz)
+        q, dq, ddq = tr.evaluate(tt)
+        f = _feasibility(model, q)
+        if f is not None and min(f[0].min(), f[1].min()) >= MARGIN and (
+                motors is None or _within(model, motors, q, dq, ddq)):
+            break
+        x = 0.98 * x
+    else:  # pragma: no cover - the rest pose itself is feasible
+        raise ParameterError("no exciting trajectory stays within the margins and motors")
     Yb = base.columns(regressor(model, q, dq, ddq)).reshape(-1, base.size)
     s = np.linalg.svd(Yb / np.linalg.norm(Yb, axis=0), compute_uv=False)
     tau = inverse_dynamics(model, q, dq, ddq)
     periods = max(1, int(math.ceil(duration * base_hz - 1e-9)))
     ok = best[2]
+    assert f is not None
     return ExcitationResult(tr, float(s[0] / s[-1]), periods, float(f[0].min()),
                             float(f[1].min()), np.abs(tau).max(axis=0),
                             np.abs(dq).max(axis=0), 0 if ok else 1,

@@ -51,6 +51,9 @@ COND_WARNING = 1e3
 SAMPLES_PER_PARAMETER = 5
 #: Lags (decimated samples) of the autocorrelation-consistent covariance.
 HAC_LAGS = 4
+#: A motor's samples slower than this fraction of its peak speed are left out of its
+#: equations (static friction).
+LOW_SPEED = 0.05
 
 
 @dataclass(frozen=True)
@@ -208,10 +211,11 @@ def check_working_mode(data: MotionData, model: Model, mode: str) -> None:
             f"{1e3 * P[i, 1]:.6g}) mm")
 
 
-def _stack(Yb: Array, tau: Array, sigma: Array) -> tuple[Array, Array]:
-    """Rows of both motors, each weighted by ``1 / sigma_k``: (2m, p) and (2m,)."""
-    A = np.concatenate([Yb[:, 0, :] / sigma[0], Yb[:, 1, :] / sigma[1]])
-    b = np.concatenate([tau[:, 0] / sigma[0], tau[:, 1] / sigma[1]])
+def _stack(Yb: Array, tau: Array, sigma: Array, keep: Array) -> tuple[Array, Array]:
+    """The kept rows of motor A then of motor D, each weighted by ``1 / sigma_k``:
+    (n_A + n_D, p) and (n_A + n_D,)."""
+    A = np.concatenate([Yb[keep[:, k], k, :] / sigma[k] for k in range(2)])
+    b = np.concatenate([tau[keep[:, k], k] / sigma[k] for k in range(2)])
     return A, b
 
 
@@ -275,18 +279,21 @@ def identify(data: MotionData, model: Model, *, mode: str, cutoff_hz: float | No
             f"decimating ({len(data.t)} read), fewer than {need} ({SAMPLES_PER_PARAMETER} per "
             f"base parameter, {base.size} of them): record longer")
     Yb = base.columns(c.Y)
-    one = np.ones(2)
-    A, b = _stack(Yb, c.tau, one)
+    # a motor's rows near rest carry its static friction, which no model of the motion
+    # predicts (the motor sticks): they are left out of its equations
+    keep = np.abs(c.dq) > LOW_SPEED * np.abs(c.dq).max(axis=0)
+    sizes = (int(keep[:, 0].sum()), int(keep[:, 1].sum()))
+    A, b = _stack(Yb, c.tau, np.ones(2), keep)
     _rank_check(A, base, data.source)
     beta0, *_ = np.linalg.lstsq(A, b, rcond=None)
     r0 = (Yb @ beta0) - c.tau
-    dof = max(m - base.size / 2.0, 1.0)
-    sigma = np.sqrt((r0**2).sum(axis=0) / dof)
+    sigma = np.array([np.sqrt((r0[keep[:, k], k] ** 2).sum()
+                              / max(sizes[k] - base.size / 2.0, 1.0)) for k in range(2)])
     sigma = np.where(sigma > 0, sigma, max(float(sigma.max()), 1e-300))
-    Aw, bw = _stack(Yb, c.tau, sigma)
+    Aw, bw = _stack(Yb, c.tau, sigma, keep)
     cond = _rank_check(Aw, base, data.source)
     beta, *_ = np.linalg.lstsq(Aw, bw, rcond=None)
-    std = _hac_std(Aw, Aw @ beta - bw, m)
+    std = _hac_std(Aw, Aw @ beta - bw, sizes)
     prior = standard_parameters(model.inertia)
     method = "weighted least squares"
     theta, ok = physical_set(beta, base, prior, model.inertia)
@@ -300,7 +307,7 @@ def identify(data: MotionData, model: Model, *, mode: str, cutoff_hz: float | No
     consistent = bool(np.all(np.abs(back - beta) <= 1e-9 * np.maximum(np.abs(beta), 1e-12)
                              + 1e-12 * np.abs(beta).max()))
     res = Yb @ beta - c.tau
-    rms = np.sqrt((res**2).mean(axis=0))
+    rms = np.array([np.sqrt((res[keep[:, k], k] ** 2).mean()) for k in range(2)])
     warnings = []
     status, message = 0, "identified"
     if cond > COND_WARNING:
@@ -320,25 +327,27 @@ def identify(data: MotionData, model: Model, *, mode: str, cutoff_hz: float | No
                                 warnings)
 
 
-def _hac_std(A: Array, r: Array, m: int) -> Array:
-    """Standard deviations of least-squares estimates whose residuals ``r`` (2m,) are
-    correlated in time (the low-pass leaves neighbouring samples related): the
-    heteroskedasticity and autocorrelation consistent (Newey-West, Bartlett weights)
-    covariance ``(A^T A)^-1 S (A^T A)^-1``, lags within each motor's rows, scaled by
-    ``2m / (2m - p)``."""
-    p = A.shape[1]
+def _hac_std(A: Array, r: Array, sizes: tuple[int, int]) -> Array:
+    """Standard deviations of least-squares estimates whose residuals ``r`` are correlated
+    in time (the low-pass leaves neighbouring samples related): the heteroskedasticity and
+    autocorrelation consistent (Newey-West, Bartlett weights) covariance
+    ``(A^T A)^-1 S (A^T A)^-1``, lags within each motor's rows (``sizes`` of them), scaled
+    by ``n / (n - p)``."""
+    n, p = A.shape
     g = A * r[:, None]
     S = g.T @ g
+    starts = (0, sizes[0])
     for lag in range(1, HAC_LAGS + 1):
         w = 1.0 - lag / (HAC_LAGS + 1.0)
         G = np.zeros((p, p))
         for k in range(2):
-            blk = g[k * m:(k + 1) * m]
-            G += blk[lag:].T @ blk[:-lag]
+            blk = g[starts[k]:starts[k] + sizes[k]]
+            if len(blk) > lag:
+                G += blk[lag:].T @ blk[:-lag]
         S += w * (G + G.T)
     inv = np.linalg.inv(A.T @ A)
-    cov = inv @ S @ inv * (2 * m / max(2 * m - p, 1))
-    return np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    cov = inv @ S @ inv * (n / max(n - p, 1))
+    return np.asarray(np.sqrt(np.clip(np.diag(cov), 0.0, None)))
 
 
 # ----------------------------------------------------------------------- physical parameters
@@ -349,7 +358,7 @@ def _scales(prior: Array) -> Array:
     for u in set(units.tolist()):
         sel = units == u
         s[sel] = np.maximum(s[sel], 1e-3 * max(float(s[sel].max()), 1e-12))
-    return np.maximum(s, 1e-12)
+    return np.asarray(np.maximum(s, 1e-12))
 
 
 def _scaled_bounds(prior_inertia: Inertia, s: Array) -> list[tuple[float | None, None]]:
