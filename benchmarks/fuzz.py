@@ -26,6 +26,7 @@ from tests.robustness.harness import (  # noqa: E402
     DEFECTS,
     run_argv_case,
     run_config_case,
+    run_identify_case,
     run_program_case,
     toml_text,
 )
@@ -33,8 +34,11 @@ from tests.robustness.strategies import (  # noqa: E402
     COMMANDS,
     configs,
     kinematics_argv,
+    motion_files,
     programs,
 )
+
+PICK_PLACE = ROOT / "examples" / "pick_place.toml"
 
 
 def main() -> int:
@@ -61,7 +65,8 @@ def main() -> int:
             print(f"  {done} cases, {dict(counts)}", file=sys.stderr, flush=True)
 
     n_prog = int(args.cases * 0.1)
-    n_cfg = int(args.cases * 0.7)
+    n_id = int(args.cases * 0.05)
+    n_cfg = int(args.cases * 0.65)
 
     @settings(max_examples=n_cfg, deadline=None, database=None, derandomize=False,
               suppress_health_check=list(HealthCheck))
@@ -79,7 +84,16 @@ def main() -> int:
         outcome, detail = run_program_case(doc)
         record(outcome, detail, f"program with\n{toml_text(doc)}", time.perf_counter() - t0)
 
-    @settings(max_examples=args.cases - n_cfg - n_prog, deadline=None, database=None,
+    @settings(max_examples=n_id, deadline=None, database=None,
+              suppress_health_check=list(HealthCheck))
+    @given(case=motion_files(), config=st.sampled_from([None, str(PICK_PLACE)]))
+    def fuzz_identify(case: tuple[str, list[str]], config: str | None) -> None:
+        t0 = time.perf_counter()
+        outcome, detail = run_identify_case(case[0], case[1], config)
+        record(outcome, detail, f"identify {case[1]} config {config} on\n{case[0][:300]}",
+               time.perf_counter() - t0)
+
+    @settings(max_examples=args.cases - n_cfg - n_prog - n_id, deadline=None, database=None,
               suppress_health_check=list(HealthCheck))
     @given(argv=kinematics_argv())
     def fuzz_argv(argv: list[str]) -> None:
@@ -92,6 +106,7 @@ def main() -> int:
     random.seed(args.seed)
     st.random_module()
     fuzz_programs()
+    fuzz_identify()
     fuzz_configs()
     fuzz_argv()
     total = sum(counts.values())

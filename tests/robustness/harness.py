@@ -172,3 +172,16 @@ def run_argv_case(argv: list[str]) -> tuple[str, str]:
             out = work / "ws.png"
             argv = [*argv, "--out", str(out)]
         return run_case(argv, work, out)
+
+
+def run_identify_case(text: str, options: list[str], config: str | None) -> tuple[str, str]:
+    """Write ``text`` as a data file and run ``dextar identify`` on it."""
+    with tempfile.TemporaryDirectory() as tmp:
+        work = Path(tmp)
+        data = work / "data.csv"
+        data.write_text(text)
+        out = work / "out"
+        argv = ["identify", str(data), "--out", str(out), "--quiet", *options]
+        if config:
+            argv += ["--config", config]
+        return run_case(argv, work, out / "summary.json")

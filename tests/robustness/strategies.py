@@ -217,3 +217,49 @@ def programs(draw: st.DrawFn) -> dict[str, Any]:
                                        "distal_mass": 0.02},
                            "program": {"start": draw(pt)}, "move": moves}
     return doc
+
+
+#: Columns of a measured-motion file.
+DATA_COLUMNS = ["t_s", "phi_rad", "psi_rad", "dphi_rad_s", "dpsi_rad_s", "tau1_Nm", "tau2_Nm"]
+BAD_CELLS = st.sampled_from(["nan", "inf", "-inf", "1e308", "-1e308", "x", "", "1e-300",
+                             "0", "-0"])
+
+
+@st.composite
+def motion_files(draw: st.DrawFn) -> tuple[str, list[str]]:
+    """The text of a measured-motion CSV (a small motion of the DexTAR in working mode +-,
+    sometimes damaged: a column dropped, bad cells, time reversed, duplicated or jittered,
+    rows cut) and extra ``dextar identify`` options."""
+    import numpy as np
+
+    n = draw(st.sampled_from([4000, 4000, 2000, 300, 2, 0]))
+    rate = draw(st.sampled_from([1000.0, 500.0]))
+    t = np.arange(n) / rate
+    w = 2 * np.pi * draw(st.sampled_from([0.3, 1.0, 2.0]))
+    amp = draw(st.sampled_from([0.2, 0.05, 0.0, 3.0]))
+    # (0, 100) mm in working mode +- is phi = 54.7, psi = 125.3 deg for the DexTAR
+    q = np.stack([0.955 + amp * np.sin(w * t), 2.187 + amp * np.sin(1.7 * w * t + 1)], -1)
+    dq = np.stack([amp * w * np.cos(w * t), 1.7 * amp * w * np.cos(1.7 * w * t + 1)], -1)
+    tau = np.stack([0.1 * np.sin(w * t) + 0.05, 0.08 * np.cos(w * t)], -1)
+    if draw(st.booleans()):
+        t = {"reverse": t[::-1], "dup": np.where(np.arange(n) == n // 2, t - 1 / rate, t),
+             "jitter": t + (np.arange(n) % 7 == 3) * 0.2 / rate}[
+            draw(st.sampled_from(["reverse", "dup", "jitter"]))]
+    rows = [[repr(float(v)) for v in r] for r in np.column_stack([t, q, dq, tau])]
+    cols = list(DATA_COLUMNS)
+    if draw(st.booleans()):
+        drop = draw(st.sampled_from(cols))
+        k = cols.index(drop)
+        cols.pop(k)
+        rows = [r[:k] + r[k + 1:] for r in rows]
+    for _ in range(draw(st.integers(0, 2))):
+        if rows:
+            i = draw(st.integers(0, len(rows) - 1))
+            j = draw(st.integers(0, len(cols) - 1))
+            rows[i][j] = draw(BAD_CELLS)
+    text = "\n".join([",".join(cols), *(",".join(r) for r in rows)]) + "\n"
+    opts: list[str] = []
+    if draw(st.booleans()):
+        opts += ["--cutoff-hz", draw(st.sampled_from(["-1", "0", "1e-3", "0.5", "5", "249",
+                                                      "250", "1e6", "nan", "inf"]))]
+    return text, opts

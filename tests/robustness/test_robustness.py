@@ -17,10 +17,11 @@ from .harness import (
     run_argv_case,
     run_case,
     run_config_case,
+    run_identify_case,
     run_program_case,
     toml_text,
 )
-from .strategies import COMMANDS, configs, kinematics_argv, programs
+from .strategies import COMMANDS, configs, kinematics_argv, motion_files, programs
 
 SETTINGS = settings(max_examples=150, deadline=None, derandomize=True,
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
@@ -62,3 +63,12 @@ def test_arbitrary_bytes_as_config(text):
 def test_random_programs_never_crash(doc):
     outcome, detail = run_program_case(doc)
     assert outcome not in DEFECTS, f"{outcome}: {detail}\ntask:\n{toml_text(doc)}"
+
+
+@settings(max_examples=12, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@given(case=motion_files())
+def test_random_measured_data_never_crash(case):
+    text, options = case
+    outcome, detail = run_identify_case(text, options, None)
+    assert outcome not in DEFECTS, f"{outcome}: {detail}\noptions {options}\n{text[:500]}"

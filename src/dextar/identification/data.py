@@ -17,6 +17,8 @@ REQUIRED = ("t_s", "phi_rad", "psi_rad", "tau1_Nm", "tau2_Nm")
 OPTIONAL = ("dphi_rad_s", "dpsi_rad_s", "ddphi_rad_s2", "ddpsi_rad_s2")
 #: Largest relative deviation of a time step from the median step.
 UNIFORM_TOL = 0.01
+#: Largest angle magnitude accepted (rad): beyond it the column is not in radians.
+MAX_ANGLE = 1000.0
 
 
 @dataclass(frozen=True)
@@ -75,6 +77,10 @@ def check_motion(d: MotionData) -> None:
         if bad.any():
             raise ParameterError(f"{d.source}: column {name} is NaN or infinite at row "
                                  f"{_rows(bad)}")
+    big = np.asarray((np.abs(d.q) > MAX_ANGLE).any(axis=1))
+    if big.any():
+        raise ParameterError(f"{d.source}: phi_rad, psi_rad beyond {MAX_ANGLE:g} rad at row "
+                             f"{_rows(big)}: not angles in radians")
     if n < 3:
         raise ParameterError(f"{d.source}: {n} samples; an identification needs many more")
     dt = np.diff(d.t)

@@ -289,7 +289,8 @@ def identify(data: MotionData, model: Model, *, mode: str, cutoff_hz: float | No
     r0 = (Yb @ beta0) - c.tau
     sigma = np.array([np.sqrt((r0[keep[:, k], k] ** 2).sum()
                               / max(sizes[k] - base.size / 2.0, 1.0)) for k in range(2)])
-    sigma = np.where(sigma > 0, sigma, max(float(sigma.max()), 1e-300))
+    if not (sigma > 0).all():  # an exact fit of a motor: weigh both alike
+        sigma = np.ones(2)
     Aw, bw = _stack(Yb, c.tau, sigma, keep)
     cond = _rank_check(Aw, base, data.source)
     beta, *_ = np.linalg.lstsq(Aw, bw, rcond=None)
@@ -301,6 +302,7 @@ def identify(data: MotionData, model: Model, *, mode: str, cutoff_hz: float | No
         method = "constrained"
         theta = _constrained_fit(Aw, bw, base, prior, model.inertia)
         beta = base.of(theta)
+        std = _hac_std(Aw, Aw @ beta - bw, sizes)  # the spread about the constrained fit
         ok = True
     inertia = realise(theta, model.inertia)
     back = base.of(standard_parameters(inertia))
