@@ -213,6 +213,18 @@ def _cmd_identify(args: argparse.Namespace) -> int:
                                       force=args.force))
 
 
+def _cmd_design(args: argparse.Namespace) -> int:
+    progress = None
+    if sys.stderr.isatty() and not args.quiet:
+        def progress(done: int, total: int) -> None:
+            sys.stderr.write(f"\rdesigns {done}/{total}" + ("\n" if done == total else ""))
+            sys.stderr.flush()
+    return _print(args, jobs.design(args.config, args.out, samples=args.samples,
+                                    seed=args.seed, workers=args.workers,
+                                    scheduler=args.scheduler, resume=args.resume,
+                                    force=args.force, progress=progress))
+
+
 def _registries_help() -> str:
     """The registered config tables, path types and laws (read when the parser is built, so
     a type registered by a plug-in is listed too)."""
@@ -293,6 +305,24 @@ def _register_stages(sub: Any) -> None:
     sp.add_argument("--force", action="store_true", help="write into an existing directory")
     sp.add_argument("--quiet", action="store_true", help="no summary output")
     sp.set_defaults(func=_cmd_identify)
+
+    sp = sub.add_parser("design", help="sweep five-bar geometries for a program task on Dask: "
+                        "designs, Pareto front, the chosen robot")
+    sp.add_argument("config", help="TOML task file (a dextar program task) with [design]")
+    sp.add_argument("--out", required=True, help="output directory")
+    sp.add_argument("--samples", type=int, default=None, help="designs (default [design])")
+    sp.add_argument("--seed", type=int, default=None, help="sampling seed (default [design])")
+    where = sp.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=int, default=None,
+                       help="processes of a local Dask cluster (default: the cores)")
+    where.add_argument("--scheduler", metavar="ADDRESS",
+                       help="a running Dask scheduler, e.g. tcp://host:8786")
+    sp.add_argument("--resume", action="store_true",
+                    help="complete the sweep in --out (evaluate only what is missing)")
+    sp.add_argument("--force", action="store_true", help="overwrite a non-empty --out")
+    sp.add_argument("--quiet", action="store_true", help="no progress or summary output")
+    sp.add_argument("--json", action="store_true", help="print one JSON object")
+    sp.set_defaults(func=_cmd_design)
 
     sp = sub.add_parser("run", help="reproduce the paper end to end and write a report")
     cfg(sp)

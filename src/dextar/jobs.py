@@ -459,10 +459,10 @@ def identify(data_path: str, out: str, *, config: str | None = None,
     from .identification.data import read_motion_csv
     from .identification.fit import check_working_mode, condition
     from .identification.fit import identify as fit
+    from .output.config_file import model_toml
     from .output.identification import (
         fit_figure,
         identification_report,
-        identified_toml,
         parameters_csv,
     )
     from .output.outdir import OutputDir
@@ -511,7 +511,7 @@ def identify(data_path: str, out: str, *, config: str | None = None,
     if config is not None:
         raw = load_toml(config)
         extra = {k: raw[k] for k in ("motors", "tolerances") if k in raw}
-    toml_text = identified_toml(
+    toml_text = model_toml(
         sc.robot_mm, sc.mode, sc.assembly, res.inertia,
         coulomb_speed_deg_s=friction_t.coulomb_speed_deg_s, gravity_mm_s2=gravity_t.vector,
         extra=extra,
@@ -546,3 +546,182 @@ def identify(data_path: str, out: str, *, config: str | None = None,
                  + (", fit.png, report.html" if figures else ""))
     warnings = [f"dextar identify: warning: {w}" for w in res.warnings]
     return JobResult(summary, "\n".join(lines), warnings)
+
+
+# ----------------------------------------------------------------------------- design sweeps
+def design(config: str, out: str, *, samples: int | None = None, seed: int | None = None,
+           workers: int | None = None, scheduler: str | None = None, resume: bool = False,
+           force: bool = False, figures: bool = True,
+           progress: Any = None) -> JobResult:
+    """Sweep the geometries of ``[design]`` on the task's program (Dask), and write
+    ``designs.csv``, ``pareto.csv``, ``best.toml``, ``summary.json``, figures and the report."""
+    import hashlib
+    import os
+
+    from .config.program import ProgramTable
+    from .config.tables import FrictionTable, GravityTable, MotorsTable
+    from .design.evaluate import Task, inertia_of
+    from .design.pareto import closest_to_ideal, pareto_mask
+    from .design.space import LENGTHS
+    from .design.sweep import Cluster, require_dask, run_sweep
+    from .geometry import FiveBar
+    from .output.config_file import model_toml
+    from .output.design import header, parse_line, row_line
+    from .output.files import write_bytes, write_text
+    from .units import SI
+
+    require_dask()
+    sc = load_scenario(config)
+    prog = sc.table("program")
+    assert isinstance(prog, ProgramTable)
+    if prog.start is None or not sc.moves:
+        raise ConfigError("dextar design sweeps a program task: give [program].start and "
+                          "[[move]] tables (see dextar program)")
+    space = sc.design.space(sc.robot_mm, samples=samples, seed=seed)
+    model = si_model(sc)
+    motors_t = sc.table("motors")
+    assert isinstance(motors_t, MotorsTable)
+    mode = prog.working_mode or sc.mode
+    task = Task(tuple(sc.moves), prog.start, mode, sc.assembly, motors_t.limits(SI),
+                motors_t.rms_torque, model.inertia, space.mass_per_length, sc.design.grid,
+                sc.tolerances)
+    designs = space.designs()
+    n = len(designs)
+    signature = hashlib.sha256(repr((Path(config).read_bytes(), space, sc.design.grid)).encode()
+                               ).hexdigest()
+    outdir = Path(out)
+    csv_path, meta_path = outdir / "designs.csv", outdir / "sweep.json"
+    rows: dict[int, dict[str, Any]] = {}
+    if resume:
+        if not (csv_path.is_file() and meta_path.is_file()):
+            raise ConfigError(f"--resume: {shown(out)} holds no sweep to resume (designs.csv "
+                              "and sweep.json)")
+        try:
+            same = json.loads(meta_path.read_text()).get("signature") == signature
+        except (ValueError, OSError):
+            same = False
+        if not same:
+            raise ConfigError(f"--resume: the sweep in {shown(out)} was made with another task, "
+                              "[design] or --samples/--seed; rerun without --resume (and "
+                              "--force to overwrite it)")
+        lines = csv_path.read_text().splitlines(keepends=True)[1:]
+        for line in lines:
+            r = parse_line(line)
+            if r is None or not 0 <= r["design"] < n:
+                continue
+            if not np.allclose([r[k] for k in LENGTHS], designs[r["design"]], rtol=1e-12):
+                raise ConfigError(f"--resume: design {r['design']} in {shown(csv_path)} has "
+                                  "other lengths than this sweep's")
+            rows[r["design"]] = r
+    else:
+        if outdir.exists() and (not outdir.is_dir() or any(outdir.iterdir())) and not force:
+            raise ConfigError(f"output directory {shown(out)!r} exists and is not empty; use "
+                              "--force to overwrite it or --resume to complete its sweep")
+    todo = [i for i in range(n) if i not in rows]
+    with Cluster(workers=workers, scheduler=scheduler) as cluster:
+        outdir.mkdir(parents=True, exist_ok=True)
+        write_text(meta_path, json.dumps({"signature": signature, "designs": n,
+                                          "task": config}) + "\n")
+        # the rows so far (a line cut short by a kill is dropped), then appended chunk by chunk
+        write_text(csv_path, header() + "".join(row_line(rows[i]) for i in sorted(rows)))
+        with open(csv_path, "a", encoding="utf-8") as fh:
+            def on_chunk(new: list[dict[str, Any]]) -> None:
+                for r in new:
+                    rows[r["design"]] = r
+                fh.write("".join(row_line(r) for r in new))
+                fh.flush()
+                os.fsync(fh.fileno())
+
+            stats = run_sweep(cluster, task, designs, todo, chunk=sc.design.chunk,
+                              on_chunk=on_chunk, progress=progress)
+    ordered = [rows[i] for i in range(n)]
+    write_text(csv_path, header() + "".join(row_line(r) for r in ordered))
+    feasible = [r for r in ordered if r["feasible"]]
+    summary: dict[str, Any] = {
+        "task": config, "designs": n, "feasible": len(feasible),
+        "feasible_fraction": len(feasible) / n, "objectives": list(space.objectives),
+        "sampling": space.sampling, "seed": space.seed,
+        "varied": [name for name, *_ in space.dims],
+        "mass_per_length_kg_m": list(space.mass_per_length) if space.mass_per_length else None,
+        "evaluated": stats.evaluated, "resumed": n - stats.evaluated,
+        "workers": stats.workers, "wall_time_s": stats.wall_s,
+        "designs_per_second": stats.evaluated / stats.wall_s if stats.wall_s > 0 else 0.0,
+        "pareto": 0, "best": None,
+        "reasons": _reason_counts(ordered)}
+    pareto_rows: list[dict[str, Any]] = []
+    pngs: dict[str, bytes] = {}
+    best_P = None
+    if feasible:
+        F = space.objective_values(feasible)
+        mask = pareto_mask(F)
+        idx = np.flatnonzero(mask)
+        b = int(idx[closest_to_ideal(F[idx])])
+        pareto_rows = [feasible[i] for i in idx]
+        best = feasible[b]
+        summary["pareto"], summary["best"] = len(pareto_rows), best
+        robot_mm = FiveBar(*(best[k] for k in LENGTHS))
+        friction_t, gravity_t = sc.table("friction"), sc.table("gravity")
+        assert isinstance(friction_t, FrictionTable) and isinstance(gravity_t, GravityTable)
+        extra = {k: v for k, v in load_toml(config).items() if k in ("motors", "tolerances")}
+        write_text(outdir / "best.toml", model_toml(
+            robot_mm, mode, sc.assembly, inertia_of(task, robot_mm.scaled(1e-3)),
+            coulomb_speed_deg_s=friction_t.coulomb_speed_deg_s,
+            gravity_mm_s2=gravity_t.vector, extra=extra,
+            comment=(f"the Pareto design closest to the ideal point of dextar design "
+                     f"{config} (design {best['design']} of {n}; objectives "
+                     f"{', '.join(space.objectives)})")))
+        if figures:
+            from .design.evaluate import evaluate_path
+            from .output.design import pareto_figure, scatter_matrix
+            from .output.figures import png_bytes, svg_bytes
+
+            best_P = evaluate_path(task, [best[k] for k in LENGTHS])
+            names = list(space.objectives)
+            X = np.array([[r[k] for k in LENGTHS] for r in ordered])
+            cols = sorted({c for *_, cs in space.dims for c in cs})
+            for name, fig in (
+                    ("pareto", pareto_figure(F, mask, b, names)),
+                    ("designs", scatter_matrix(X[:, cols], np.array([r["feasible"] for r in
+                                                                     ordered]),
+                                               [f"{LENGTHS[c]} [mm]" for c in cols])),
+                    ("best_workspace", _best_workspace(robot_mm, mode, best_P))):
+                pngs[name] = png_bytes(fig)
+                write_bytes(outdir / f"{name}.png", pngs[name])
+                write_bytes(outdir / f"{name}.svg", svg_bytes(fig))
+    write_text(outdir / "pareto.csv", header() + "".join(row_line(r) for r in pareto_rows))
+    if figures:
+        from .output.design import design_report
+
+        write_text(outdir / "report.html", design_report(summary, pareto_rows, pngs))
+    write_text(outdir / "summary.json", json.dumps(summary, indent=2, allow_nan=False) + "\n")
+    b_ = summary["best"]
+    text = (f"design sweep: {n} designs ({stats.evaluated} evaluated, {n - stats.evaluated} "
+            f"resumed) on {stats.workers} workers in {stats.wall_s:.1f} s "
+            f"({summary['designs_per_second']:.3g} designs/s); {len(feasible)} feasible, "
+            f"{len(pareto_rows)} on the Pareto front"
+            + (f"; chosen design {b_['design']}: l1 = {b_['l1']:.4g}, l2 = {b_['l2']:.4g}, "
+               f"L1 = {b_['L1']:.4g}, L2 = {b_['L2']:.4g}, d = {b_['d']:.4g} mm -> "
+               f"{shown(out, 'best.toml')}" if b_ else "; no feasible design"))
+    return JobResult(summary, text)
+
+
+def _reason_counts(rows: list[dict[str, Any]]) -> dict[str, int]:
+    """How many designs failed for each kind of reason (the text before its first colon)."""
+    out: dict[str, int] = {}
+    for r in rows:
+        if not r["feasible"]:
+            kind = str(r["reason"]).split(":")[0][:60]
+            out[kind] = out.get(kind, 0) + 1
+    return out
+
+
+def _best_workspace(robot_mm: Any, mode: str, P: Any) -> Any:
+    from .kinematics import workspace_map
+    from .output.figures import plot_workspace
+
+    ws = workspace_map(robot_mm, mode, resolution=241)
+    fig = plot_workspace(ws, path=P, unit="mm")
+    fig.axes[0].set_title(f"chosen design: l1 = {robot_mm.l1:.4g}, l2 = {robot_mm.l2:.4g}, "
+                          f"L1 = {robot_mm.L1:.4g}, L2 = {robot_mm.L2:.4g}, d = "
+                          f"{robot_mm.d:.4g} mm", fontsize=9)
+    return fig

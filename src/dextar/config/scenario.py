@@ -24,6 +24,7 @@ from ..paths import Path
 from ..program import Move
 from ..trajectory import Trajectory, check_path, sample_trajectory
 from ..units import Units
+from .design import DesignTable
 from .program import ProgramTable, read_moves
 from .tables import (
     TABLES,
@@ -88,6 +89,11 @@ class Scenario:
     def paper(self) -> PaperTable:
         """``[paper]``."""
         return self._get(PaperTable)
+
+    @property
+    def design(self) -> DesignTable:
+        """``[design]`` (a sweep's ranges and objectives)."""
+        return self._get(DesignTable)
 
     @property
     def tolerances(self) -> Tolerances:

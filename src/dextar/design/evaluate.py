@@ -1,0 +1,179 @@
+"""One design evaluated on the task: the program planned on that robot, its metrics, or the
+reason it fails.
+
+Everything a worker needs travels in a :class:`Task` (picklable, SI), so a design's row
+depends only on the task and the design's lengths: the same on any worker, in any chunk.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from scipy import ndimage
+
+from .._arrays import Array
+from ..dynamics import Inertia, Rod
+from ..errors import DextarError
+from ..geometry import FiveBar
+from ..kinematics import jacobian, workspace_map
+from ..kinematics.checker import Tolerances, pose_distances
+from ..laws import MotorLimits
+from ..program import Move, plan_program, sizing
+from .space import LENGTHS, METRICS
+
+#: Grid of the workspace map behind ``workspace_area_mm2`` (points per side).
+AREA_RESOLUTION = 81
+#: Setpoint rate of the plans a sweep makes (the sizing integrates over them).
+SWEEP_RATE_HZ = 500.0
+
+
+@dataclass(frozen=True)
+class Task:
+    """What a design is evaluated on (SI unless named).
+
+    Attributes
+    ----------
+    moves : tuple of Move
+    start_mm : (float, float)
+    working_mode, assembly : str
+    motors : MotorLimits, optional
+    rms_limit : (float, float), optional
+    template : Inertia
+        Effector, payload, rotors, friction and gravity; its rods are kept when
+        ``mass_per_length`` is None.
+    mass_per_length : (float, float), optional
+        kg/m of the proximal and distal rods.
+    grid : int
+        Time-optimal grid of each move.
+    tolerances : Tolerances
+    """
+
+    moves: tuple[Move, ...]
+    start_mm: tuple[float, float]
+    working_mode: str
+    assembly: str
+    motors: MotorLimits | None
+    rms_limit: tuple[float, float] | None
+    template: Inertia
+    mass_per_length: tuple[float, float] | None
+    grid: int
+    tolerances: Tolerances
+
+
+def footprint_mm(lengths: Sequence[float]) -> float:
+    """``max(l1 + L1, l2 + L2) + d / 2`` (mm): the half-width a robot sweeps from its middle."""
+    l1, l2, L1, L2, d = (float(v) for v in lengths)
+    return max(l1 + L1, l2 + L2) + 0.5 * d
+
+
+def inertia_of(task: Task, robot: FiveBar) -> Inertia:
+    """The task's inertia on ``robot`` (m): uniform rods of ``mass_per_length`` when given."""
+    if task.mass_per_length is None:
+        return task.template
+    mp, md = task.mass_per_length
+    return task.template.with_(
+        proximal=(Rod.uniform(mp * robot.l1, robot.l1), Rod.uniform(mp * robot.l2, robot.l2)),
+        distal=(Rod.uniform(md * robot.L1, robot.L1), Rod.uniform(md * robot.L2, robot.L2)))
+
+
+def usable_area_mm2(robot_mm: FiveBar, mode: str, start_mm: Sequence[float],
+                    tol: float) -> float:
+    """Area (mm^2) of the region of working mode ``mode`` around the task's start that the
+    end-effector reaches without meeting a parallel singularity (within ``tol``): the
+    connected cells of the workspace map holding the start, on a grid of
+    :data:`AREA_RESOLUTION` points per side."""
+    ws = workspace_map(robot_mm, mode, resolution=AREA_RESOLUTION)
+    free = ws.reachable & (np.abs(ws.type2) > tol)
+    x, y = ws.x, ws.y
+    i = int(np.argmin(np.abs(y - start_mm[1])))
+    j = int(np.argmin(np.abs(x - start_mm[0])))
+    labels, _ = ndimage.label(free)
+    lab = labels[i, j]
+    if lab == 0:  # the start's cell is on the boundary of the grid's region: its neighbours
+        near = labels[max(i - 1, 0):i + 2, max(j - 1, 0):j + 2]
+        lab = int(near.max())
+        if lab == 0:
+            return 0.0
+    return float((labels == lab).sum() * (x[1] - x[0]) * (y[1] - y[0]))
+
+
+def evaluate_design(task: Task, lengths: Sequence[float]) -> dict[str, Any]:
+    """The row of one design ``(l1, l2, L1, L2, d)`` (mm): its lengths, ``feasible``,
+    ``reason`` (empty when feasible) and the metrics of :data:`~dextar.design.space.METRICS`
+    (None where the plan failed before they exist)."""
+    row: dict[str, Any] = {k: float(v) for k, v in zip(LENGTHS, lengths, strict=True)}
+    row.update({"feasible": False, "reason": ""})
+    row.update(dict.fromkeys(METRICS))
+    row["footprint_mm"] = footprint_mm(lengths)
+    try:
+        robot_mm = FiveBar(*(float(v) for v in lengths))
+    except DextarError as exc:
+        row["reason"] = f"geometry: {exc}"
+        return row
+    robot = robot_mm.scaled(1e-3)
+    try:
+        res = plan_program(robot, inertia_of(task, robot), task.moves, start=task.start_mm,
+                           working_mode=task.working_mode, assembly=task.assembly,
+                           motors=task.motors, rms_limit=task.rms_limit,
+                           servo_rate_hz=SWEEP_RATE_HZ, grid=task.grid,
+                           tolerances=task.tolerances)
+    except DextarError as exc:
+        row["reason"] = str(exc)
+        return row
+    motors, violations = sizing(res)
+    d = pose_distances(robot, res.q, res.P)
+    J = jacobian(robot, res.q, res.P, tol=0.0)
+    s = np.linalg.svd(J, compute_uv=False)
+    row.update({
+        "cycle_time_s": res.cycle_time_s,
+        "min_type1_distance": float(d.type1.min()), "min_type2_distance": float(d.type2.min()),
+        "gci": float(np.mean(s[:, 1] / s[:, 0])),
+        "peak_torque_A_Nm": motors[0]["peak_torque_Nm"],
+        "peak_torque_D_Nm": motors[1]["peak_torque_Nm"],
+        "rms_torque_A_Nm": motors[0]["rms_torque_Nm"],
+        "rms_torque_D_Nm": motors[1]["rms_torque_Nm"],
+        "workspace_area_mm2": usable_area_mm2(robot_mm, task.working_mode, task.start_mm,
+                                              task.tolerances.type2)})
+    if violations:
+        v = violations[0]
+        where = f" at t = {v['t_s']:.4g} s in move {v['move']}" if v["t_s"] is not None else ""
+        row["reason"] = (f"motors exceeded: motor {v['motor']} {v['quantity']} "
+                         f"{v['value']:.4g} above {v['limit']:.4g}{where}")
+        return row
+    for k in METRICS:
+        if not math.isfinite(float(row[k])):
+            row["reason"] = f"{k} is not finite"
+            return row
+    row["feasible"] = True
+    return row
+
+
+def evaluate_chunk(task: Task, designs: Array, first: int) -> list[dict[str, Any]]:
+    """Rows of the designs (m, 5) numbered from ``first`` (the unit of work of a sweep). A
+    design whose evaluation raises an unexpected error is a row with that error as its
+    reason: the sweep never stops for one design, and the error shows in the file."""
+    rows = []
+    for k, lengths in enumerate(np.asarray(designs, float)):
+        try:
+            row = evaluate_design(task, lengths)
+        except Exception as exc:  # noqa: BLE001 - kept as the design's reason
+            row = {kk: float(v) for kk, v in zip(LENGTHS, lengths, strict=True)}
+            row.update({"feasible": False, "reason": f"internal error: {type(exc).__name__}: "
+                        f"{exc}", **dict.fromkeys(METRICS)})
+            row["footprint_mm"] = footprint_mm(lengths)
+        rows.append({"design": first + k, **row})
+    return rows
+
+
+def evaluate_path(task: Task, lengths: Sequence[float]) -> Array:
+    """The end-effector's path (n, 2) in mm of the task planned on one design (to draw it)."""
+    robot = FiveBar(*(float(v) for v in lengths)).scaled(1e-3)
+    res = plan_program(robot, inertia_of(task, robot), task.moves, start=task.start_mm,
+                       working_mode=task.working_mode, assembly=task.assembly,
+                       motors=task.motors, rms_limit=task.rms_limit,
+                       servo_rate_hz=SWEEP_RATE_HZ, grid=task.grid, tolerances=task.tolerances)
+    return np.asarray(res.P * 1e3)

@@ -1,0 +1,110 @@
+"""The design space of a sweep: ranges of the rod lengths and base distance, how they are
+sampled, and what is minimised.
+
+A design is a row ``(l1, l2, L1, L2, d)`` in mm. ``l`` (or ``L``) as one range gives both
+legs the same length (a symmetric robot, one dimension); ``l1`` and ``l2`` as two ranges make
+two dimensions. A length without a range keeps the task's value.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.stats import qmc
+
+from .._arrays import Array
+from ..errors import ConfigError
+
+#: The columns of a design, in mm.
+LENGTHS = ("l1", "l2", "L1", "L2", "d")
+#: The metrics a design has (``-`` before one in ``objectives`` maximises it).
+METRICS = ("cycle_time_s", "footprint_mm", "min_type1_distance", "min_type2_distance", "gci",
+           "peak_torque_A_Nm", "peak_torque_D_Nm", "rms_torque_A_Nm", "rms_torque_D_Nm",
+           "workspace_area_mm2")
+SAMPLINGS = ("sobol", "grid", "random")
+
+
+@dataclass(frozen=True)
+class DesignSpace:
+    """What a sweep varies and minimises.
+
+    Attributes
+    ----------
+    dims : tuple of (name, lo, hi, columns)
+        Each dimension: its config name, its range in mm and the design columns it sets.
+    fixed : (float, float, float, float, float)
+        The task's lengths (mm), for the columns no dimension sets.
+    mass_per_length : (float, float), optional
+        kg/m of the proximal and distal rods (uniform rods whose masses follow the lengths);
+        None keeps the task's rods.
+    samples : int
+    sampling : str
+    seed : int
+    objectives : tuple of str
+    """
+
+    dims: tuple[tuple[str, float, float, tuple[int, ...]], ...]
+    fixed: tuple[float, float, float, float, float]
+    mass_per_length: tuple[float, float] | None
+    samples: int
+    sampling: str
+    seed: int
+    objectives: tuple[str, ...]
+
+    def __post_init__(self) -> None:
+        if not self.dims:
+            raise ConfigError("config table [design] varies nothing: give a range for l, L, "
+                              "l1, l2, L1, L2 or d")
+        for name, lo, hi, _ in self.dims:
+            if not (math.isfinite(lo) and math.isfinite(hi)):
+                raise ConfigError(f"config key [design].{name} = [{lo}, {hi}] must be finite")
+            if lo > hi:
+                raise ConfigError(f"config key [design].{name} = [{lo:g}, {hi:g}] is inverted "
+                                  "(the low end first)")
+            if lo == hi:
+                raise ConfigError(f"config key [design].{name} = [{lo:g}, {hi:g}] is empty: "
+                                  "leave the key out to keep the task's value")
+            if lo < 0 or (lo == 0 and name != "d"):
+                raise ConfigError(f"config key [design].{name} = [{lo:g}, {hi:g}] must be "
+                                  f"{'>= 0' if name == 'd' else 'positive'} mm")
+        if self.sampling not in SAMPLINGS:
+            raise ConfigError(f"config key [design].sampling = {self.sampling!r}: one of "
+                              f"{', '.join(SAMPLINGS)}")
+        for obj in self.objectives:
+            if obj.lstrip("-") not in METRICS:
+                raise ConfigError(f"config key [design].objectives: unknown objective {obj!r}; "
+                                  f"known: {', '.join(METRICS)} (a leading - maximises)")
+        if not self.objectives:
+            raise ConfigError("config key [design].objectives is empty")
+
+    def designs(self) -> Array:
+        """The sampled designs, shape (n, 5) in mm (``n = samples``; for ``grid``, the
+        smallest full grid with at least ``samples`` points, cut to ``samples``)."""
+        k = len(self.dims)
+        n = self.samples
+        if self.sampling == "sobol":
+            with warnings.catch_warnings():  # not a power of 2: balance is not needed here
+                warnings.simplefilter("ignore", UserWarning)
+                u = qmc.Sobol(d=k, scramble=True, seed=self.seed).random(n)
+        elif self.sampling == "random":
+            u = np.random.default_rng(self.seed).random((n, k))
+        else:
+            m = max(2, math.ceil(n ** (1.0 / k) - 1e-9))
+            axes = np.meshgrid(*([np.linspace(0.0, 1.0, m)] * k), indexing="ij")
+            u = np.stack([a.ravel() for a in axes], -1)[:n]
+        out = np.tile(np.asarray(self.fixed, float), (len(u), 1))
+        for j, (_name, lo, hi, cols) in enumerate(self.dims):
+            for c in cols:
+                out[:, c] = lo + (hi - lo) * u[:, j]
+        return out
+
+    def objective_values(self, rows: list[dict[str, float]]) -> Array:
+        """The objectives of ``rows`` to minimise, shape (n, n_objectives)."""
+        F = np.empty((len(rows), len(self.objectives)))
+        for j, obj in enumerate(self.objectives):
+            sign = -1.0 if obj.startswith("-") else 1.0
+            F[:, j] = [sign * float(r[obj.lstrip("-")]) for r in rows]
+        return F

@@ -1,0 +1,150 @@
+"""The sweep engine: designs go out to Dask workers in chunks and come back as rows.
+
+Dask (``dask.distributed``) runs the chunks: a ``LocalCluster`` of worker processes by
+default, or a running cluster by its scheduler's address. A chunk is evaluated by
+:func:`~dextar.design.evaluate.evaluate_chunk`; a worker that dies has its chunks retried by
+Dask; a design that fails is a row with its reason, so the sweep never stops for one design.
+Rows reach the caller chunk by chunk (``on_chunk``), in the order chunks finish.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .._arrays import Array
+from ..errors import ConfigError
+from .evaluate import Task, evaluate_chunk
+
+#: How to get the extra that holds Dask.
+INSTALL_HINT = "pip install -e '.[design]' (or pip install 'dextar[design]')"
+#: Seconds to wait for a scheduler given by address.
+CONNECT_TIMEOUT_S = 10
+
+
+@dataclass(frozen=True)
+class SweepStats:
+    """What a sweep run did: designs evaluated, wall time (s) and workers."""
+
+    evaluated: int
+    wall_s: float
+    workers: int
+
+
+def require_dask() -> Any:
+    """The ``distributed`` module, or a :class:`ConfigError` naming the extra to install."""
+    try:
+        import distributed
+    except ImportError:
+        raise ConfigError(f"dextar design needs Dask (dask.distributed): {INSTALL_HINT}"
+                          ) from None
+    return distributed
+
+
+def chunks_of(indices: Sequence[int], size: int) -> list[list[int]]:
+    """``indices`` (sorted) in runs of at most ``size`` consecutive design numbers."""
+    out: list[list[int]] = []
+    for i in indices:
+        if out and len(out[-1]) < size and out[-1][-1] == i - 1:
+            out[-1].append(i)
+        else:
+            out.append([i])
+    return out
+
+
+class Cluster:
+    """A Dask client: on a new ``LocalCluster`` of ``workers`` processes (default: the
+    cores), or on the running scheduler at ``scheduler``. A context manager; closing it
+    closes the local cluster."""
+
+    def __init__(self, *, workers: int | None = None, scheduler: str | None = None) -> None:
+        """Connect (within :data:`CONNECT_TIMEOUT_S` for a scheduler address).
+
+        Raises
+        ------
+        ConfigError
+            Dask is not installed, ``workers`` is not positive, or no scheduler answers.
+        """
+        distributed = require_dask()
+        if workers is not None and workers < 1:
+            raise ConfigError(f"--workers {workers} must be at least 1")
+        self.cluster = None
+        if scheduler is not None:
+            try:
+                self.client = distributed.Client(scheduler, timeout=f"{CONNECT_TIMEOUT_S}s")
+            except (OSError, TimeoutError, ValueError, TypeError) as exc:
+                raise ConfigError(f"--scheduler {scheduler!r}: no Dask scheduler answers "
+                                  f"there within {CONNECT_TIMEOUT_S} s ({type(exc).__name__}: "
+                                  f"{exc})") from None
+        else:
+            self.cluster = distributed.LocalCluster(n_workers=workers, threads_per_worker=1,
+                                                    processes=True, dashboard_address=None)
+            self.client = distributed.Client(self.cluster)
+
+    @property
+    def workers(self) -> int:
+        """Workers the scheduler knows now."""
+        return len(self.client.scheduler_info().get("workers", {}))
+
+    def close(self) -> None:
+        """Close the client (and the local cluster)."""
+        self.client.close()
+        if self.cluster is not None:
+            self.cluster.close()
+
+    def __enter__(self) -> Cluster:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def run_sweep(cluster: Cluster, task: Task, designs: Array, todo: Sequence[int], *,
+              chunk: int, on_chunk: Callable[[list[dict[str, Any]]], None],
+              progress: Callable[[int, int], None] | None = None) -> SweepStats:
+    """Evaluate the designs numbered ``todo`` (rows of ``designs`` (n, 5), mm) on Dask.
+
+    Parameters
+    ----------
+    cluster : Cluster
+    task : Task
+    designs : ndarray, shape (n, 5)
+    todo : sequence of int
+        The designs to evaluate (the others are done already).
+    chunk : int
+        Designs per unit of work.
+    on_chunk : callable
+        Called in this process with each finished chunk's rows, as chunks finish.
+    progress : callable, optional
+        ``progress(done, total)`` after each chunk.
+
+    Returns
+    -------
+    SweepStats
+    """
+    distributed = require_dask()
+    t0 = time.perf_counter()
+    client = cluster.client
+    n_workers = cluster.workers
+    done = 0
+    if todo:
+        task_f = client.scatter(task, broadcast=True)
+        parts = chunks_of(sorted(todo), chunk)
+        futures = [client.submit(evaluate_chunk, task_f, designs[p[0]:p[-1] + 1], p[0],
+                                 pure=False, retries=2) for p in parts]
+        for fut in distributed.as_completed(futures):
+            rows = fut.result()
+            on_chunk(rows)
+            done += len(rows)
+            if progress is not None:
+                progress(done, len(todo))
+    return SweepStats(len(todo), time.perf_counter() - t0, n_workers)
+
+
+def local_rows(task: Task, designs: Array, indices: Sequence[int]) -> list[dict[str, Any]]:
+    """The rows of some designs evaluated in this process (to check a sweep's rows)."""
+    return [r for i in indices for r in evaluate_chunk(task, np.asarray(designs)[i:i + 1], i)]

@@ -1,0 +1,129 @@
+"""Writing a design sweep: the rows of ``designs.csv`` (one formatting for rows fresh and
+resumed, so a resumed sweep ends with the same bytes), the figures and the report."""
+
+from __future__ import annotations
+
+import csv
+import html
+import io
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from .._arrays import Array
+from ..design.space import LENGTHS, METRICS
+from .html_page import figures, page
+
+#: Columns of designs.csv and pareto.csv.
+COLUMNS = ("design", *(f"{k}_mm" for k in LENGTHS), "feasible", "reason", *METRICS)
+
+
+def header() -> str:
+    """The CSV header line."""
+    return ",".join(COLUMNS) + "\n"
+
+
+def row_line(row: Mapping[str, Any]) -> str:
+    """One design's CSV line: numbers to 17 digits, an empty cell for a metric that does not
+    exist (the plan failed first), ``true``/``false`` for ``feasible``."""
+    cells: list[str] = [str(int(row["design"]))]
+    cells += [repr(float(row[k])) for k in LENGTHS]
+    cells += ["true" if row["feasible"] else "false", str(row["reason"])]
+    cells += ["" if row[k] is None else repr(float(row[k])) for k in METRICS]
+    buf = io.StringIO()
+    csv.writer(buf, lineterminator="\n").writerow(cells)
+    return buf.getvalue()
+
+
+def parse_line(line: str) -> dict[str, Any] | None:
+    """A row back from its CSV line; None for a line cut short (a sweep killed mid-write)."""
+    if not line.endswith("\n"):
+        return None
+    try:
+        cells = next(csv.reader([line]))
+    except (csv.Error, StopIteration):
+        return None
+    if len(cells) != len(COLUMNS):
+        return None
+    try:
+        row: dict[str, Any] = {"design": int(cells[0])}
+        row.update({k: float(c) for k, c in zip(LENGTHS, cells[1:6], strict=True)})
+        row["feasible"] = cells[6] == "true"
+        row["reason"] = cells[7]
+        row.update({k: None if c == "" else float(c)
+                    for k, c in zip(METRICS, cells[8:], strict=True)})
+    except ValueError:
+        return None
+    return row
+
+
+def pareto_figure(F: Array, pareto: Array, best: int, names: Sequence[str]) -> Figure:
+    """The feasible designs on the first two objectives (minimised; a maximised objective
+    is drawn with its sign), the Pareto designs marked, the chosen one starred."""
+    fig = Figure(figsize=(6.0, 4.6))
+    ax = fig.subplots()
+    if F.shape[1] == 1:
+        ax.plot(np.sort(F[:, 0]), ".", color="0.6", label="feasible designs (sorted)")
+        ax.set_ylabel(names[0])
+        ax.set_xlabel("rank")
+    else:
+        ax.scatter(F[:, 0], F[:, 1], s=8, color="0.7", label="feasible designs")
+        ax.scatter(F[pareto, 0], F[pareto, 1], s=18, color="C0", label="Pareto designs")
+        ax.scatter(F[best, 0], F[best, 1], s=140, marker="*", color="C3", label="chosen")
+        ax.set_xlabel(names[0])
+        ax.set_ylabel(names[1])
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    return fig
+
+
+def scatter_matrix(X: Array, feasible: Array, names: Sequence[str]) -> Figure:
+    """Every pair of varied lengths (mm), feasible designs in blue, the others in grey."""
+    k = X.shape[1]
+    fig = Figure(figsize=(2.2 * k + 1, 2.2 * k + 1))
+    axes = fig.subplots(k, k, squeeze=False)
+    for i in range(k):
+        for j in range(k):
+            ax = axes[i, j]
+            if i == j:
+                ax.hist([X[feasible, i], X[~feasible, i]], bins=20, stacked=True,
+                        color=["C0", "0.7"])
+            else:
+                ax.scatter(X[~feasible, j], X[~feasible, i], s=3, color="0.7")
+                ax.scatter(X[feasible, j], X[feasible, i], s=3, color="C0")
+            if i == k - 1:
+                ax.set_xlabel(names[j])
+            if j == 0:
+                ax.set_ylabel(names[i])
+            ax.tick_params(labelsize=7)
+    fig.suptitle("designs: feasible (blue) and not (grey)")
+    fig.tight_layout()
+    return fig
+
+
+def design_report(summary: Mapping[str, Any], pareto_rows: Sequence[Mapping[str, Any]],
+                  pngs: dict[str, bytes]) -> str:
+    """The sweep's report: counts, the chosen design, the Pareto designs, the figures."""
+    esc = html.escape
+    facts = [(k, summary[k]) for k in ("designs", "feasible", "feasible_fraction", "pareto",
+                                       "objectives", "sampling", "seed", "workers",
+                                       "wall_time_s", "designs_per_second", "evaluated",
+                                       "resumed") if k in summary]
+    rows = "".join(f"<tr><td>{esc(k)}</td><td>{esc(str(v))}</td></tr>" for k, v in facts)
+    head = "".join(f"<th>{esc(c)}</th>" for c in COLUMNS if c not in ("feasible", "reason"))
+    body = "".join(
+        f"<tr><td>{r['design']}</td>" + "".join(f"<td>{float(r[k]):.4g}</td>"
+                                                for k in (*LENGTHS, *METRICS)) + "</tr>"
+        for r in pareto_rows)
+    best = summary.get("best")
+    chosen = (f"<p>Chosen (the Pareto design closest to the ideal point): design "
+              f"{best['design']}, l1 = {best['l1']:.4g}, l2 = {best['l2']:.4g}, L1 = "
+              f"{best['L1']:.4g}, L2 = {best['L2']:.4g}, d = {best['d']:.4g} mm; written to "
+              "best.toml.</p>") if best else "<p>No feasible design.</p>"
+    return page("dextar design sweep",
+                f"<h1>Design sweep of {esc(str(summary['task']))}</h1><table>{rows}</table>"
+                f"{chosen}<h2>Pareto designs</h2><table><tr>{head}</tr>{body}</table>"
+                f"<h2>Figures</h2>{figures(pngs)}")
