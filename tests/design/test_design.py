@@ -1,0 +1,216 @@
+"""dextar design: a sweep on local Dask workers whose rows are the single-design function's,
+the Pareto set by brute force, the same file for 1 and 2 workers and after a kill and a
+resume, and bad input refused by name."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from dextar.cli import main
+from dextar.config import load_scenario
+from dextar.design.evaluate import Task, evaluate_design
+from dextar.design.pareto import closest_to_ideal, pareto_mask
+from dextar.jobs import si_model
+from dextar.output.design import parse_line
+from dextar.units import SI
+
+pytest.importorskip("distributed")
+
+TASK = """
+[robot]
+preset = "dextar"
+working_mode = "+-"
+[inertia]
+effector_mass = 0.08
+payload = 0.05
+[friction]
+coulomb = 0.02
+viscous = 0.01
+[gravity]
+vector = [0.0, -9810.0]
+[motors]
+peak_torque = 3.4
+max_speed_rpm = 30
+[program]
+start = [-40.0, 110.0]
+[[move]]
+type = "line"
+to = [40.0, 110.0]
+[[move]]
+type = "dwell"
+time = 0.1
+[design]
+l = [50.0, 120.0]
+L = [60.0, 140.0]
+d = [0.0, 100.0]
+mass_per_length = [0.4, 0.3]
+samples = 64
+chunk = 4
+grid = 30
+"""
+
+
+def write_task(folder: Path, extra: str = "", design: str | None = None) -> Path:
+    text = TASK if design is None else TASK.split("[design]")[0] + design
+    path = folder / "task.toml"
+    path.write_text(text + extra)
+    return path
+
+
+def rows_of(out: Path) -> list[dict]:
+    lines = (out / "designs.csv").read_text().splitlines(keepends=True)[1:]
+    return [parse_line(x) for x in lines]
+
+
+@pytest.fixture(scope="module")
+def sweep2(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("sweep")
+    task = write_task(folder)
+    out = folder / "two"
+    assert main(["design", str(task), "--out", str(out), "--workers", "2", "--quiet"]) == 0
+    return task, out
+
+
+def test_rows_are_the_single_design_function(sweep2):
+    task_path, out = sweep2
+    rows = rows_of(out)
+    assert [r["design"] for r in rows] == list(range(64))
+    sc = load_scenario(task_path)
+    prog = sc.table("program")
+    mt = sc.table("motors")
+    task = Task(tuple(sc.moves), prog.start, sc.mode, sc.assembly, mt.limits(SI),
+                mt.rms_torque, si_model(sc).inertia, (0.4, 0.3), 30, sc.tolerances)
+    for i in (0, 7, 21, 42, 63):
+        direct = evaluate_design(task, [rows[i][k] for k in ("l1", "l2", "L1", "L2", "d")])
+        for k, v in direct.items():
+            if isinstance(v, float):
+                assert rows[i][k] == pytest.approx(v, rel=1e-12), (i, k)
+            else:
+                assert rows[i][k] == v, (i, k)
+    # the sweep meets every kind of design: feasible ones and refused ones with a reason
+    assert any(r["feasible"] for r in rows) and any(not r["feasible"] for r in rows)
+    assert all(r["reason"] for r in rows if not r["feasible"])
+
+
+def test_pareto_set_by_brute_force(sweep2):
+    _, out = sweep2
+    rows = [r for r in rows_of(out) if r["feasible"]]
+    F = np.array([[r["cycle_time_s"], r["footprint_mm"], -r["min_type2_distance"]]
+                  for r in rows])
+    brute = {rows[i]["design"] for i in range(len(rows))
+             if not any(all(F[j] <= F[i]) and any(F[j] < F[i]) for j in range(len(rows)))}
+    written = {r["design"] for r in
+               (parse_line(x) for x in (out / "pareto.csv").read_text().splitlines(True)[1:])}
+    assert written == brute and brute
+    s = json.loads((out / "summary.json").read_text())
+    assert s["pareto"] == len(brute) and s["designs"] == 64
+    assert s["feasible"] == len(rows) and s["best"]["design"] in brute
+    # best.toml is a config every command takes: the chosen robot's lengths
+    sc = load_scenario(out / "best.toml")
+    assert sc.robot_mm.l1 == pytest.approx(s["best"]["l1"], rel=1e-12)
+
+
+def test_pareto_helpers_on_a_known_front():
+    F = np.array([[1, 5], [2, 2], [5, 1], [3, 3], [2, 2], [6, 6]], float)
+    assert pareto_mask(F).tolist() == [True, True, True, False, True, False]
+    assert closest_to_ideal(F[[0, 1, 2]]) == 1
+
+
+def test_one_worker_gives_the_same_file(sweep2, tmp_path):
+    task, out2 = sweep2
+    out1 = tmp_path / "one"
+    assert main(["design", str(task), "--out", str(out1), "--workers", "1", "--quiet"]) == 0
+    assert (out1 / "designs.csv").read_bytes() == (out2 / "designs.csv").read_bytes()
+    assert (out1 / "pareto.csv").read_bytes() == (out2 / "pareto.csv").read_bytes()
+
+
+def test_a_killed_sweep_resumes_to_the_same_file(sweep2, tmp_path):
+    task, out2 = sweep2
+    out = tmp_path / "killed"
+    proc = subprocess.Popen([sys.executable, "-m", "dextar", "design", str(task), "--out",
+                             str(out), "--workers", "1", "--quiet"], start_new_session=True)
+    csv_path = out / "designs.csv"
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline:
+        if csv_path.exists() and len(csv_path.read_text().splitlines()) > 20:
+            break
+        if proc.poll() is not None:
+            break
+        time.sleep(0.05)
+    os.killpg(proc.pid, signal.SIGKILL)
+    proc.wait()
+    partial = csv_path.read_text()
+    done = len(partial.splitlines()) - 1
+    assert 0 < done < 64, done  # killed half-way
+    # a line cut short by the kill is dropped on resume
+    csv_path.write_text(partial + "64,1.0,2.")
+    assert main(["design", str(task), "--out", str(out), "--resume", "--quiet"]) == 0
+    assert csv_path.read_bytes() == (out2 / "designs.csv").read_bytes()
+    s = json.loads((out / "summary.json").read_text())
+    assert s["resumed"] == done and s["evaluated"] == 64 - done
+
+
+@pytest.mark.parametrize("design, message", [
+    ('l = [120.0, 50.0]\nsamples = 4\n', r"\[design\].l = \[120, 50\] is inverted"),
+    ('l = [70.0, 70.0]\nsamples = 4\n', r"\[design\].l = \[70, 70\] is empty"),
+    ('l = [50.0, 120.0]\nobjectives = ["speed"]\n', "unknown objective 'speed'"),
+    ('samples = 4\n', r"\[design\] varies nothing"),
+    ('l = [50.0, 120.0]\nl1 = [50.0, 60.0]\n', r"\[design\].l and \[design\].l1 both"),
+])
+def test_bad_design_tables_exit_2(tmp_path, capsys, design, message):
+    task = write_task(tmp_path, design=f"[design]\n{design}")
+    assert main(["design", str(task), "--out", str(tmp_path / "o"), "--workers", "1"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and __import__("re").search(message, err), err
+    assert not (tmp_path / "o").exists()
+
+
+def test_geometries_that_cannot_assemble_are_rows(tmp_path):
+    """Rods too short for the base: every design is a row with its reason, no crash."""
+    task = write_task(tmp_path, design='[design]\nl = [5.0, 10.0]\nL = [5.0, 10.0]\n'
+                                       'd = [60.0, 100.0]\nsamples = 8\ngrid = 30\n')
+    assert main(["design", str(task), "--out", str(tmp_path / "o"), "--workers", "1",
+                 "--quiet"]) == 0
+    rows = rows_of(tmp_path / "o")
+    assert len(rows) == 8 and not any(r["feasible"] for r in rows)
+    assert all(r["reason"] for r in rows)
+    s = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert s["feasible"] == 0 and s["best"] is None
+
+
+def test_unreachable_scheduler_is_named_within_10_s(tmp_path, capsys):
+    task = write_task(tmp_path)
+    t0 = time.monotonic()
+    assert main(["design", str(task), "--out", str(tmp_path / "o"), "--scheduler",
+                 "tcp://127.0.0.1:9"]) == 2
+    assert time.monotonic() - t0 < 15
+    err = capsys.readouterr().err
+    assert "--scheduler 'tcp://127.0.0.1:9': no Dask scheduler answers" in err
+    assert len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "o").exists()
+
+
+def test_without_dask_the_extra_is_named(tmp_path, capsys, monkeypatch):
+    monkeypatch.setitem(sys.modules, "distributed", None)
+    task = write_task(tmp_path)
+    assert main(["design", str(task), "--out", str(tmp_path / "o")]) == 2
+    assert "pip install -e '.[design]'" in capsys.readouterr().err
+
+
+def test_resume_refuses_another_sweep(sweep2, tmp_path, capsys):
+    task, out2 = sweep2
+    import shutil
+
+    out = tmp_path / "copy"
+    shutil.copytree(out2, out)
+    assert main(["design", str(task), "--out", str(out), "--resume", "--seed", "5"]) == 2
+    assert "was made with another task" in capsys.readouterr().err
+    assert main(["design", str(task), "--out", str(out)]) == 2
+    assert "--resume" in capsys.readouterr().err
