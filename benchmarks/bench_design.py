@@ -1,7 +1,12 @@
-"""Design sweep speed: designs per second on one core (in this process, no Dask), then a
-Dask local cluster of 1, 2 and 4 workers on the same designs, and the parallel efficiency
-(designs/s at N workers over N times that at 1). The task is the pick-and-place example
-(time-optimal moves, blended corners, dwells), with [design] ranges as in the README.
+"""Design sweep speed, printed: designs per second on one core in this process (no Dask) for
+
+* a ``dextar run`` task (examples/line_si.toml: one line, a min-jerk law, motors added):
+  geometry and torque metrics, no time-optimal law (issue floor: 200 designs/s per core);
+* the pick-and-place program (time-optimal moves, blended corners, dwells, a fitted law)
+  (issue floor: 20 designs/s per core);
+
+then each task on a Dask local cluster of 1, 2 and 4 workers, with the parallel efficiency
+(designs/s at N workers over N times that at 1; this machine's core count is printed).
 
 Run: python benchmarks/bench_design.py [--designs 48]
 """
@@ -10,49 +15,67 @@ from __future__ import annotations
 
 import argparse
 import os
+import tempfile
 import time
 from pathlib import Path
 
 from dextar.config import load_toml
-from dextar.config.scenario import scenario_from_dict
-from dextar.design.evaluate import Task, evaluate_chunk
+from dextar.design.evaluate import evaluate_chunk
 from dextar.design.sweep import Cluster, run_sweep
-from dextar.jobs import si_model
-from dextar.units import SI
+from dextar.jobs import design_task
 
-EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "pick_place.toml"
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+RANGES = {"l": [50.0, 120.0], "L": [60.0, 140.0], "d": [0.0, 100.0],
+          "mass_per_length": [0.4, 0.3]}
+
+
+def task_file(folder: Path, example: str, samples: int, extra: dict) -> Path:
+    from tests.robustness.harness import toml_text
+
+    doc = load_toml(EXAMPLES / example)
+    doc.update(extra)
+    doc["design"] = {**RANGES, "samples": samples}
+    path = folder / example
+    path.write_text(toml_text(doc))
+    return path
+
+
+def measure(name: str, path: Path, chunk: int) -> None:
+    task, space = design_task(str(path))
+    designs = space.designs()
+    evaluate_chunk(task, designs[:2], 0)  # warm caches
+    t0 = time.perf_counter()
+    rows = evaluate_chunk(task, designs, 0)
+    serial = len(rows) / (time.perf_counter() - t0)
+    print(f"{name}: {len(rows)} designs ({sum(r['feasible'] for r in rows)} feasible), "
+          f"{serial:.1f} designs/s on one core in this process")
+    base = None
+    for n in (1, 2, 4):
+        with Cluster(workers=n) as cl:
+            run_sweep(cl, task, designs, range(min(8, len(designs))), chunk=chunk,
+                      on_chunk=lambda rows: None)  # workers warm
+            stats = run_sweep(cl, task, designs, range(len(designs)), chunk=chunk,
+                              on_chunk=lambda rows: None)
+        rate = stats.evaluated / stats.wall_s
+        base = base or rate
+        print(f"  dask, {n} worker(s): {rate:.1f} designs/s, efficiency "
+              f"{rate / (n * base):.2f} ({os.cpu_count()} cores here)")
 
 
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--designs", type=int, default=48)
     args = ap.parse_args()
-    doc = load_toml(EXAMPLE)
-    doc["design"] = {"l": [50.0, 120.0], "L": [60.0, 140.0], "d": [0.0, 100.0],
-                     "mass_per_length": [0.4, 0.3], "samples": args.designs}
-    sc = scenario_from_dict(doc)
-    space = sc.design.space(sc.robot_mm)
-    designs = space.designs()
-    prog, mt = sc.table("program"), sc.table("motors")
-    task = Task(tuple(sc.moves), prog.start, sc.mode, sc.assembly, mt.limits(SI),
-                mt.rms_torque, si_model(sc).inertia, space.mass_per_length, sc.design.grid,
-                sc.tolerances)
-    t0 = time.perf_counter()
-    rows = evaluate_chunk(task, designs, 0)
-    serial = len(rows) / (time.perf_counter() - t0)
-    feasible = sum(r["feasible"] for r in rows)
-    print(f"pick-and-place task, {len(rows)} designs ({feasible} feasible), time-optimal grid "
-          f"{sc.design.grid}: {serial:.2f} designs/s on one core in this process "
-          "(issue floor: 20)")
-    base = None
-    for n in (1, 2, 4):
-        with Cluster(workers=n) as cl:
-            stats = run_sweep(cl, task, designs, range(len(designs)), chunk=2,
-                              on_chunk=lambda rows: None)
-        rate = stats.evaluated / stats.wall_s
-        base = base or rate
-        print(f"dask, {n} worker(s): {rate:.2f} designs/s, efficiency {rate / (n * base):.2f} "
-              f"({os.cpu_count()} cores here)")
+    import sys
+
+    sys.path.insert(0, str(EXAMPLES.parent))
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        run = task_file(folder, "line_si.toml", 20 * args.designs,
+                        {"motors": {"peak_torque": 1.0}})
+        measure("run task (line, min-jerk; floor 200/s per core)", run, 64)
+        prog = task_file(folder, "pick_place.toml", args.designs, {})
+        measure("pick-and-place program (time-optimal; floor 20/s per core)", prog, 2)
 
 
 if __name__ == "__main__":

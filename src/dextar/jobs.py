@@ -558,9 +558,8 @@ def design(config: str, out: str, *, samples: int | None = None, seed: int | Non
     import hashlib
     import os
 
-    from .config.program import ProgramTable
-    from .config.tables import FrictionTable, GravityTable, MotorsTable
-    from .design.evaluate import Task, inertia_of
+    from .config.tables import FrictionTable, GravityTable
+    from .design.evaluate import inertia_of
     from .design.pareto import closest_to_ideal, pareto_mask
     from .design.space import LENGTHS
     from .design.sweep import Cluster, require_dask, run_sweep
@@ -568,23 +567,11 @@ def design(config: str, out: str, *, samples: int | None = None, seed: int | Non
     from .output.config_file import model_toml
     from .output.design import header, parse_line, row_line
     from .output.files import write_bytes, write_text
-    from .units import SI
 
     require_dask()
     sc = load_scenario(config)
-    prog = sc.table("program")
-    assert isinstance(prog, ProgramTable)
-    if prog.start is None or not sc.moves:
-        raise ConfigError("dextar design sweeps a program task: give [program].start and "
-                          "[[move]] tables (see dextar program)")
-    space = sc.design.space(sc.robot_mm, samples=samples, seed=seed)
-    model = si_model(sc)
-    motors_t = sc.table("motors")
-    assert isinstance(motors_t, MotorsTable)
-    mode = prog.working_mode or sc.mode
-    task = Task(tuple(sc.moves), prog.start, mode, sc.assembly, motors_t.limits(SI),
-                motors_t.rms_torque, model.inertia, space.mass_per_length, sc.design.grid,
-                sc.tolerances)
+    task, space = design_task(config, samples=samples, seed=seed, scenario=sc)
+    mode = task.working_mode
     designs = space.designs()
     n = len(designs)
     signature = hashlib.sha256(repr((Path(config).read_bytes(), space, sc.design.grid)).encode()
@@ -638,7 +625,7 @@ def design(config: str, out: str, *, samples: int | None = None, seed: int | Non
     write_text(csv_path, header() + "".join(row_line(r) for r in ordered))
     feasible = [r for r in ordered if r["feasible"]]
     summary: dict[str, Any] = {
-        "task": config, "designs": n, "feasible": len(feasible),
+        "task": config, "task_kind": task.kind, "designs": n, "feasible": len(feasible),
         "feasible_fraction": len(feasible) / n, "objectives": list(space.objectives),
         "sampling": space.sampling, "seed": space.seed,
         "varied": [name for name, *_ in space.dims],
@@ -705,12 +692,60 @@ def design(config: str, out: str, *, samples: int | None = None, seed: int | Non
     return JobResult(summary, text)
 
 
+def design_task(config: str, *, samples: int | None = None, seed: int | None = None,
+                scenario: Scenario | None = None) -> tuple[Any, Any]:
+    """The :class:`~dextar.design.evaluate.Task` and the design space of a sweep's task file:
+    a program task (``[program]`` and ``[[move]]``) or a run task (``[path]`` and ``[law]``;
+    a law that does not depend on the robot is computed once here)."""
+    from .config.program import ProgramTable
+    from .config.tables import MotorsTable
+    from .design.evaluate import Task
+    from .units import SI
+
+    sc = scenario or load_scenario(config)
+    prog = sc.table("program")
+    assert isinstance(prog, ProgramTable)
+    space = sc.design.space(sc.robot_mm, samples=samples, seed=seed)
+    model = si_model(sc)
+    motors_t = sc.table("motors")
+    assert isinstance(motors_t, MotorsTable)
+    motors = motors_t.limits(SI)
+    if sc.moves:  # a program task
+        if prog.start is None:
+            raise ConfigError("config key [program].start is required (the start point, at "
+                              "rest)")
+        mode = prog.working_mode or sc.mode
+        task = Task(tuple(sc.moves), prog.start, mode, sc.assembly, motors,
+                    motors_t.rms_torque, model.inertia, space.mass_per_length, sc.design.grid,
+                    sc.tolerances)
+    else:  # a run task: one path and law
+        from .laws import LawRequest
+
+        mode = sc.mode
+        path = sc.path_table.build(SI)
+        kind = sc.law_table.kind
+        values = sc.law_table.run_values(SI)
+        law = None if kind.needs_dynamics else kind.build(LawRequest(
+            path, values, model.inertia.point_mass, None, SI, motors))
+        start = path.position(0.0) * 1e3
+        task = Task((), (float(start[0]), float(start[1])), mode, sc.assembly, motors,
+                    motors_t.rms_torque, model.inertia, space.mass_per_length, sc.design.grid,
+                    sc.tolerances, path=path, law=law,
+                    law_type=kind.name if law is None else None,
+                    law_values=values if law is None else None)
+    return task, space
+
+
 def _reason_counts(rows: list[dict[str, Any]]) -> dict[str, int]:
-    """How many designs failed for each kind of reason (the text before its first colon)."""
+    """How many designs failed for each kind of reason."""
+    kinds = (("geometry", "geometry"), ("motors exceeded", "motors exceeded"),
+             ("singularity", "singularity"), ("out of reach", "unreachable"),
+             ("internal error", "internal error"))
     out: dict[str, int] = {}
     for r in rows:
         if not r["feasible"]:
-            kind = str(r["reason"]).split(":")[0][:60]
+            text = str(r["reason"])
+            kind = next((name for key, name in kinds if key in text), "other")
             out[kind] = out.get(kind, 0) + 1
     return out
 

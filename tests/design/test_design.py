@@ -214,3 +214,33 @@ def test_resume_refuses_another_sweep(sweep2, tmp_path, capsys):
     assert "was made with another task" in capsys.readouterr().err
     assert main(["design", str(task), "--out", str(out)]) == 2
     assert "--resume" in capsys.readouterr().err
+
+
+def test_a_run_task_sweeps_its_path_and_law(tmp_path):
+    """A dextar run config (one path, one law) is a task too: geometry and torque metrics
+    along its path; its rows are the single-design function's."""
+    from dextar.config import load_toml
+    from dextar.jobs import design_task
+
+    from ..program.test_program import EXAMPLES
+    from ..robustness.harness import toml_text
+
+    doc = load_toml(EXAMPLES / "line_si.toml")
+    doc["motors"] = {"peak_torque": 1.0}
+    doc["design"] = {"l": [50.0, 120.0], "L": [60.0, 140.0], "d": [10.0, 100.0],
+                     "samples": 32, "chunk": 16, "objectives": ["peak_torque_A_Nm", "-gci"]}
+    path = tmp_path / "run.toml"
+    path.write_text(toml_text(doc))
+    out = tmp_path / "o"
+    assert main(["design", str(path), "--out", str(out), "--workers", "1", "--quiet"]) == 0
+    rows = rows_of(out)
+    task, space = design_task(str(path))
+    assert task.kind == "run"
+    for i in (0, 9, 31):
+        direct = evaluate_design(task, space.designs()[i])
+        assert rows[i]["feasible"] == direct["feasible"] and rows[i]["reason"] == direct["reason"]
+        if direct["feasible"]:
+            assert rows[i]["cycle_time_s"] == 0.25  # the law's duration
+            assert rows[i]["peak_torque_A_Nm"] == pytest.approx(direct["peak_torque_A_Nm"],
+                                                                rel=1e-12)
+    assert json.loads((out / "summary.json").read_text())["task_kind"] == "run"

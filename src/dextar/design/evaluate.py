@@ -8,7 +8,7 @@ depends only on the task and the design's lengths: the same on any worker, in an
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -16,17 +16,21 @@ import numpy as np
 from scipy import ndimage
 
 from .._arrays import Array
-from ..dynamics import Inertia, Rod
+from ..dynamics import Inertia, Model, RobotAlongPath, Rod, inverse_dynamics
 from ..errors import DextarError
 from ..geometry import FiveBar
 from ..kinematics import jacobian, workspace_map
 from ..kinematics.checker import Tolerances, pose_distances
-from ..laws import MotorLimits
-from ..program import Move, plan_program, sizing
+from ..kinematics.workspace import inverse_condition
+from ..laws import Law, LawRequest, MotorLimits, law_type
+from ..paths import Path
+from ..program import Move, ProgramResult, plan_program, sizing
+from ..trajectory import check_path, sample_trajectory
+from ..units import SI
 from .space import LENGTHS, METRICS
 
 #: Grid of the workspace map behind ``workspace_area_mm2`` (points per side).
-AREA_RESOLUTION = 81
+AREA_RESOLUTION = 61
 #: Setpoint rate of the plans a sweep makes (the sizing integrates over them).
 SWEEP_RATE_HZ = 500.0
 
@@ -50,6 +54,16 @@ class Task:
     grid : int
         Time-optimal grid of each move.
     tolerances : Tolerances
+    path : Path, optional
+        A ``dextar run`` task: one path (SI) instead of moves.
+    law : Law, optional
+        Its law when it does not depend on the robot (computed once for the sweep).
+    law_type : str, optional
+        Its law's name when it does (``time-optimal``: planned on each design).
+    law_values : mapping, optional
+        That law's keys (SI).
+    samples : int
+        Samples along a run task's path.
     """
 
     moves: tuple[Move, ...]
@@ -62,6 +76,16 @@ class Task:
     mass_per_length: tuple[float, float] | None
     grid: int
     tolerances: Tolerances
+    path: Path | None = None
+    law: Law | None = None
+    law_type: str | None = None
+    law_values: Mapping[str, Any] | None = None
+    samples: int = 201
+
+    @property
+    def kind(self) -> str:
+        """``"program"`` or ``"run"`` (one path and law)."""
+        return "program" if self.path is None else "run"
 
 
 def footprint_mm(lengths: Sequence[float]) -> float:
@@ -116,22 +140,18 @@ def evaluate_design(task: Task, lengths: Sequence[float]) -> dict[str, Any]:
         return row
     robot = robot_mm.scaled(1e-3)
     try:
-        res = plan_program(robot, inertia_of(task, robot), task.moves, start=task.start_mm,
-                           working_mode=task.working_mode, assembly=task.assembly,
-                           motors=task.motors, rms_limit=task.rms_limit,
-                           servo_rate_hz=SWEEP_RATE_HZ, grid=task.grid,
-                           tolerances=task.tolerances)
+        res = _plan(task, robot)
     except DextarError as exc:
         row["reason"] = str(exc)
         return row
     motors, violations = sizing(res)
     d = pose_distances(robot, res.q, res.P)
     J = jacobian(robot, res.q, res.P, tol=0.0)
-    s = np.linalg.svd(J, compute_uv=False)
+    dex = inverse_condition(J[:, 0, 0], J[:, 0, 1], J[:, 1, 0], J[:, 1, 1])
     row.update({
         "cycle_time_s": res.cycle_time_s,
         "min_type1_distance": float(d.type1.min()), "min_type2_distance": float(d.type2.min()),
-        "gci": float(np.mean(s[:, 1] / s[:, 0])),
+        "gci": float(np.mean(dex)),
         "peak_torque_A_Nm": motors[0]["peak_torque_Nm"],
         "peak_torque_D_Nm": motors[1]["peak_torque_Nm"],
         "rms_torque_A_Nm": motors[0]["rms_torque_Nm"],
@@ -152,6 +172,32 @@ def evaluate_design(task: Task, lengths: Sequence[float]) -> dict[str, Any]:
     return row
 
 
+def _plan(task: Task, robot: FiveBar) -> ProgramResult:
+    """The task on ``robot`` (m): its program planned, or its path sampled under its law (a
+    one-move result with the same fields)."""
+    inertia = inertia_of(task, robot)
+    if task.path is None:
+        return plan_program(robot, inertia, task.moves, start=task.start_mm,
+                            working_mode=task.working_mode, assembly=task.assembly,
+                            motors=task.motors, rms_limit=task.rms_limit,
+                            servo_rate_hz=SWEEP_RATE_HZ, grid=task.grid,
+                            tolerances=task.tolerances)
+    model = Model(robot, inertia, task.assembly, tol=task.tolerances.type2)
+    law = task.law
+    if law is None:  # a law planned on the robot (time-optimal)
+        assert task.law_type is not None
+        check_path(robot, task.path, mode=task.working_mode, tolerances=task.tolerances,
+                   units=SI)
+        dyn = RobotAlongPath(model, task.path, task.working_mode, SI)
+        law = law_type(task.law_type).build(LawRequest(
+            task.path, task.law_values or {}, inertia.point_mass, dyn, SI, task.motors))
+    tr = sample_trajectory(robot, task.path, law, mode=task.working_mode,
+                           samples=task.samples, tolerances=task.tolerances, units=SI)
+    tau = inverse_dynamics(model, tr.q, tr.dq, tr.ddq, t=tr.t)
+    return ProgramResult([], float(law.duration), tr.t, np.zeros(len(tr.t), int), tr.P, tr.q,
+                         tr.dq, tr.ddq, tau, task.motors, task.rms_limit)
+
+
 def evaluate_chunk(task: Task, designs: Array, first: int) -> list[dict[str, Any]]:
     """Rows of the designs (m, 5) numbered from ``first`` (the unit of work of a sweep). A
     design whose evaluation raises an unexpected error is a row with that error as its
@@ -170,10 +216,6 @@ def evaluate_chunk(task: Task, designs: Array, first: int) -> list[dict[str, Any
 
 
 def evaluate_path(task: Task, lengths: Sequence[float]) -> Array:
-    """The end-effector's path (n, 2) in mm of the task planned on one design (to draw it)."""
+    """The end-effector's path (n, 2) in mm of the task on one design (to draw it)."""
     robot = FiveBar(*(float(v) for v in lengths)).scaled(1e-3)
-    res = plan_program(robot, inertia_of(task, robot), task.moves, start=task.start_mm,
-                       working_mode=task.working_mode, assembly=task.assembly,
-                       motors=task.motors, rms_limit=task.rms_limit,
-                       servo_rate_hz=SWEEP_RATE_HZ, grid=task.grid, tolerances=task.tolerances)
-    return np.asarray(res.P * 1e3)
+    return np.asarray(_plan(task, robot).P * 1e3)

@@ -82,7 +82,7 @@ class Cluster:
                                   f"{exc})") from None
         else:
             self.cluster = distributed.LocalCluster(n_workers=workers, threads_per_worker=1,
-                                                    processes=True, dashboard_address=None)
+                                                    processes=True, dashboard_address=":0")
             self.client = distributed.Client(self.cluster)
 
     @property

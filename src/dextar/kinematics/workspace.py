@@ -50,6 +50,18 @@ class WorkspaceMap:
         return float(self.reachable.sum() * dx * dy)
 
 
+def inverse_condition(m11: Array, m12: Array, m21: Array, m22: Array) -> Array:
+    """Inverse condition number ``s_min / s_max`` in ``[0, 1]`` of 2x2 matrices given by their
+    entries (arrays of one shape), in closed form (0 for a zero matrix)."""
+    fro2 = m11**2 + m12**2 + m21**2 + m22**2
+    detm = np.abs(m11 * m22 - m12 * m21)
+    disc = np.sqrt(np.maximum(fro2 * fro2 - 4.0 * detm * detm, 0.0))
+    smax2 = 0.5 * (fro2 + disc)
+    smin2 = np.maximum(0.5 * (fro2 - disc), 0.0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.asarray(np.sqrt(np.where(smax2 > 0, smin2 / smax2, 0.0)))
+
+
 def workspace_map(
     robot: FiveBar,
     mode: str | tuple[int, int] = "+-",
@@ -97,13 +109,6 @@ def workspace_map(
     det = ux * vy - uy * vx
     type2 = np.where(reachable, det / (robot.L1 * robot.L2), 0.0)
     # J is proportional to adj(A) B; the condition number ignores the factor 1/det A.
-    m11, m12, m21, m22 = vy * b1, -uy * b2, -vx * b1, ux * b2
-    fro2 = m11**2 + m12**2 + m21**2 + m22**2
-    detm = np.abs(m11 * m22 - m12 * m21)
-    disc = np.sqrt(np.maximum(fro2 * fro2 - 4.0 * detm * detm, 0.0))
-    smax2 = 0.5 * (fro2 + disc)
-    smin2 = np.maximum(0.5 * (fro2 - disc), 0.0)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        dex = np.sqrt(np.where(smax2 > 0, smin2 / smax2, 0.0))
+    dex = inverse_condition(vy * b1, -uy * b2, -vx * b1, ux * b2)
     dex = np.where(reachable, dex, 0.0)
     return WorkspaceMap(robot, x, y, reachable, type2, dex, working_mode_name(signs))
