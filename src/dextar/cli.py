@@ -238,6 +238,15 @@ def _registries_help() -> str:
             f"[path].type:\n{paths}\n[law].type:\n{laws}")
 
 
+def into_directory(sp: argparse.ArgumentParser, force: str = "write into an existing "
+                   "directory") -> None:
+    """The options of a command that writes a directory: --out, --force, --quiet, --json."""
+    sp.add_argument("--out", required=True, help="output directory")
+    sp.add_argument("--force", action="store_true", help=force)
+    sp.add_argument("--quiet", action="store_true", help="no progress or summary output")
+    sp.add_argument("--json", action="store_true", help="print one JSON object")
+
+
 def _register_stages(sub: Any) -> None:
     epilog = _registries_help()
 
@@ -272,10 +281,7 @@ def _register_stages(sub: Any) -> None:
     sp = sub.add_parser("program", help="plan a robot program under the motors: setpoints "
                         "and sizing (exit 1 when a motor limit is exceeded)")
     sp.add_argument("config", help="TOML task file with [program], [[move]] and [motors]")
-    sp.add_argument("--json", action="store_true", help="print one JSON object")
-    sp.add_argument("--out", required=True, help="output directory")
-    sp.add_argument("--force", action="store_true", help="write into an existing directory")
-    sp.add_argument("--quiet", action="store_true", help="no summary output")
+    into_directory(sp)
     sp.set_defaults(func=_cmd_program)
 
     sp = sub.add_parser("excite", help="an exciting trajectory for identification (a Fourier "
@@ -300,16 +306,14 @@ def _register_stages(sub: Any) -> None:
                     help="data not used in the fit: predicted against measured torques")
     sp.add_argument("--cutoff-hz", type=float, default=None,
                     help="low-pass cut-off, Hz (default: from the data's bandwidth)")
-    sp.add_argument("--json", action="store_true", help="print one JSON object")
-    sp.add_argument("--out", required=True, help="output directory")
-    sp.add_argument("--force", action="store_true", help="write into an existing directory")
-    sp.add_argument("--quiet", action="store_true", help="no summary output")
+    into_directory(sp)
     sp.set_defaults(func=_cmd_identify)
 
-    sp = sub.add_parser("design", help="sweep five-bar geometries for a program task on Dask: "
-                        "designs, Pareto front, the chosen robot")
-    sp.add_argument("config", help="TOML task file (a dextar program task) with [design]")
-    sp.add_argument("--out", required=True, help="output directory")
+    sp = sub.add_parser("design", help="sweep five-bar geometries for a task on Dask: designs, "
+                        "Pareto front, the chosen robot")
+    sp.add_argument("config", help="TOML task file (a program task or a run config) with "
+                    "[design]")
+    into_directory(sp, force="overwrite a non-empty --out")
     sp.add_argument("--samples", type=int, default=None, help="designs (default [design])")
     sp.add_argument("--seed", type=int, default=None, help="sampling seed (default [design])")
     where = sp.add_mutually_exclusive_group()
@@ -319,9 +323,6 @@ def _register_stages(sub: Any) -> None:
                        help="a running Dask scheduler, e.g. tcp://host:8786")
     sp.add_argument("--resume", action="store_true",
                     help="complete the sweep in --out (evaluate only what is missing)")
-    sp.add_argument("--force", action="store_true", help="overwrite a non-empty --out")
-    sp.add_argument("--quiet", action="store_true", help="no progress or summary output")
-    sp.add_argument("--json", action="store_true", help="print one JSON object")
     sp.set_defaults(func=_cmd_design)
 
     sp = sub.add_parser("run", help="reproduce the paper end to end and write a report")

@@ -13,17 +13,11 @@ from dextar.dynamics.regressor import standard_parameters
 from dextar.identification.base import base_parameters
 from dextar.jobs import si_model
 
-from ..program.test_program import EXAMPLES
+from ..program.test_program import EXAMPLES, read
 
 CONFIG = str(EXAMPLES / "pick_place.toml")
 COLUMNS = ["t_s", "phi_rad", "psi_rad", "dphi_rad_s", "dpsi_rad_s", "ddphi_rad_s2",
            "ddpsi_rad_s2", "tau1_Nm", "tau2_Nm"]
-
-
-def read(path):
-    with open(path) as fh:
-        rows = list(csv.reader(fh))
-    return rows[0], np.array(rows[1:], float)
 
 
 @pytest.fixture(scope="module")
