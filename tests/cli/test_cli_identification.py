@@ -62,7 +62,7 @@ def test_identify_writes_a_config_that_reproduces_the_base_parameters(excite_csv
         assert key in s
     assert s["status"] == "identified" and s["n_samples"] == 10001
     head, *_ = (out / "parameters.csv").read_text().splitlines()
-    assert head == "name,meaning,unit,value,std,rel_std_percent"
+    assert head == "name,meaning,value,std,rel_std_percent,unit"
     # the identified config loads and its model has exactly the identified base parameters
     model = si_model(load_scenario(out / "identified.toml"))
     base = base_parameters(model)

@@ -17,13 +17,14 @@ from .html_page import figures, page
 
 
 def parameters_csv(res: IdentificationResult) -> str:
-    """``name, meaning, unit, value, std, rel_std_percent``: one row per base parameter."""
-    out = ["name,meaning,unit,value,std,rel_std_percent"]
+    """``name, meaning, value, std, rel_std_percent, unit``: one row per base parameter
+    (SI values)."""
+    out = ["name,meaning,value,std,rel_std_percent,unit"]
     for name, meaning, unit, v, s in zip(res.base.names, res.base.meanings, res.base.units,
                                          res.beta, res.std, strict=True):
         rel = 100.0 * s / abs(v) if v != 0 else math.inf
-        out.append(f'{name},"{meaning}",{unit},{_num(v)},{_num(s)},'
-                   f"{_num(rel) if math.isfinite(rel) else 'inf'}")
+        out.append(f'{name},"{meaning}",{_num(v)},{_num(s)},'
+                   f"{_num(rel) if math.isfinite(rel) else 'inf'},{unit}")
     return "\n".join(out) + "\n"
 
 
@@ -60,7 +61,7 @@ def identification_report(summary: Mapping[str, Any], csv_rows: str,
     for line in csv_rows.splitlines()[1:]:
         name, rest = line.split(",", 1)
         meaning, tail = rest[1:].split('",', 1)
-        unit, value, std, rel = tail.split(",")
+        value, std, rel, unit = tail.split(",")
         rows.append(f"<tr><td>{esc(name)}</td><td>{esc(meaning)}</td><td>{esc(unit)}</td>"
                     f"<td>{float(value):.6g}</td><td>{float(std):.3g}</td>"
                     f"<td>{esc(rel if rel == 'inf' else f'{float(rel):.3g}')}</td></tr>")
