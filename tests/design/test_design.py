@@ -244,3 +244,13 @@ def test_a_run_task_sweeps_its_path_and_law(tmp_path):
             assert rows[i]["peak_torque_A_Nm"] == pytest.approx(direct["peak_torque_A_Nm"],
                                                                 rel=1e-12)
     assert json.loads((out / "summary.json").read_text())["task_kind"] == "run"
+
+
+def test_bad_samples_and_seed_exit_2(tmp_path, capsys):
+    task = write_task(tmp_path)
+    for args, message in ((["--samples", "0"], "samples = 0"), (["--seed", "-1"], "seed = -1"),
+                          (["--workers", "0"], "--workers 0 must be at least 1")):
+        assert main(["design", str(task), "--out", str(tmp_path / "o"), *args]) == 2
+        err = capsys.readouterr().err
+        assert message in err and len(err.strip().splitlines()) == 1, err
+        assert not (tmp_path / "o").exists()

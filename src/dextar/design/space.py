@@ -25,6 +25,8 @@ METRICS = ("cycle_time_s", "footprint_mm", "min_type1_distance", "min_type2_dist
            "peak_torque_A_Nm", "peak_torque_D_Nm", "rms_torque_A_Nm", "rms_torque_D_Nm",
            "workspace_area_mm2")
 SAMPLINGS = ("sobol", "grid", "random")
+#: Most designs a sweep samples.
+MAX_SAMPLES = 1_000_000
 
 
 @dataclass(frozen=True)
@@ -70,6 +72,12 @@ class DesignSpace:
             if lo < 0 or (lo == 0 and name != "d"):
                 raise ConfigError(f"config key [design].{name} = [{lo:g}, {hi:g}] must be "
                                   f"{'>= 0' if name == 'd' else 'positive'} mm")
+        if not (isinstance(self.samples, int) and 1 <= self.samples <= MAX_SAMPLES):
+            raise ConfigError(f"samples = {self.samples!r} ([design].samples or --samples) must "
+                              f"be an integer from 1 to {MAX_SAMPLES}")
+        if not (isinstance(self.seed, int) and 0 <= self.seed < 2**31):
+            raise ConfigError(f"seed = {self.seed!r} ([design].seed or --seed) must be an "
+                              "integer from 0 to 2^31 - 1")
         if self.sampling not in SAMPLINGS:
             raise ConfigError(f"config key [design].sampling = {self.sampling!r}: one of "
                               f"{', '.join(SAMPLINGS)}")

@@ -12,6 +12,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from itertools import islice
 from typing import Any
 
 import numpy as np
@@ -22,6 +23,8 @@ from .evaluate import Task, evaluate_chunk
 
 #: How to get the extra that holds Dask.
 INSTALL_HINT = "pip install -e '.[design]' (or pip install 'dextar[design]')"
+#: Chunks kept in flight per worker.
+IN_FLIGHT_PER_WORKER = 4
 #: Seconds to wait for a scheduler given by address.
 CONNECT_TIMEOUT_S = 10
 
@@ -133,15 +136,25 @@ def run_sweep(cluster: Cluster, task: Task, designs: Array, todo: Sequence[int],
     done = 0
     if todo:
         task_f = client.scatter(task, broadcast=True)
-        parts = chunks_of(sorted(todo), chunk)
-        futures = [client.submit(evaluate_chunk, task_f, designs[p[0]:p[-1] + 1], p[0],
-                                 pure=False, retries=2) for p in parts]
-        for fut in distributed.as_completed(futures):
+        parts = iter(chunks_of(sorted(todo), chunk))
+
+        def submit(p: list[int]) -> Any:
+            return client.submit(evaluate_chunk, task_f, designs[p[0]:p[-1] + 1], p[0],
+                                 pure=False, retries=2)
+
+        # a bounded number of chunks in flight: the scheduler and this process stay small
+        # whatever the number of designs
+        in_flight = max(IN_FLIGHT_PER_WORKER * max(n_workers, 1), 8)
+        queue = distributed.as_completed([submit(p) for p in islice(parts, in_flight)])
+        for fut in queue:
             rows = fut.result()
             on_chunk(rows)
             done += len(rows)
             if progress is not None:
                 progress(done, len(todo))
+            nxt = next(parts, None)
+            if nxt is not None:
+                queue.add(submit(nxt))
     return SweepStats(len(todo), time.perf_counter() - t0, n_workers)
 
 
