@@ -26,7 +26,7 @@ INSTALL_HINT = "pip install -e '.[design]' (or pip install 'dextar[design]')"
 #: Chunks kept in flight per worker.
 IN_FLIGHT_PER_WORKER = 4
 #: Seconds to wait for a scheduler given by address.
-CONNECT_TIMEOUT_S = 10
+CONNECT_TIMEOUT_S = 8
 
 
 @dataclass(frozen=True)
