@@ -254,3 +254,54 @@ def test_bad_samples_and_seed_exit_2(tmp_path, capsys):
         err = capsys.readouterr().err
         assert message in err and len(err.strip().splitlines()) == 1, err
         assert not (tmp_path / "o").exists()
+
+
+def _design_tables():
+    from hypothesis import strategies as st
+
+    value = st.one_of(
+        st.lists(st.floats(allow_nan=True, allow_infinity=True, width=32), min_size=0,
+                 max_size=3),
+        st.tuples(st.floats(0, 200), st.floats(0, 200)).map(list),
+        st.text(alphabet="abcLl-_ 1", max_size=4), st.integers(-3, 10**7), st.booleans())
+    keys = st.sampled_from(["l", "L", "l1", "l2", "L1", "L2", "d", "mass_per_length",
+                            "samples", "sampling", "seed", "objectives", "chunk", "grid",
+                            "bogus"])
+    return st.dictionaries(keys, value, max_size=6)
+
+
+def test_random_design_tables_are_read_or_refused_by_name(tmp_path_factory):
+    """Any [design] table either gives a design space whose first designs evaluate to rows
+    (finite numbers or empty cells) or is refused with a ConfigError naming [design]."""
+    from hypothesis import HealthCheck, given, settings
+
+    from dextar.design.evaluate import evaluate_chunk
+    from dextar.errors import ConfigError
+    from dextar.jobs import design_task
+    from dextar.output.design import row_line
+
+    from ..robustness.harness import toml_text
+
+    base = {k: v for k, v in __import__("tomllib").loads(TASK).items() if k != "design"}
+
+    @settings(max_examples=60, deadline=None, derandomize=True,
+              suppress_health_check=list(HealthCheck))
+    @given(table=_design_tables())
+    def check(table):
+        folder = tmp_path_factory.mktemp("d")
+        path = folder / "t.toml"
+        path.write_text(toml_text({**base, "design": table}))
+        try:
+            task, space = design_task(str(path))
+        except ConfigError as exc:
+            assert "design" in str(exc) or "samples" in str(exc) or "seed" in str(exc), exc
+            return
+        designs = space.designs()
+        assert designs.shape == (space.samples, 5) and np.isfinite(designs).all()
+        for row in evaluate_chunk(task, designs[:2], 0):
+            line = row_line(row)
+            assert "nan" not in line and "inf" not in line
+            assert parse_line(line) == row  # the CSV line gives the row back exactly
+            assert not row["reason"].startswith("internal error"), row["reason"]
+
+    check()
