@@ -305,3 +305,38 @@ def test_random_design_tables_are_read_or_refused_by_name(tmp_path_factory):
             assert not row["reason"].startswith("internal error"), row["reason"]
 
     check()
+
+
+def test_a_running_cluster_by_address_gives_the_same_file(sweep2, tmp_path):
+    """`dask scheduler` and `dask worker` started as the README shows; --scheduler uses them."""
+    import shutil
+    import socket
+
+    dask_cli = Path(sys.executable).with_name("dask")
+    if not dask_cli.exists():
+        dask_cli = Path(shutil.which("dask") or "dask")
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    address = f"tcp://127.0.0.1:{port}"
+    procs = [subprocess.Popen([str(dask_cli), "scheduler", "--host", "127.0.0.1", "--port",
+                               str(port), "--no-dashboard"], start_new_session=True,
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
+    try:
+        time.sleep(2)
+        procs.append(subprocess.Popen([str(dask_cli), "worker", address, "--nthreads", "1",
+                                       "--no-dashboard"], start_new_session=True,
+                                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        from distributed import Client
+
+        with Client(address, timeout="20s") as c:
+            c.wait_for_workers(1, timeout=30)
+        task, out2 = sweep2
+        out = tmp_path / "remote"
+        assert main(["design", str(task), "--out", str(out), "--scheduler", address,
+                     "--quiet"]) == 0
+        assert (out / "designs.csv").read_bytes() == (out2 / "designs.csv").read_bytes()
+    finally:
+        for p in procs:
+            os.killpg(p.pid, signal.SIGKILL)
+            p.wait()
