@@ -556,7 +556,6 @@ def design(config: str, out: str, *, samples: int | None = None, seed: int | Non
     """Sweep the geometries of ``[design]`` on the task's program (Dask), and write
     ``designs.csv``, ``pareto.csv``, ``best.toml``, ``summary.json``, figures and the report."""
     import hashlib
-    import os
 
     from .config.tables import FrictionTable, GravityTable
     from .design.evaluate import inertia_of
@@ -565,7 +564,7 @@ def design(config: str, out: str, *, samples: int | None = None, seed: int | Non
     from .design.sweep import Cluster, require_dask, run_sweep
     from .geometry import FiveBar
     from .output.config_file import model_toml
-    from .output.design import header, parse_line, row_line
+    from .output.design import DesignsFile, header, row_line
     from .output.files import write_bytes, write_text
 
     require_dask()
@@ -577,52 +576,12 @@ def design(config: str, out: str, *, samples: int | None = None, seed: int | Non
     signature = hashlib.sha256(repr((Path(config).read_bytes(), space, sc.design.grid)).encode()
                                ).hexdigest()
     outdir = Path(out)
-    csv_path, meta_path = outdir / "designs.csv", outdir / "sweep.json"
-    rows: dict[int, dict[str, Any]] = {}
-    if resume:
-        if not (csv_path.is_file() and meta_path.is_file()):
-            raise ConfigError(f"--resume: {shown(out)} holds no sweep to resume (designs.csv "
-                              "and sweep.json)")
-        try:
-            same = json.loads(meta_path.read_text()).get("signature") == signature
-        except (ValueError, OSError):
-            same = False
-        if not same:
-            raise ConfigError(f"--resume: the sweep in {shown(out)} was made with another task, "
-                              "[design] or --samples/--seed; rerun without --resume (and "
-                              "--force to overwrite it)")
-        lines = csv_path.read_text().splitlines(keepends=True)[1:]
-        for line in lines:
-            r = parse_line(line)
-            if r is None or not 0 <= r["design"] < n:
-                continue
-            if not np.allclose([r[k] for k in LENGTHS], designs[r["design"]], rtol=1e-12):
-                raise ConfigError(f"--resume: design {r['design']} in {shown(csv_path)} has "
-                                  "other lengths than this sweep's")
-            rows[r["design"]] = r
-    else:
-        if outdir.exists() and (not outdir.is_dir() or any(outdir.iterdir())) and not force:
-            raise ConfigError(f"output directory {shown(out)!r} exists and is not empty; use "
-                              "--force to overwrite it or --resume to complete its sweep")
-    todo = [i for i in range(n) if i not in rows]
-    with Cluster(workers=workers, scheduler=scheduler) as cluster:
-        outdir.mkdir(parents=True, exist_ok=True)
-        write_text(meta_path, json.dumps({"signature": signature, "designs": n,
-                                          "task": config}) + "\n")
-        # the rows so far (a line cut short by a kill is dropped), then appended chunk by chunk
-        write_text(csv_path, header() + "".join(row_line(rows[i]) for i in sorted(rows)))
-        with open(csv_path, "a", encoding="utf-8") as fh:
-            def on_chunk(new: list[dict[str, Any]]) -> None:
-                for r in new:
-                    rows[r["design"]] = r
-                fh.write("".join(row_line(r) for r in new))
-                fh.flush()
-                os.fsync(fh.fileno())
-
-            stats = run_sweep(cluster, task, designs, todo, chunk=sc.design.chunk,
-                              on_chunk=on_chunk, progress=progress)
-    ordered = [rows[i] for i in range(n)]
-    write_text(csv_path, header() + "".join(row_line(r) for r in ordered))
+    store = DesignsFile(outdir, designs, signature, resume=resume, force=force,
+                        label=shown(out))
+    with Cluster(workers=workers, scheduler=scheduler) as cluster, store:
+        stats = run_sweep(cluster, task, designs, store.missing, chunk=sc.design.chunk,
+                          on_chunk=store.append, progress=progress)
+    ordered = store.finish()
     feasible = [r for r in ordered if r["feasible"]]
     summary: dict[str, Any] = {
         "task": config, "task_kind": task.kind, "designs": n, "feasible": len(feasible),

@@ -6,7 +6,10 @@ from __future__ import annotations
 import csv
 import html
 import io
+import json
+import os
 from collections.abc import Mapping, Sequence
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -14,6 +17,8 @@ from matplotlib.figure import Figure
 
 from .._arrays import Array
 from ..design.space import LENGTHS, METRICS
+from ..errors import ConfigError
+from .files import write_text
 from .html_page import figures, page
 
 #: Columns of designs.csv and pareto.csv.
@@ -127,3 +132,82 @@ def design_report(summary: Mapping[str, Any], pareto_rows: Sequence[Mapping[str,
                 f"<h1>Design sweep of {esc(str(summary['task']))}</h1><table>{rows}</table>"
                 f"{chosen}<h2>Pareto designs</h2><table><tr>{head}</tr>{body}</table>"
                 f"<h2>Figures</h2>{figures(pngs)}")
+
+
+class DesignsFile:
+    """``designs.csv`` of a sweep in ``outdir``, with ``sweep.json`` (the sweep's signature).
+
+    Opened fresh (refused over a non-empty folder without ``force``) or to ``resume`` (the
+    complete rows of the same sweep kept, a line cut short by a kill dropped). Rows are
+    appended as chunks finish (flushed to disk each time); :meth:`finish` rewrites the file
+    in design order, atomically."""
+
+    def __init__(self, outdir: Path, designs: Array, signature: str, *, resume: bool,
+                 force: bool, label: str) -> None:
+        """Check the folder (and read the rows to resume); nothing is written yet.
+
+        Raises
+        ------
+        ConfigError
+            A non-empty folder without ``force`` or ``resume``; ``resume`` without a sweep
+            of the same signature, or with rows of other lengths.
+        """
+        self.outdir, self.designs, self.signature = outdir, designs, signature
+        self.csv, self.meta = outdir / "designs.csv", outdir / "sweep.json"
+        self.rows: dict[int, dict[str, Any]] = {}
+        self._fh: Any = None
+        n = len(designs)
+        if resume:
+            if not (self.csv.is_file() and self.meta.is_file()):
+                raise ConfigError(f"--resume: {label} holds no sweep to resume (designs.csv "
+                                  "and sweep.json)")
+            try:
+                same = json.loads(self.meta.read_text()).get("signature") == signature
+            except (ValueError, OSError):
+                same = False
+            if not same:
+                raise ConfigError(f"--resume: the sweep in {label} was made with another task, "
+                                  "[design] or --samples/--seed; rerun without --resume (and "
+                                  "--force to overwrite it)")
+            for line in self.csv.read_text().splitlines(keepends=True)[1:]:
+                r = parse_line(line)
+                if r is None or not 0 <= r["design"] < n:
+                    continue
+                if not np.allclose([r[k] for k in LENGTHS], designs[r["design"]], rtol=1e-12):
+                    raise ConfigError(f"--resume: design {r['design']} in {self.csv} has other "
+                                      "lengths than this sweep's")
+                self.rows[r["design"]] = r
+        elif outdir.exists() and (not outdir.is_dir() or any(outdir.iterdir())) and not force:
+            raise ConfigError(f"output directory {label!r} exists and is not empty; use "
+                              "--force to overwrite it or --resume to complete its sweep")
+
+    @property
+    def missing(self) -> list[int]:
+        """The designs without a row."""
+        return [i for i in range(len(self.designs)) if i not in self.rows]
+
+    def __enter__(self) -> DesignsFile:
+        self.outdir.mkdir(parents=True, exist_ok=True)
+        write_text(self.meta, json.dumps({"signature": self.signature,
+                                          "designs": len(self.designs)}) + "\n")
+        write_text(self.csv, header() + "".join(row_line(self.rows[i]) for i in
+                                                sorted(self.rows)))
+        self._fh = open(self.csv, "a", encoding="utf-8")  # noqa: SIM115 - closed in __exit__
+        return self
+
+    def append(self, rows: list[dict[str, Any]]) -> None:
+        """Append a finished chunk's rows and flush them to disk."""
+        for r in rows:
+            self.rows[r["design"]] = r
+        self._fh.write("".join(row_line(r) for r in rows))
+        self._fh.flush()
+        os.fsync(self._fh.fileno())
+
+    def __exit__(self, *exc: object) -> None:
+        self._fh.close()
+
+    def finish(self) -> list[dict[str, Any]]:
+        """Every row in design order, the file rewritten so (atomically)."""
+        ordered = [self.rows[i] for i in range(len(self.designs))]
+        write_text(self.csv, header() + "".join(row_line(r) for r in ordered))
+        return ordered
