@@ -272,3 +272,41 @@ def test_the_readme_program_plans_within_the_motors(tmp_path):
     s = json.loads((out / "summary.json").read_text())
     assert s["status"] == "fits" and s["moves"][0]["blended_with_next"]
     assert all(m["peak_torque_ratio"] <= 1 + 1e-3 for m in s["motors"])
+
+
+def test_fit_by_time_scaling_equals_resampling():
+    """For a law that only stretches with its duration (min-jerk), the motors' ratio at any
+    duration from one sampling equals the ratio of the law resampled at that duration; the
+    shortcut declines a law whose shape changes with the duration (the optimal law)."""
+    from dextar.config import load_scenario
+    from dextar.dynamics import Model, inverse_dynamics
+    from dextar.jobs import si_model
+    from dextar.laws import LawRequest, law_type
+    from dextar.paths import Line
+    from dextar.program.plan import _stretched_ratio
+    from dextar.trajectory import sample_trajectory
+    from dextar.units import SI
+
+    sc = load_scenario(EXAMPLES / "pick_place.toml")
+    m = si_model(sc)
+    model = Model(m.robot, m.inertia, "up")
+    motors = sc.table("motors").limits(SI)
+    path = Line((-0.04, 0.09), (0.04, 0.12))
+
+    def motion(law):
+        tr = sample_trajectory(m.robot, path, law, mode=sc.mode, samples=401, units=SI)
+        return tr.q, tr.dq, tr.ddq
+
+    for name, extra in (("min-jerk", {}), ("optimal", {"eta": 0.1})):
+        def build(T, name=name, extra=extra):
+            return law_type(name).build(LawRequest(path, {"duration": T, **extra}, 0.13, None,
+                                                   SI))
+
+        fast = _stretched_ratio(build, motion, model, motors)
+        if name == "optimal":
+            assert fast is None
+            continue
+        for T in (0.05, 0.3, 2.0):
+            q, dq, ddq = motion(build(T))
+            ref = max(motors.ratios(inverse_dynamics(model, q, dq, ddq), dq))
+            assert fast(T) == pytest.approx(ref, rel=1e-9)

@@ -30,7 +30,14 @@ from typing import Any
 import numpy as np
 
 from .._arrays import Array
-from ..dynamics import Inertia, Model, RobotAlongJointLine, RobotAlongPath, inverse_dynamics
+from ..dynamics import (
+    Inertia,
+    Model,
+    RobotAlongJointLine,
+    RobotAlongPath,
+    gravity_torques,
+    inverse_dynamics,
+)
 from ..errors import ConfigError, DextarError, ParameterError
 from ..geometry import FiveBar, canonical_working_mode
 from ..kinematics import direct_kinematics, inverse_kinematics, singularity_distances
@@ -284,15 +291,15 @@ def _plan_chain(robot: FiveBar, inertia: Inertia, group: list[Move], P0: Array, 
         return sample_trajectory(robot, path, law, mode=mode, times=times, samples=801,
                                  tolerances=tol, units=SI)
 
-    def sample_law(law: Law) -> tuple[Array, Array]:
+    def motion(law: Law) -> tuple[Array, Array, Array]:
         tr = traj(law)
-        return inverse_dynamics(model, tr.q, tr.dq, tr.ddq), tr.dq
+        return tr.q, tr.dq, tr.ddq
 
     # resolve each blend with at least 40 segments of the time-optimal grid
     shortest = min(piece.length for piece in path.pieces)
     fine = min(max(grid, int(math.ceil(40 * path.length / shortest))), 8000)
     law = _law(first, path.length, RobotAlongPath(model, path, mode, SI), motors, fine,
-               sample_law, inertia.point_mass, path)
+               motion, model, path)
     tr = traj(law)
     d1, d2 = singularity_distances(robot, tr.q, tr.P)
     shift = np.round((q0 - tr.q[0]) / (2 * np.pi)) * 2 * np.pi
@@ -360,9 +367,11 @@ def _arc(mv: Move, P0: Array) -> Path:
 
 
 def _law(mv: Move, length: float, dynamics: Any, motors: MotorLimits | None,
-         grid: int, sample: Callable[[Law], tuple[Array, Array]], mass: float,
+         grid: int, motion: Callable[[Law], tuple[Array, Array, Array]], model: Model,
          path: Path | None) -> Law:
-    """The move's law: time-optimal, a fixed-shape law with its duration, or ``"fit"``."""
+    """The move's law: time-optimal, a fixed-shape law with its duration, or ``"fit"``.
+    ``motion(law)`` samples the joint motion ``q, qdot, qddot`` on fixed fractions of the
+    law's duration."""
     if mv.law == "time-optimal":
         if motors is None:
             raise ConfigError("the time-optimal law needs a [motors] table")
@@ -371,6 +380,7 @@ def _law(mv: Move, length: float, dynamics: Any, motors: MotorLimits | None,
     if kind.needs_dynamics:
         raise ConfigError(f"law {mv.law!r} is not available in a program")
     params = dict(mv.params)
+    mass = model.inertia.point_mass
 
     def build(duration: float) -> Law:
         values = {k: v for k, v in params.items() if v is not None}
@@ -389,11 +399,12 @@ def _law(mv: Move, length: float, dynamics: Any, motors: MotorLimits | None,
     if "duration" not in kind.params:
         raise ConfigError(f"law {mv.law!r} has no duration to fit")
 
-    def ratio(T: float) -> float:
-        tau, dq = sample(build(T))
-        tr, sp = motors.ratios(tau, dq)
+    def sampled(T: float) -> float:
+        q, dq, ddq = motion(build(T))
+        tr, sp = motors.ratios(inverse_dynamics(model, q, dq, ddq), dq)
         return max(tr, sp)
 
+    ratio = _stretched_ratio(build, motion, model, motors) or sampled
     hi = 0.05
     while ratio(hi) > 1.0:
         hi *= 2.0
@@ -409,6 +420,34 @@ def _law(mv: Move, length: float, dynamics: Any, motors: MotorLimits | None,
         if hi - lo <= 1e-6 * hi:
             break
     return build(hi)
+
+
+def _stretched_ratio(build: Callable[[float], Law],
+                     motion: Callable[[Law], tuple[Array, Array, Array]], model: Model,
+                     motors: MotorLimits) -> Callable[[float], float] | None:
+    """The motors' ratio at any duration ``T`` from one sampling, for a law whose shape only
+    stretches with its duration (``s_T(t) = s_1(t / T)``: uniform, min-jerk); None for other
+    laws (checked on the law itself). With the joint motion at ``T = 1`` on the same fractions
+    of the motion, ``qdot_T = qdot / T`` and ``qddot_T = qddot / T^2``, so the torques are
+    ``(M qddot + c(q, qdot)) / T^2 + g(q) + friction(qdot / T)`` exactly."""
+    one, two = build(1.0), build(2.0)
+    f = np.linspace(0.0, 1.0, 65)
+    scale = np.array([1.0, 2.0, 4.0, 8.0])[:, None]
+    a, b = one.evaluate(f), two.evaluate(2.0 * f) * scale
+    if not np.allclose(a, b, rtol=1e-9, atol=1e-12 * float(np.abs(a).max())):
+        return None
+    q, dq, ddq = motion(one)
+    ine = model.inertia
+    inertial = inverse_dynamics(Model(model.robot, ine.frictionless(), model.assembly,
+                                      tol=model.tol), q, dq, ddq)
+    g = gravity_torques(model, q)
+
+    def ratio(T: float) -> float:
+        dqT = dq / T
+        tr, sp = motors.ratios(inertial / (T * T) + g + ine.friction_torques(dqT), dqT)
+        return max(tr, sp)
+
+    return ratio
 
 
 @dataclass(frozen=True)
@@ -440,7 +479,6 @@ def _plan_move(robot: FiveBar, inertia: Inertia, mv: Move, P0: Array, q0: Array,
                assembly: str, motors: MotorLimits | None, grid: int, tol: Tolerances,
                start_s: float) -> tuple[PlannedMove, Array, Array, str]:
     model = Model(robot, inertia, assembly, tol=tol.type2)
-    mass = inertia.point_mass
     if mv.type == "dwell":
         if not mv.time > 0:
             raise ConfigError(f"'time' must be positive, got {mv.time!r}")
@@ -452,8 +490,6 @@ def _plan_move(robot: FiveBar, inertia: Inertia, mv: Move, P0: Array, q0: Array,
                     np.zeros((n, 2)))
 
         if motors is not None:  # holding still against gravity must be within the motors
-            from ..dynamics import gravity_torques
-
             g = gravity_torques(Model(robot, inertia, assembly, tol=0.0), q0)
             ratio = np.abs(g) / np.asarray(motors.peak_torque)
             if ratio.max() > 1.0:
@@ -472,12 +508,12 @@ def _plan_move(robot: FiveBar, inertia: Inertia, mv: Move, P0: Array, q0: Array,
             return sample_trajectory(robot, path, law, mode=mode, times=times,
                                      samples=401, tolerances=tol, units=SI)
 
-        def sample_law(law: Law) -> tuple[Array, Array]:
+        def motion(law: Law) -> tuple[Array, Array, Array]:
             tr = traj(law)
-            return inverse_dynamics(model, tr.q, tr.dq, tr.ddq), tr.dq
+            return tr.q, tr.dq, tr.ddq
 
         law = _law(mv, path.length, RobotAlongPath(model, path, mode, SI), motors, grid,
-                   sample_law, mass, path)
+                   motion, model, path)
         tr = traj(law)
         d1, d2 = singularity_distances(robot, tr.q, tr.P)
 
@@ -508,12 +544,12 @@ def _plan_move(robot: FiveBar, inertia: Inertia, mv: Move, P0: Array, q0: Array,
             return sample_joint_trajectory(robot, line, law, assembly=assembly, times=times,
                                            samples=401, tolerances=tol, units=SI)
 
-        def jsample_law(law: Law) -> tuple[Array, Array]:
+        def jmotion(law: Law) -> tuple[Array, Array, Array]:
             tr = jtraj(law)
-            return inverse_dynamics(model, tr.q, tr.dq, tr.ddq), tr.dq
+            return tr.q, tr.dq, tr.ddq
 
         law = _law(mv, line.length, RobotAlongJointLine(model, line, SI), motors, grid,
-                   jsample_law, mass, None)
+                   jmotion, model, None)
         tr = jtraj(law)
         d1, d2 = singularity_distances(robot, tr.q, tr.P)
         P1 = direct_kinematics(robot, q1, assembly)
