@@ -79,6 +79,9 @@ def pareto_figure(F: Array, pareto: Array, best: int, names: Sequence[str]) -> F
         ax.scatter(F[best, 0], F[best, 1], s=140, marker="*", color="C3", label="chosen")
         ax.set_xlabel(names[0])
         ax.set_ylabel(names[1])
+        if F.shape[1] > 2:
+            ax.set_title(f"Pareto on {F.shape[1]} objectives ({', '.join(names)}), shown on "
+                         "the first two", fontsize=8)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
