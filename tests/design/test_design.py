@@ -340,3 +340,31 @@ def test_a_running_cluster_by_address_gives_the_same_file(sweep2, tmp_path):
         for p in procs:
             os.killpg(p.pid, signal.SIGKILL)
             p.wait()
+
+
+def test_a_worker_that_dies_is_replaced_and_the_rows_are_complete(sweep2):
+    """One of two workers is killed after the first chunk: Dask reruns its chunks elsewhere
+    and the sweep ends with every row, equal to the uninterrupted sweep's."""
+    from dextar.design.sweep import Cluster, run_sweep
+    from dextar.jobs import design_task
+
+    task_path, out2 = sweep2
+    task, space = design_task(str(task_path))
+    designs = space.designs()
+    got: dict[int, dict] = {}
+    killed = []
+
+    with Cluster(workers=2) as cl:
+        def on_chunk(rows):
+            got.update({r["design"]: r for r in rows})
+            if not killed:
+                victim = sorted(cl.client.scheduler_info()["workers"])[0]
+                pid = cl.client.run(os.getpid, workers=[victim])[victim]
+                os.kill(pid, signal.SIGKILL)  # the worker process dies mid-sweep
+                killed.append(pid)
+
+        run_sweep(cl, task, designs, range(len(designs)), chunk=4, on_chunk=on_chunk)
+    assert killed and sorted(got) == list(range(64))
+    expected = rows_of(out2)
+    for i in range(64):
+        assert got[i] == expected[i]
