@@ -174,3 +174,12 @@ def test_collinear_columns_name_the_combination(base):
     with pytest.raises(ParameterError, match=r"the combination .*J_A'.*fv_A|the combination "
                                              r".*fv_A.*J_A'"):
         _rank_check(A, base, "data.csv")
+
+
+def test_values_beyond_any_measurement_are_refused(prior, excitation):
+    model, mode, _ = prior
+    d = synthetic(model, excitation, 10.0, seed=7)
+    tau = d.tau.copy()
+    tau[50, 0] = 1e308
+    with pytest.raises(ParameterError, match=r"tau1_Nm, tau2_Nm beyond 1e\+09 at row 52"):
+        MotionData(d.t, d.q, tau)

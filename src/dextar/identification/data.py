@@ -19,6 +19,8 @@ OPTIONAL = ("dphi_rad_s", "dpsi_rad_s", "ddphi_rad_s2", "ddpsi_rad_s2")
 UNIFORM_TOL = 0.01
 #: Largest angle magnitude accepted (rad): beyond it the column is not in radians.
 MAX_ANGLE = 1000.0
+#: Largest magnitude accepted for times, rates, accelerations and torques (SI).
+MAX_VALUE = 1e9
 
 
 @dataclass(frozen=True)
@@ -81,6 +83,13 @@ def check_motion(d: MotionData) -> None:
     if big.any():
         raise ParameterError(f"{d.source}: phi_rad, psi_rad beyond {MAX_ANGLE:g} rad at row "
                              f"{_rows(big)}: not angles in radians")
+    for name, arr in named.items():
+        if arr is None or name.startswith("phi"):
+            continue
+        huge = np.asarray((np.abs(arr) > MAX_VALUE).any(axis=1))
+        if huge.any():
+            raise ParameterError(f"{d.source}: column {name} beyond {MAX_VALUE:g} at row "
+                                 f"{_rows(huge)}: not a measurement in SI units")
     if n < 3:
         raise ParameterError(f"{d.source}: {n} samples; an identification needs many more")
     dt = np.diff(d.t)

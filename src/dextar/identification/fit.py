@@ -39,7 +39,7 @@ from .._arrays import Array
 from ..dynamics.exact import Model
 from ..dynamics.inertia import Inertia, Rod
 from ..dynamics.regressor import INDEX, STANDARD, regressor, standard_parameters
-from ..errors import ParameterError
+from ..errors import NumericalError, ParameterError
 from ..geometry import parse_working_mode
 from ..kinematics import direct_kinematics, working_mode
 from .base import BaseParameters, base_parameters
@@ -188,6 +188,10 @@ def condition(data: MotionData, model: Model, *, cutoff_hz: float | None = None
     n = len(data.t)
     Yf = _lowpass(Y.reshape(n, -1), fc, fs).reshape(Y.shape)
     tau = _lowpass(data.tau, fc, fs)
+    for name, arr in (("the regressor", Yf), ("the torques", tau)):
+        if not np.isfinite(arr).all():
+            raise NumericalError(f"{data.source}: {name} overflow after filtering (values "
+                                 "too large for double precision)")
     edge = min(int(math.ceil(fs / fc)), n // 10)
     step = max(1, int(fs / (2.5 * fc)))
     keep = np.arange(edge, n - edge, step)
@@ -222,6 +226,9 @@ def _stack(Yb: Array, tau: Array, sigma: Array, keep: Array) -> tuple[Array, Arr
 def _rank_check(A: Array, base: BaseParameters, source: str) -> float:
     """Condition number of ``A`` with unit-norm columns; raise for a rank-deficient ``A``
     naming the base-parameter combinations the data cannot identify."""
+    if not np.isfinite(A).all():
+        raise NumericalError(f"{source}: the weighted regressor is not finite (values too "
+                             "large or too small for double precision)")
     norms = np.linalg.norm(A, axis=0)
     names = base.names
     if (norms == 0).any():
