@@ -27,3 +27,8 @@ def test_paper_toml_is_the_default():
     b = load_scenario(None)
     assert a.robot == b.robot and a.path == b.path and a.inertia == b.inertia
     assert a.law_table == b.law_table and a.units == b.units and a.paper == b.paper
+
+
+def test_identification_script_runs(capsys):
+    runpy.run_path(str(EXAMPLES / "identify_synthetic.py"), run_name="__main__")
+    assert "identification checks passed" in capsys.readouterr().out
