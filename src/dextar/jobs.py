@@ -459,7 +459,6 @@ def identify(data_path: str, out: str, *, config: str | None = None,
     from .identification.data import read_motion_csv
     from .identification.fit import check_working_mode, condition
     from .identification.fit import identify as fit
-    from .output.config_file import model_toml
     from .output.identification import (
         fit_figure,
         identification_report,
@@ -474,7 +473,8 @@ def identify(data_path: str, out: str, *, config: str | None = None,
     data = read_motion_csv(data_path)
     vdata = read_motion_csv(validate) if validate else None
     res = fit(data, model, mode=sc.mode, cutoff_hz=cutoff_hz)
-    c = condition(data, model, cutoff_hz=res.cutoff_hz)
+    c = res.conditioned
+    assert c is not None
     Yb = res.base.columns(c.Y)
     summary: dict[str, Any] = {
         "status": ("identified" if res.status == 0 else "poorly conditioned" if res.status == 1
@@ -506,19 +506,12 @@ def identify(data_path: str, out: str, *, config: str | None = None,
         summary["validation_rms_torque_Nm"] = [float(v) for v in
                                                np.sqrt((vc.tau ** 2).mean(axis=0))]
         panels.append(("validation data", vc.t, vc.tau, pred))
-    friction_t, gravity_t = sc.table("friction"), sc.table("gravity")
-    extra: dict[str, Any] = {}
-    if config is not None:
-        raw = load_toml(config)
-        extra = {k: raw[k] for k in ("motors", "tolerances") if k in raw}
-    toml_text = model_toml(
-        sc.robot_mm, sc.mode, sc.assembly, res.inertia,
-        coulomb_speed_deg_s=friction_t.coulomb_speed_deg_s, gravity_mm_s2=gravity_t.vector,
-        extra=extra,
-        comment=(f"identified by dextar from {data_path} ({res.method}, condition number "
-                 f"{res.condition_number:.4g})\nbase parameters reproduced exactly; the split "
-                 "between rods, rotor and payload that the torques cannot see follows "
-                 f"{config or 'the defaults'}"))
+    toml_text = _model_config(
+        sc, config, sc.robot_mm, sc.mode, res.inertia,
+        f"identified by dextar from {data_path} ({res.method}, condition number "
+        f"{res.condition_number:.4g})\nbase parameters reproduced exactly; the split "
+        "between rods, rotor and payload that the torques cannot see follows "
+        f"{config or 'the defaults'}")
     csv_rows = parameters_csv(res)
     with OutputDir(out, force=force) as od:
         od.write_text("identified.toml", toml_text)
@@ -528,8 +521,7 @@ def identify(data_path: str, out: str, *, config: str | None = None,
 
             png = png_bytes(fit_figure(panels))
             od.write_bytes("fit.png", png)
-            od.write_text("report.html", identification_report(summary, csv_rows,
-                                                               {"fit": png}))
+            od.write_text("report.html", identification_report(summary, {"fit": png}))
         od.write_text("summary.json", json.dumps(summary, indent=2, allow_nan=False) + "\n")
     lines = [f"identified {res.base.size} base parameters from {res.n_samples} samples "
              f"({res.n_used} used after filtering at {res.cutoff_hz:.3g} Hz): {res.method}, "
@@ -557,13 +549,11 @@ def design(config: str, out: str, *, samples: int | None = None, seed: int | Non
     ``designs.csv``, ``pareto.csv``, ``best.toml``, ``summary.json``, figures and the report."""
     import hashlib
 
-    from .config.tables import FrictionTable, GravityTable
     from .design.evaluate import inertia_of
     from .design.pareto import closest_to_ideal, pareto_mask
     from .design.space import LENGTHS
     from .design.sweep import Cluster, require_dask, run_sweep
     from .geometry import FiveBar
-    from .output.config_file import model_toml
     from .output.design import DesignsFile, header, row_line
     from .output.files import write_bytes, write_text
 
@@ -596,7 +586,6 @@ def design(config: str, out: str, *, samples: int | None = None, seed: int | Non
         "reasons": _reason_counts(ordered)}
     pareto_rows: list[dict[str, Any]] = []
     pngs: dict[str, bytes] = {}
-    best_P = None
     if feasible:
         F = space.objective_values(feasible)
         mask = pareto_mask(F)
@@ -606,16 +595,10 @@ def design(config: str, out: str, *, samples: int | None = None, seed: int | Non
         best = feasible[b]
         summary["pareto"], summary["best"] = len(pareto_rows), best
         robot_mm = FiveBar(*(best[k] for k in LENGTHS))
-        friction_t, gravity_t = sc.table("friction"), sc.table("gravity")
-        assert isinstance(friction_t, FrictionTable) and isinstance(gravity_t, GravityTable)
-        extra = {k: v for k, v in load_toml(config).items() if k in ("motors", "tolerances")}
-        write_text(outdir / "best.toml", model_toml(
-            robot_mm, mode, sc.assembly, inertia_of(task, robot_mm.scaled(1e-3)),
-            coulomb_speed_deg_s=friction_t.coulomb_speed_deg_s,
-            gravity_mm_s2=gravity_t.vector, extra=extra,
-            comment=(f"the Pareto design closest to the ideal point of dextar design "
-                     f"{config} (design {best['design']} of {n}; objectives "
-                     f"{', '.join(space.objectives)})")))
+        write_text(outdir / "best.toml", _model_config(
+            sc, config, robot_mm, mode, inertia_of(task, robot_mm.scaled(1e-3)),
+            f"the Pareto design closest to the ideal point of dextar design {config} (design "
+            f"{best['design']} of {n}; objectives {', '.join(space.objectives)})"))
         if figures:
             from .design.evaluate import evaluate_path
             from .output.design import pareto_figure, scatter_matrix
@@ -693,6 +676,22 @@ def design_task(config: str, *, samples: int | None = None, seed: int | None = N
                     law_type=kind.name if law is None else None,
                     law_values=values if law is None else None)
     return task, space
+
+
+def _model_config(sc: Scenario, config: str | None, robot_mm: Any, mode: str, inertia: Any,
+                  comment: str) -> str:
+    """A config file of ``inertia`` (SI) on ``robot_mm``, with the scenario's friction speed
+    and gravity and its ``[motors]`` and ``[tolerances]`` as the file gives them."""
+    from .config.tables import FrictionTable, GravityTable
+    from .output.config_file import model_toml
+
+    friction_t, gravity_t = sc.table("friction"), sc.table("gravity")
+    assert isinstance(friction_t, FrictionTable) and isinstance(gravity_t, GravityTable)
+    raw = load_toml(config) if config is not None else {}
+    extra: dict[str, Any] = {k: raw[k] for k in ("motors", "tolerances") if k in raw}
+    return model_toml(robot_mm, mode, sc.assembly, inertia,
+                      coulomb_speed_deg_s=friction_t.coulomb_speed_deg_s,
+                      gravity_mm_s2=gravity_t.vector, extra=extra, comment=comment)
 
 
 def _reason_counts(rows: list[dict[str, Any]]) -> dict[str, int]:

@@ -293,20 +293,19 @@ def test_fit_by_time_scaling_equals_resampling():
     motors = sc.table("motors").limits(SI)
     path = Line((-0.04, 0.09), (0.04, 0.12))
 
-    def motion(law):
-        tr = sample_trajectory(m.robot, path, law, mode=sc.mode, samples=401, units=SI)
-        return tr.q, tr.dq, tr.ddq
+    def traj(law):
+        return sample_trajectory(m.robot, path, law, mode=sc.mode, samples=401, units=SI)
 
     for name, extra in (("min-jerk", {}), ("optimal", {"eta": 0.1})):
         def build(T, name=name, extra=extra):
             return law_type(name).build(LawRequest(path, {"duration": T, **extra}, 0.13, None,
                                                    SI))
 
-        fast = _stretched_ratio(build, motion, model, motors)
+        fast = _stretched_ratio(build, traj, model, motors)
         if name == "optimal":
             assert fast is None
             continue
         for T in (0.05, 0.3, 2.0):
-            q, dq, ddq = motion(build(T))
-            ref = max(motors.ratios(inverse_dynamics(model, q, dq, ddq), dq))
+            tr = traj(build(T))
+            ref = max(motors.ratios(inverse_dynamics(model, tr.q, tr.dq, tr.ddq), tr.dq))
             assert fast(T) == pytest.approx(ref, rel=1e-9)

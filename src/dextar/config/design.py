@@ -7,7 +7,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
-from ..design.space import LENGTHS, METRICS, SAMPLINGS, DesignSpace
+from ..design.space import LENGTHS, SAMPLINGS, DesignSpace, check_objectives
 from ..errors import ConfigError
 from ..geometry import FiveBar
 from ..params import Param, read_params
@@ -57,10 +57,7 @@ class DesignTable(Table):
         if not isinstance(objectives, list) or not all(isinstance(o, str) for o in objectives):
             raise ConfigError(f"config key [design].objectives must be a list of metric names, "
                               f"got {objectives!r}")
-        for o in objectives:
-            if o.lstrip("-") not in METRICS:
-                raise ConfigError(f"config key [design].objectives: unknown objective {o!r}; "
-                                  f"known: {', '.join(METRICS)} (a leading - maximises)")
+        check_objectives(objectives)
         for a, b in (("l", "l1"), ("l", "l2"), ("L", "L1"), ("L", "L2")):
             if a in values and b in values:
                 raise ConfigError(f"config keys [design].{a} and [design].{b} both set the "

@@ -125,14 +125,20 @@ def usable_area_mm2(robot_mm: FiveBar, mode: str, start_mm: Sequence[float],
     return float((labels == lab).sum() * (x[1] - x[0]) * (y[1] - y[0]))
 
 
+def _unplanned_row(lengths: Sequence[float], reason: str) -> dict[str, Any]:
+    """A design's row before (or without) its plan: its lengths, not feasible, ``reason``, its
+    footprint and no other metric."""
+    row: dict[str, Any] = {k: float(v) for k, v in zip(LENGTHS, lengths, strict=True)}
+    row.update({"feasible": False, "reason": reason, **dict.fromkeys(METRICS)})
+    row["footprint_mm"] = footprint_mm(lengths)
+    return row
+
+
 def evaluate_design(task: Task, lengths: Sequence[float]) -> dict[str, Any]:
     """The row of one design ``(l1, l2, L1, L2, d)`` (mm): its lengths, ``feasible``,
     ``reason`` (empty when feasible) and the metrics of :data:`~dextar.design.space.METRICS`
     (None where the plan failed before they exist)."""
-    row: dict[str, Any] = {k: float(v) for k, v in zip(LENGTHS, lengths, strict=True)}
-    row.update({"feasible": False, "reason": ""})
-    row.update(dict.fromkeys(METRICS))
-    row["footprint_mm"] = footprint_mm(lengths)
+    row = _unplanned_row(lengths, "")
     try:
         robot_mm = FiveBar(*(float(v) for v in lengths))
     except DextarError as exc:
@@ -207,10 +213,7 @@ def evaluate_chunk(task: Task, designs: Array, first: int) -> list[dict[str, Any
         try:
             row = evaluate_design(task, lengths)
         except Exception as exc:  # noqa: BLE001 - kept as the design's reason
-            row = {kk: float(v) for kk, v in zip(LENGTHS, lengths, strict=True)}
-            row.update({"feasible": False, "reason": f"internal error: {type(exc).__name__}: "
-                        f"{exc}", **dict.fromkeys(METRICS)})
-            row["footprint_mm"] = footprint_mm(lengths)
+            row = _unplanned_row(lengths, f"internal error: {type(exc).__name__}: {exc}")
         rows.append({"design": first + k, **row})
     return rows
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -27,6 +28,16 @@ METRICS = ("cycle_time_s", "footprint_mm", "min_type1_distance", "min_type2_dist
 SAMPLINGS = ("sobol", "grid", "random")
 #: Most designs a sweep samples.
 MAX_SAMPLES = 1_000_000
+
+
+def check_objectives(objectives: Sequence[str]) -> None:
+    """Raise :class:`ConfigError` for an empty list or an unknown metric name."""
+    for obj in objectives:
+        if obj.lstrip("-") not in METRICS:
+            raise ConfigError(f"config key [design].objectives: unknown objective {obj!r}; "
+                              f"known: {', '.join(METRICS)} (a leading - maximises)")
+    if not objectives:
+        raise ConfigError("config key [design].objectives is empty")
 
 
 @dataclass(frozen=True)
@@ -81,12 +92,7 @@ class DesignSpace:
         if self.sampling not in SAMPLINGS:
             raise ConfigError(f"config key [design].sampling = {self.sampling!r}: one of "
                               f"{', '.join(SAMPLINGS)}")
-        for obj in self.objectives:
-            if obj.lstrip("-") not in METRICS:
-                raise ConfigError(f"config key [design].objectives: unknown objective {obj!r}; "
-                                  f"known: {', '.join(METRICS)} (a leading - maximises)")
-        if not self.objectives:
-            raise ConfigError("config key [design].objectives is empty")
+        check_objectives(self.objectives)
 
     def designs(self) -> Array:
         """The sampled designs, shape (n, 5) in mm (``n = samples``; for ``grid``, the

@@ -15,8 +15,6 @@ from dataclasses import dataclass
 from itertools import islice
 from typing import Any
 
-import numpy as np
-
 from .._arrays import Array
 from ..errors import ConfigError
 from .evaluate import Task, evaluate_chunk
@@ -156,8 +154,3 @@ def run_sweep(cluster: Cluster, task: Task, designs: Array, todo: Sequence[int],
             if nxt is not None:
                 queue.add(submit(nxt))
     return SweepStats(len(todo), time.perf_counter() - t0, n_workers)
-
-
-def local_rows(task: Task, designs: Array, indices: Sequence[int]) -> list[dict[str, Any]]:
-    """The rows of some designs evaluated in this process (to check a sweep's rows)."""
-    return [r for i in indices for r in evaluate_chunk(task, np.asarray(designs)[i:i + 1], i)]

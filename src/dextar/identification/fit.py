@@ -114,6 +114,8 @@ class IdentificationResult:
         does not reproduce the base parameters exactly.
     message : str
     warnings : list of str
+    conditioned : Conditioned, optional
+        The filtered, decimated data the fit used (for plots and residuals).
     """
 
     base: BaseParameters
@@ -132,6 +134,7 @@ class IdentificationResult:
     status: int
     message: str
     warnings: list[str] = field(default_factory=list)
+    conditioned: Conditioned | None = None
 
     @property
     def success(self) -> bool:
@@ -310,7 +313,6 @@ def identify(data: MotionData, model: Model, *, mode: str, cutoff_hz: float | No
         theta = _constrained_fit(Aw, bw, base, prior, model.inertia)
         beta = base.of(theta)
         std = _hac_std(Aw, Aw @ beta - bw, sizes)  # the spread about the constrained fit
-        ok = True
     inertia = realise(theta, model.inertia)
     back = base.of(standard_parameters(inertia))
     consistent = bool(np.all(np.abs(back - beta) <= 1e-9 * np.maximum(np.abs(beta), 1e-12)
@@ -333,7 +335,7 @@ def identify(data: MotionData, model: Model, *, mode: str, cutoff_hz: float | No
                         "inertia or friction): the fit was constrained to physical parameters")
     return IdentificationResult(base, beta, std, theta, inertia, method, cond, rms, sigma,
                                 len(data.t), m, c.cutoff_hz, consistent, status, message,
-                                warnings)
+                                warnings, c)
 
 
 def _hac_std(A: Array, r: Array, sizes: tuple[int, int]) -> Array:
@@ -414,11 +416,11 @@ def physical_set(beta: Array, base: BaseParameters, prior: Array, prior_inertia:
               and np.all(rods(r.x) >= -1e-9)
               and all(lo is None or r.x[i] >= lo - 1e-12 for i, (lo, _hi) in enumerate(sb)))
     if ok:  # land exactly on the constraints (SLSQP stops within its tolerance)
-        theta = _polish(theta, base, beta, s)
+        theta = _polish(theta, base, beta)
     return theta, ok
 
 
-def _polish(theta: Array, base: BaseParameters, beta: Array, s: Array) -> Array:
+def _polish(theta: Array, base: BaseParameters, beta: Array) -> Array:
     """Move ``theta`` onto ``K theta = beta`` exactly along the independent parameters."""
     idx = list(base.independent)
     out = theta.copy()

@@ -53,18 +53,16 @@ def fit_figure(panels: Sequence[tuple[str, Array, Array, Array]]) -> Figure:
     return fig
 
 
-def identification_report(summary: Mapping[str, Any], csv_rows: str,
-                          pngs: dict[str, bytes]) -> str:
+def identification_report(summary: Mapping[str, Any], pngs: dict[str, bytes]) -> str:
     """The report page: the summary, the base parameters with their deviations, the fit."""
     esc = html.escape
     rows = []
-    for line in csv_rows.splitlines()[1:]:
-        name, rest = line.split(",", 1)
-        meaning, tail = rest[1:].split('",', 1)
-        value, std, rel, unit = tail.split(",")
-        rows.append(f"<tr><td>{esc(name)}</td><td>{esc(meaning)}</td><td>{esc(unit)}</td>"
-                    f"<td>{float(value):.6g}</td><td>{float(std):.3g}</td>"
-                    f"<td>{esc(rel if rel == 'inf' else f'{float(rel):.3g}')}</td></tr>")
+    for p in summary["base_parameters"]:
+        v, s = p["value"], p["std"]
+        rel = f"{100.0 * s / abs(v):.3g}" if v != 0 else "inf"
+        rows.append(f"<tr><td>{esc(p['name'])}</td><td>{esc(p['meaning'])}</td>"
+                    f"<td>{esc(p['unit'])}</td><td>{v:.6g}</td><td>{s:.3g}</td>"
+                    f"<td>{rel}</td></tr>")
     facts = [("status", summary["status"]), ("message", summary["message"]),
              ("method", summary["method"]), ("samples read / used",
                                              f"{summary['n_samples']} / {summary['n_used']}"),

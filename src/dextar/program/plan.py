@@ -291,15 +291,11 @@ def _plan_chain(robot: FiveBar, inertia: Inertia, group: list[Move], P0: Array, 
         return sample_trajectory(robot, path, law, mode=mode, times=times, samples=801,
                                  tolerances=tol, units=SI)
 
-    def motion(law: Law) -> tuple[Array, Array, Array]:
-        tr = traj(law)
-        return tr.q, tr.dq, tr.ddq
-
     # resolve each blend with at least 40 segments of the time-optimal grid
     shortest = min(piece.length for piece in path.pieces)
     fine = min(max(grid, int(math.ceil(40 * path.length / shortest))), 8000)
     law = _law(first, path.length, RobotAlongPath(model, path, mode, SI), motors, fine,
-               motion, model, path)
+               traj, model, path)
     tr = traj(law)
     d1, d2 = singularity_distances(robot, tr.q, tr.P)
     shift = np.round((q0 - tr.q[0]) / (2 * np.pi)) * 2 * np.pi
@@ -367,11 +363,10 @@ def _arc(mv: Move, P0: Array) -> Path:
 
 
 def _law(mv: Move, length: float, dynamics: Any, motors: MotorLimits | None,
-         grid: int, motion: Callable[[Law], tuple[Array, Array, Array]], model: Model,
+         grid: int, traj: Callable[[Law], Trajectory], model: Model,
          path: Path | None) -> Law:
     """The move's law: time-optimal, a fixed-shape law with its duration, or ``"fit"``.
-    ``motion(law)`` samples the joint motion ``q, qdot, qddot`` on fixed fractions of the
-    law's duration."""
+    ``traj(law)`` samples the motion on fixed fractions of the law's duration."""
     if mv.law == "time-optimal":
         if motors is None:
             raise ConfigError("the time-optimal law needs a [motors] table")
@@ -400,11 +395,11 @@ def _law(mv: Move, length: float, dynamics: Any, motors: MotorLimits | None,
         raise ConfigError(f"law {mv.law!r} has no duration to fit")
 
     def sampled(T: float) -> float:
-        q, dq, ddq = motion(build(T))
-        tr, sp = motors.ratios(inverse_dynamics(model, q, dq, ddq), dq)
+        tr_ = traj(build(T))
+        tr, sp = motors.ratios(inverse_dynamics(model, tr_.q, tr_.dq, tr_.ddq), tr_.dq)
         return max(tr, sp)
 
-    ratio = _stretched_ratio(build, motion, model, motors) or sampled
+    ratio = _stretched_ratio(build, traj, model, motors) or sampled
     hi = 0.05
     while ratio(hi) > 1.0:
         hi *= 2.0
@@ -423,7 +418,7 @@ def _law(mv: Move, length: float, dynamics: Any, motors: MotorLimits | None,
 
 
 def _stretched_ratio(build: Callable[[float], Law],
-                     motion: Callable[[Law], tuple[Array, Array, Array]], model: Model,
+                     traj: Callable[[Law], Trajectory], model: Model,
                      motors: MotorLimits) -> Callable[[float], float] | None:
     """The motors' ratio at any duration ``T`` from one sampling, for a law whose shape only
     stretches with its duration (``s_T(t) = s_1(t / T)``: uniform, min-jerk); None for other
@@ -436,7 +431,8 @@ def _stretched_ratio(build: Callable[[float], Law],
     a, b = one.evaluate(f), two.evaluate(2.0 * f) * scale
     if not np.allclose(a, b, rtol=1e-9, atol=1e-12 * float(np.abs(a).max())):
         return None
-    q, dq, ddq = motion(one)
+    tr = traj(one)
+    q, dq, ddq = tr.q, tr.dq, tr.ddq
     ine = model.inertia
     inertial = inverse_dynamics(Model(model.robot, ine.frictionless(), model.assembly,
                                       tol=model.tol), q, dq, ddq)
@@ -508,12 +504,8 @@ def _plan_move(robot: FiveBar, inertia: Inertia, mv: Move, P0: Array, q0: Array,
             return sample_trajectory(robot, path, law, mode=mode, times=times,
                                      samples=401, tolerances=tol, units=SI)
 
-        def motion(law: Law) -> tuple[Array, Array, Array]:
-            tr = traj(law)
-            return tr.q, tr.dq, tr.ddq
-
         law = _law(mv, path.length, RobotAlongPath(model, path, mode, SI), motors, grid,
-                   motion, model, path)
+                   traj, model, path)
         tr = traj(law)
         d1, d2 = singularity_distances(robot, tr.q, tr.P)
 
@@ -544,12 +536,8 @@ def _plan_move(robot: FiveBar, inertia: Inertia, mv: Move, P0: Array, q0: Array,
             return sample_joint_trajectory(robot, line, law, assembly=assembly, times=times,
                                            samples=401, tolerances=tol, units=SI)
 
-        def jmotion(law: Law) -> tuple[Array, Array, Array]:
-            tr = jtraj(law)
-            return tr.q, tr.dq, tr.ddq
-
         law = _law(mv, line.length, RobotAlongJointLine(model, line, SI), motors, grid,
-                   jmotion, model, None)
+                   jtraj, model, None)
         tr = jtraj(law)
         d1, d2 = singularity_distances(robot, tr.q, tr.P)
         P1 = direct_kinematics(robot, q1, assembly)
