@@ -46,7 +46,7 @@ def toppra_duration(along: RobotAlongPath, n: int) -> tuple[float, float]:
         canlinear_colloc_to_interpolate,
     )
 
-    co = along.coefficients(n)
+    co = along.coefficients(np.linspace(0.0, along.length, n + 1))
 
     class Torque(LinearConstraint):
         def __init__(self) -> None:

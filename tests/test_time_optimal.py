@@ -160,3 +160,32 @@ def test_motors_table_errors_named():
                          ({"peak_torque": -1.0}, r"\[motors\]\.peak_torque must be positive")):
         with pytest.raises(ConfigError, match=word):
             scenario_from_dict({**MOTORS, "motors": motors})
+
+
+def test_a_graded_grid_holds_the_limits_and_converges_with_the_uniform_one():
+    """A grid of arc lengths finer at one end: the limits hold on a dense sampling, and its
+    duration lies between the uniform grids of its coarsest and finest steps (the
+    discretisation's loss grows with the step)."""
+    S = SEMI.length
+    u = np.linspace(0.0, 1.0, 301)
+    s = S * (0.4 * u + 0.6 * u**2)  # steps from 0.4 S/300 to 1.6 S/300
+    graded = solve_time_optimal_law(MODEL, SEMI, torque_limit=(20.0, 20.0), grid=s)
+    fine = solve_time_optimal_law(MODEL, SEMI, torque_limit=(20.0, 20.0), grid=750)
+    coarse = solve_time_optimal_law(MODEL, SEMI, torque_limit=(20.0, 20.0), grid=187)
+    np.testing.assert_allclose(graded.knots_s, s, rtol=0, atol=1e-12 * S)
+    assert graded.success and "300 segments of" in graded.message and " to " in graded.message
+    assert fine.duration < graded.duration < coarse.duration
+    ratio = peak_torque(MODEL, SEMI, graded, n=8001) / 20.0
+    assert ratio.max() <= 1 + 1e-3 and ratio.max() > 0.99
+
+
+@pytest.mark.parametrize("grid, words", [
+    (5, "at least 10 segments"), (50.5, "whole number"),
+    (np.linspace(0.0, 1.0, 8), "at least 11 points"),
+    (np.r_[0.0, 0.5, 0.4, np.linspace(0.6, SEMI.length, 10)], "strictly increasing"),
+    (np.linspace(0.1, SEMI.length, 20), "from 0 to the path's length"),
+    (np.linspace(0.0, 2 * SEMI.length, 20), "from 0 to the path's length"),
+    (np.r_[np.linspace(0.0, 1.0, 12), np.nan, SEMI.length], "finite")])
+def test_bad_grids_are_named(grid, words):
+    with pytest.raises(dx.DextarError, match=words):
+        solve_time_optimal_law(MODEL, SEMI, torque_limit=(20.0, 20.0), grid=grid)

@@ -309,3 +309,26 @@ def test_fit_by_time_scaling_equals_resampling():
             tr = traj(build(T))
             ref = max(motors.ratios(inverse_dynamics(model, tr.q, tr.dq, tr.ddq), tr.dq))
             assert fast(T) == pytest.approx(ref, rel=1e-9)
+
+
+def test_chain_grid_resolves_each_blend_and_keeps_the_joints():
+    """A blended chain is one motion with ``grid`` segments shared by length; each blend gets
+    at least 40, each piece at least 10, and every piece starts on a grid point."""
+    from dextar.paths import Arc, Line
+    from dextar.paths.composite import Quintic, blended
+    from dextar.program.plan import BLEND_SEGMENTS, chain_grid
+
+    pieces = [Line((-40.0, 90.0), (-40.0, 110.0)),
+              Arc(40.0, -np.pi, 0.0, center=(0.0, 110.0), clockwise=True),  # over the top
+              Line((40.0, 110.0), (40.0, 90.0))]
+    path, _ = blended(pieces, [5.0, 5.0])
+    for grid in (30, 100, 400):
+        s = chain_grid(path, grid)
+        assert s[0] == 0.0 and s[-1] == path.length and np.all(np.diff(s) > 0)
+        starts = path.starts
+        assert np.abs(s[:, None] - starts[None, :]).min(axis=0).max() <= 1e-12 * path.length
+        for k, piece in enumerate(path.pieces):
+            inside = ((s > starts[k] + 1e-12) & (s <= starts[k + 1] + 1e-12)).sum()
+            least = BLEND_SEGMENTS if isinstance(piece, Quintic) else 10
+            share = int(np.ceil(grid * piece.length / path.length))
+            assert inside == max(least, share)

@@ -38,7 +38,7 @@ class DesignTable(Table):
         "objectives": Param("text", "", None, "metrics to minimise (a leading - maximises)"),
         "chunk": Param("integer", "", 8, "designs per unit of work", minimum=1,
                        maximum=10_000),
-        "grid": Param("integer", "", 100, "time-optimal segments per move in the sweep",
+        "grid": Param("integer", "", 100, "time-optimal segments per motion in the sweep",
                       minimum=10, maximum=100_000),
     }
 

@@ -39,12 +39,17 @@ class RobotAlongPath:
     mode: str = "+-"
     units: Units | None = None
 
-    def coefficients(self, segments: int) -> PathCoefficients:
-        """The path dynamics on ``segments + 1`` equally spaced arc lengths."""
+    @property
+    def length(self) -> float:
+        """The path's arc length."""
+        return float(self.path.length)
+
+    def coefficients(self, s: Array) -> PathCoefficients:
+        """The path dynamics at the arc lengths ``s`` (N + 1,), from 0 to the length."""
         S = self.path.length
         # a unit-speed law makes t = s, qdot = q', qddot = q''
         jp = sample_trajectory(self.model.robot, self.path, UniformLaw(S, S), mode=self.mode,
-                               samples=segments + 1, units=self.units)
+                               times=np.asarray(s, float), units=self.units)
         robot, ine = self.model.robot, self.model.inertia
         quiet = Model(robot, ine.frictionless(), jp.assembly)
         a = np.einsum("nij,nj->ni", mass_matrix(quiet, jp.q), jp.dq)
@@ -65,7 +70,8 @@ class RobotAlongPath:
 def time_optimal_law(model: Model, path: Path, *,
                      torque_limit: tuple[float, float] | None = None,
                      speed_limit: tuple[float, float] | None = None,
-                     motors: MotorLimits | None = None, mode: str = "+-", grid: int = 400,
+                     motors: MotorLimits | None = None, mode: str = "+-",
+                     grid: int | Array = 400,
                      tol: float = 1e-3, units: Units | None = None) -> TimeOptimalLaw:
     """The fastest rest-to-rest law along ``path`` for ``model`` within the motors' torque
     (and speed) limits; see :func:`dextar.laws.time_optimal.solve_time_optimal_law`."""
@@ -83,9 +89,14 @@ class RobotAlongJointLine:
     line: JointLine
     units: Units | None = None
 
-    def coefficients(self, segments: int) -> PathCoefficients:
-        """The path dynamics on ``segments + 1`` equally spaced joint-space lengths."""
-        s = np.linspace(0.0, self.line.length, segments + 1)
+    @property
+    def length(self) -> float:
+        """The joint-space line's length."""
+        return float(self.line.length)
+
+    def coefficients(self, s: Array) -> PathCoefficients:
+        """The path dynamics at the joint-space lengths ``s`` (N + 1,)."""
+        s = np.asarray(s, float)
         q = self.line.at(s)
         u = np.broadcast_to(self.line.direction, q.shape).copy()
         robot, ine = self.model.robot, self.model.inertia

@@ -53,6 +53,10 @@ from .base import Law
 
 #: Greatest number of solves (friction tangent updates and limit margins).
 MAX_SOLVES = 8
+#: The friction tangent has settled when no speed along the path moves by more than this
+#: fraction of the largest between two solves; the law's duration then moves by about its
+#: square (the tangent iteration converges quadratically).
+TANGENT_RTOL = 1e-3
 #: Where the output check samples each segment (fractions of its duration): both ends
 #: (the acceleration jumps at the knots) and seven interior points.
 CHECK_FRACTIONS = np.concatenate([[1e-9], np.linspace(0.125, 0.875, 7), [1.0 - 1e-9]])
@@ -113,7 +117,7 @@ class PathCoefficients:
     Attributes
     ----------
     s : ndarray, shape (N + 1,)
-        Arc lengths, equally spaced from 0 to the path's length.
+        Arc lengths of the grid, increasing from 0 to the path's length.
     P : ndarray, shape (N + 1, 2)
         End-effector positions (for the words of an error).
     a, b, g : ndarray, shape (N + 1, 2)
@@ -187,8 +191,13 @@ class MotorLimits:
 class PathDynamics(Protocol):
     """The robot along a path, as the time-optimal law needs it."""
 
-    def coefficients(self, segments: int) -> PathCoefficients:
-        """The coefficients on ``segments + 1`` equally spaced arc lengths."""
+    @property
+    def length(self) -> float:
+        """The path's length."""
+        ...
+
+    def coefficients(self, s: Array) -> PathCoefficients:
+        """The coefficients at the arc lengths ``s`` (N + 1,), from 0 to the length."""
         ...
 
     def ratios(self, law: Law, times: Array, motors: MotorLimits) -> tuple[float, float]:
@@ -200,7 +209,7 @@ class PathDynamics(Protocol):
 def solve_time_optimal_law(dynamics: PathDynamics, *,
                            torque_limit: tuple[float, float] | None = None,
                            speed_limit: tuple[float, float] | None = None,
-                           motors: MotorLimits | None = None, grid: int = 400,
+                           motors: MotorLimits | None = None, grid: int | Array = 400,
                            tol: float = 1e-3, units: Units | None = None) -> TimeOptimalLaw:
     """The fastest rest-to-rest law along a path within motor torque and speed limits.
 
@@ -214,8 +223,9 @@ def solve_time_optimal_law(dynamics: PathDynamics, *,
         ``|qdot|`` limits of the motors (rad per run time unit).
     motors : MotorLimits, optional
         The limits with a torque-speed envelope (instead of the two above).
-    grid : int
-        Number of segments in arc length.
+    grid : int or ndarray, shape (N + 1,)
+        Number of equal segments in arc length, or the grid's arc lengths (increasing from 0
+        to the path's length; finer where the dynamics change fast, e.g. in a blend).
     tol : float
         Allowed relative excess of a torque or speed over its limit on the check samples.
     units : Units, optional
@@ -242,15 +252,14 @@ def solve_time_optimal_law(dynamics: PathDynamics, *,
     tmax = np.asarray(motors.peak_torque, float)
     wmax = np.asarray(motors.max_speed, float)
     knee = None if motors.knee_speed is None else np.asarray(motors.knee_speed, float)
-    if int(grid) < 10:
-        raise ParameterError(f"grid = {grid} must be at least 10")
     if not (0 < tol < 1):
         raise ParameterError(f"tolerance {tol!r} must be in (0, 1)")
-    n = int(grid)
-    co = dynamics.coefficients(n)
-    length = float(co.s[-1])
+    length = float(dynamics.length)
+    s_grid = _grid(grid, length)
+    n = len(s_grid) - 1
+    co = dynamics.coefficients(s_grid)
     _check_holding(co, tmax, units)
-    ds = length / n
+    ds = np.diff(co.s)
     x0: Array | None = None  # tangent points of the viscous bound
     scale_t, scale_w = 1.0, 1.0
     law: TimeOptimalLaw | None = None
@@ -258,25 +267,27 @@ def solve_time_optimal_law(dynamics: PathDynamics, *,
     for solve in range(1, MAX_SOLVES + 1):
         x = _reachability(co, ds, tmax * scale_t, wmax * scale_w, x0, units,
                           None if knee is None else knee * scale_w)
+        tangent_moved = has_viscous and (x0 is None or np.abs(np.sqrt(x) - np.sqrt(x0)).max()
+                                         > TANGENT_RTOL * np.sqrt(x).max())
+        bounded = x0 is not None or not has_viscous  # friction bound in place
+        if has_viscous:
+            x0 = x
+        if tangent_moved and solve < MAX_SOLVES:
+            continue  # the check waits for the friction tangent to settle
         law = _law(length, co.s, x, tmax, wmax, solve)
         dts = np.diff(law.knots_t)
         times = (law.knots_t[:-1, None] + dts[:, None] * CHECK_FRACTIONS[None, :]).reshape(-1)
         tr_ratio, sp_ratio = dynamics.ratios(law, times, motors)
         law = _with(law, tr_ratio, sp_ratio, 0, "")
-        tangent_moved = has_viscous and (x0 is None or np.abs(np.sqrt(x) - np.sqrt(x0)).max()
-                                         > 1e-6 * np.sqrt(x).max())
-        within = tr_ratio <= 1 + tol and sp_ratio <= 1 + tol
-        if within and not tangent_moved:
+        if tr_ratio <= 1 + tol and sp_ratio <= 1 + tol:
             break
-        bounded = x0 is not None or not has_viscous  # friction bound in place
-        if not within and bounded:  # discretisation excess: tighten by it
+        if bounded:  # discretisation excess: tighten by it
             scale_t *= min(1.0, (1 + 0.25 * tol) / max(tr_ratio, 1e-300))
             scale_w *= min(1.0, (1 + 0.25 * tol) / max(sp_ratio, 1e-300))
-        if has_viscous:
-            x0 = x
     assert law is not None
     ok = law.max_torque_ratio <= 1 + tol and law.max_speed_ratio <= 1 + tol
-    where = f"{n} segments of {ds:.4g}"
+    where = (f"{n} segments of {ds[0]:.4g}" if np.ptp(ds) <= 1e-9 * length else
+             f"{n} segments of {ds.min():.4g} to {ds.max():.4g}")
     margin = "" if scale_t == 1.0 and scale_w == 1.0 else (
         f"; limits tightened by {1 - scale_t:.2%} (torque) and {1 - scale_w:.2%} (speed) so "
         "that they hold between the grid points")
@@ -289,6 +300,26 @@ def solve_time_optimal_law(dynamics: PathDynamics, *,
            f"{law.max_torque_ratio:.5f}, speed ratio {law.max_speed_ratio:.5f} (tolerance "
            f"{1 + tol:g}); refine the grid")
     return _with(law, law.max_torque_ratio, law.max_speed_ratio, 1, msg)
+
+
+def _grid(grid: int | Array, length: float) -> Array:
+    """The grid's arc lengths (N + 1,) from a number of equal segments or given points."""
+    if np.ndim(grid) == 0:
+        if int(grid) != grid or int(grid) < 10:
+            raise ParameterError(f"grid = {grid} must be a whole number of at least 10 segments")
+        return np.linspace(0.0, length, int(grid) + 1)
+    s = np.asarray(grid, float)
+    if s.ndim != 1 or s.size < 11:
+        raise ParameterError(f"a grid of arc lengths must have at least 11 points, got shape "
+                             f"{s.shape}")
+    if not np.all(np.isfinite(s)) or not np.all(np.diff(s) > 0):
+        raise ParameterError("a grid of arc lengths must be finite and strictly increasing")
+    if abs(s[0]) > 1e-9 * length or abs(s[-1] - length) > 1e-9 * length:
+        raise ParameterError(f"a grid of arc lengths must run from 0 to the path's length "
+                             f"{length:.6g}, got {s[0]:.6g} to {s[-1]:.6g}")
+    s = s.copy()
+    s[0], s[-1] = 0.0, length
+    return s
 
 
 def _with(law: TimeOptimalLaw, tr: float, sp: float, status: int, message: str
@@ -347,7 +378,7 @@ def _friction_bounds(co: PathCoefficients, x0: Array | None
     return phi_lo, psi_lo, phi_hi, psi_hi
 
 
-def _rows(co: PathCoefficients, ds: float, tmax: Array, wmax: Array,
+def _rows(co: PathCoefficients, ds: Array, tmax: Array, wmax: Array,
           x0: Array | None, knee: Array | None = None) -> tuple[Array, Array, Array]:
     """Static rows ``Gu u + Gx x <= h`` of every stage, arrays (N, m).
 
@@ -379,21 +410,22 @@ def _rows(co: PathCoefficients, ds: float, tmax: Array, wmax: Array,
     return _stage_rows(pu_, px_, ph_, ds)
 
 
-def _stage_rows(pu: Array, px: Array, ph: Array, ds: float) -> tuple[Array, Array, Array]:
-    """The rows of each stage from the rows at its two points (interpolation scheme)."""
+def _stage_rows(pu: Array, px: Array, ph: Array, ds: Array) -> tuple[Array, Array, Array]:
+    """The rows of each stage from the rows at its two points (interpolation scheme); ``ds``
+    (N,) the stages' lengths."""
     # stage k: rows at point k with X = x, rows at point k + 1 with X = x + 2 ds u
-    Gu = np.concatenate([pu[:-1], pu[1:] + 2 * ds * px[1:]], axis=1)
+    Gu = np.concatenate([pu[:-1], pu[1:] + 2 * ds[:, None] * px[1:]], axis=1)
     Gx = np.concatenate([px[:-1], px[1:]], axis=1)
     h = np.concatenate([ph[:-1], ph[1:]], axis=1)
     return Gu, Gx, h
 
 
-def _reachability(co: PathCoefficients, ds: float, tmax: Array, wmax: Array,
+def _reachability(co: PathCoefficients, ds: Array, tmax: Array, wmax: Array,
                   x0: Array | None, units: Units | None, knee: Array | None = None) -> Array:
     """Squared speeds ``x`` at the grid points of the fastest admissible motion."""
     Gu, Gx, h = _rows(co, ds, tmax, wmax, x0, knee)
     n = Gu.shape[0]
-    tiny = 1e-12 * (np.abs(Gu) + 2 * ds * np.abs(Gx))
+    tiny = 1e-12 * (np.abs(Gu) + 2 * ds[:, None] * np.abs(Gx))
     up, lo_, xonly = Gu > tiny, Gu < -tiny, np.abs(Gu) <= tiny
     with np.errstate(divide="ignore", invalid="ignore"):
         alpha = np.where(xonly, 0.0, -Gx / Gu)
@@ -412,7 +444,7 @@ def _reachability(co: PathCoefficients, ds: float, tmax: Array, wmax: Array,
                           np.where(xonly & (Gx < 0), h / Gx, -np.inf).max(axis=1))
         empty = ((c == 0) & (d < 0)).any(axis=(1, 2)) | (xonly & (Gx == 0) & (h < 0)).any(axis=1)
     x_lo = np.where(empty, np.inf, np.maximum(x_lo, 0.0))
-    inv2 = 1.0 / (2 * ds)
+    inv2 = (1.0 / (2 * ds))[:, None]
     # The controllability rows lo <= x + 2 ds u <= hi combine with the static rows into bounds
     # on x linear in hi (lower rows) or lo (upper rows): x <= m hi + q or x >= m hi + q. The
     # coefficients are precomputed for all stages at once; the pass only evaluates them.
@@ -463,11 +495,11 @@ def _reachability(co: PathCoefficients, ds: float, tmax: Array, wmax: Array,
     if K_lo[0] > 1e-12 * (1.0 + K_hi[0]):
         raise _unreachable(co, 0, tmax, units)
     x = [0.0] * (n + 1)
-    two_ds = 2 * ds
+    two_ds, half = (2 * ds).tolist(), inv2[:, 0].tolist()
     for k in range(n):
         xk = x[k]
-        u_hi = (K_hi[k + 1] - xk) * inv2
-        u_lo = (K_lo[k + 1] - xk) * inv2
+        u_hi = (K_hi[k + 1] - xk) * half[k]
+        u_lo = (K_lo[k + 1] - xk) * half[k]
         for a_, b_ in zip(AU[k], BU[k], strict=True):
             v = a_ * xk + b_
             if v < u_hi:
@@ -478,7 +510,7 @@ def _reachability(co: PathCoefficients, ds: float, tmax: Array, wmax: Array,
                 u_lo = v
         if u_lo > u_hi + 1e-9 * (1.0 + abs(u_hi)):
             raise _unreachable(co, k, tmax, units)
-        x[k + 1] = min(max(xk + two_ds * u_hi, K_lo[k + 1]), K_hi[k + 1])
+        x[k + 1] = min(max(xk + two_ds[k] * u_hi, K_lo[k + 1]), K_hi[k + 1])
     x[n] = 0.0
     return np.array(x)
 

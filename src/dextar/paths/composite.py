@@ -145,6 +145,11 @@ class Composite(Path):
         return np.concatenate([[0.0], np.cumsum(self._lengths)])
 
     @property
+    def starts(self) -> Array:
+        """Arc length at the start of each piece and the total length, shape (n + 1,)."""
+        return self._starts.copy()
+
+    @property
     def length(self) -> float:
         """Sum of the pieces' lengths."""
         return float(self._starts[-1])

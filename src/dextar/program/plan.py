@@ -46,6 +46,7 @@ from ..laws import Law, LawRequest, MotorLimits, law_type
 from ..laws.time_optimal import solve_time_optimal_law
 from ..params import to_run_units
 from ..paths import Arc, Line, Path
+from ..paths.composite import Composite, Quintic, blended
 from ..trajectory import (
     JointLine,
     Trajectory,
@@ -57,6 +58,8 @@ from ..units import SI
 
 #: Move types.
 MOVE_TYPES = ("line", "arc", "dwell", "joint")
+#: Fewest time-optimal grid segments across a blend.
+BLEND_SEGMENTS = 40
 
 
 @dataclass(frozen=True)
@@ -206,7 +209,8 @@ def plan_program(robot: FiveBar, inertia: Inertia, moves: Sequence[Move], *,
     servo_rate_hz : float
         Setpoint rate.
     grid : int
-        Time-optimal grid (segments per move).
+        Time-optimal grid: segments per motion (blended moves are one motion, see
+        :func:`chain_grid`).
     tolerances : Tolerances
 
     Returns
@@ -265,8 +269,6 @@ def _plan_chain(robot: FiveBar, inertia: Inertia, group: list[Move], P0: Array, 
                 mode: str, assembly: str, motors: MotorLimits | None, grid: int,
                 tol: Tolerances, start_s: float) -> tuple[PlannedMove, Array, Array]:
     """Moves joined by blends: one path with G2 corners, one law, no stop at the corners."""
-    from ..paths.composite import blended
-
     first = group[0]
     for mv in group[1:]:
         if mv.law != first.law or (mv.duration is not None and mv.duration != first.duration):
@@ -291,11 +293,8 @@ def _plan_chain(robot: FiveBar, inertia: Inertia, group: list[Move], P0: Array, 
         return sample_trajectory(robot, path, law, mode=mode, times=times, samples=801,
                                  tolerances=tol, units=SI)
 
-    # resolve each blend with at least 40 segments of the time-optimal grid
-    shortest = min(piece.length for piece in path.pieces)
-    fine = min(max(grid, int(math.ceil(40 * path.length / shortest))), 8000)
-    law = _law(first, path.length, RobotAlongPath(model, path, mode, SI), motors, fine,
-               traj, model, path)
+    law = _law(first, path.length, RobotAlongPath(model, path, mode, SI), motors,
+               chain_grid(path, grid), traj, model, path)
     tr = traj(law)
     d1, d2 = singularity_distances(robot, tr.q, tr.P)
     shift = np.round((q0 - tr.q[0]) / (2 * np.pi)) * 2 * np.pi
@@ -312,13 +311,28 @@ def _plan_chain(robot: FiveBar, inertia: Inertia, group: list[Move], P0: Array, 
     # when each move starts: the time its first piece starts (s(t) increases)
     tt = np.linspace(0.0, law.duration, 4001)
     ss = law.evaluate(tt)[0]
-    starts_s = [float(path._starts[owner.index(k)]) for k in range(len(group))]
+    starts_s = [float(path.starts[owner.index(k)]) for k in range(len(group))]
     t_at = [float(np.interp(v, ss, tt)) for v in starts_s] + [law.duration]
     members = tuple((mv.index, start_s + t_at[k], t_at[k + 1] - t_at[k])
                     for k, mv in enumerate(group))
     pm = PlannedMove(first, law, start_s, law.duration, q0, tr.q[-1] + shift, sample,
                      float(d1.min()), float(d2.min()), owner_of, members)
     return pm, tr.P[-1], tr.q[-1] + shift
+
+
+def chain_grid(path: Composite, grid: int) -> Array:
+    """The time-optimal grid (arc lengths) of a blended chain, one motion: its ``grid``
+    segments shared among the pieces by length, a blend at least :data:`BLEND_SEGMENTS` (its
+    curvature and so its torques change fast), any piece at least 10; the pieces' joints are
+    grid points."""
+    parts = [np.zeros(1)]
+    for piece, start in zip(path.pieces, path.starts[:-1], strict=True):
+        share = math.ceil(grid * piece.length / path.length)
+        n = max(share, BLEND_SEGMENTS if isinstance(piece, Quintic) else 10)
+        parts.append(start + np.linspace(0.0, piece.length, n + 1)[1:])
+    s = np.concatenate(parts)
+    s[-1] = path.length
+    return s
 
 
 def _target(mv: Move) -> Array:
