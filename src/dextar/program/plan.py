@@ -377,7 +377,7 @@ def _arc(mv: Move, P0: Array) -> Path:
 
 
 def _law(mv: Move, length: float, dynamics: Any, motors: MotorLimits | None,
-         grid: int, traj: Callable[[Law], Trajectory], model: Model,
+         grid: int | Array, traj: Callable[[Law], Trajectory], model: Model,
          path: Path | None) -> Law:
     """The move's law: time-optimal, a fixed-shape law with its duration, or ``"fit"``.
     ``traj(law)`` samples the motion on fixed fractions of the law's duration."""
