@@ -52,15 +52,21 @@ class Quintic(Path):
         rows = np.array([self.p0_, self.v0, self.a0, self.a1, self.v1, self.p1_], float)
         return np.asarray(_H.T @ rows)
 
+    @cached_property
+    def _derivative_coefs(self) -> tuple[Array, ...]:
+        """The coefficients of ``r`` and its first three derivatives, each (6 - k, 2)."""
+        c = self._coef
+        return tuple(np.polynomial.polynomial.polyder(c, k) if k else c for k in range(4))
+
     def derivatives(self, p: object) -> tuple[Array, Array, Array, Array]:
         """The position and its first three derivatives at ``p``, each of shape (..., 2)."""
-        u = self._check_parameter(p)
-        c = self._coef
+        u = self._check_parameter(p)[..., None]
         out = []
-        for k in range(4):
-            ck = np.polynomial.polynomial.polyder(c, k) if k else c
-            out.append(np.stack([np.polynomial.polynomial.polyval(u, ck[:, j])
-                                 for j in range(2)], axis=-1))
+        for ck in self._derivative_coefs:  # Horner, both coordinates at once
+            acc = np.broadcast_to(ck[-1], u.shape[:-1] + (2,))
+            for row in ck[-2::-1]:
+                acc = acc * u + row
+            out.append(np.array(acc))
         return out[0], out[1], out[2], out[3]
 
 

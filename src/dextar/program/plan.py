@@ -22,6 +22,7 @@ The computation is in SI units (m, kg, s, N m).
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -283,7 +284,7 @@ def _plan_chain(robot: FiveBar, inertia: Inertia, group: list[Move], P0: Array, 
         pieces.append(piece)
         P = _target(mv)
     try:
-        path, owner = blended(pieces, [SI.length(mv.blend) for mv in group[:-1]])
+        path, owner = _blended(tuple(pieces), tuple(SI.length(mv.blend) for mv in group[:-1]))
     except ParameterError as exc:
         raise ConfigError(f"blend: {exc}") from None
     model = Model(robot, inertia, assembly, tol=tol.type2)
@@ -317,7 +318,16 @@ def _plan_chain(robot: FiveBar, inertia: Inertia, group: list[Move], P0: Array, 
                     for k, mv in enumerate(group))
     pm = PlannedMove(first, law, start_s, law.duration, q0, tr.q[-1] + shift, sample,
                      float(d1.min()), float(d2.min()), owner_of, members)
-    return pm, tr.P[-1], tr.q[-1] + shift
+    return pm, _target(group[-1]), tr.q[-1] + shift
+
+
+@functools.lru_cache(maxsize=32)
+def _blended(pieces: tuple[Path, ...], blends: tuple[float, ...]
+             ) -> tuple[Composite, tuple[int, ...]]:
+    """:func:`~dextar.paths.composite.blended`, kept for the next robot: the task-space path of
+    a chain depends on the task only, and its blends' arc-length tables are costly."""
+    path, owner = blended(pieces, blends)
+    return path, tuple(owner)
 
 
 def chain_grid(path: Composite, grid: int) -> Array:
@@ -534,7 +544,7 @@ def _plan_move(robot: FiveBar, inertia: Inertia, mv: Move, P0: Array, q0: Array,
             P, q, dq, ddq = sample(t)
             return P, q + shift, dq, ddq
 
-        P1 = tr.P[-1]
+        P1 = _target(mv)  # exactly where the move was sent (the next starts there)
         return (PlannedMove(mv, law, start_s, law.duration, q0, tr.q[-1] + shift, shifted,
                             float(d1.min()), float(d2.min())), P1, tr.q[-1] + shift, mode)
     if mv.type == "joint":
