@@ -313,7 +313,7 @@ def test_fit_by_time_scaling_equals_resampling():
 
 def test_chain_grid_resolves_each_blend_and_keeps_the_joints():
     """A blended chain is one motion with ``grid`` segments shared by length; each blend gets
-    at least 40, each piece at least 10, and every piece starts on a grid point."""
+    at least 20, each piece at least 10, and every piece starts on a grid point."""
     from dextar.paths import Arc, Line
     from dextar.paths.composite import Quintic, blended
     from dextar.program.plan import BLEND_SEGMENTS, chain_grid

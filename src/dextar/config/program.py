@@ -28,7 +28,7 @@ class ProgramTable(Table):
         "law": Param("text", "", "time-optimal", "default law of every move"),
         "blend": Param("number", "", 0.0, "default corner blend radius, mm", minimum=0.0),
         "grid": Param("integer", "", 400, "time-optimal segments per motion (blended moves "
-                      "are one motion; a blend gets at least 40)", minimum=10,
+                      "are one motion; a blend gets at least 20)", minimum=10,
                       maximum=100_000),
     }
 

@@ -31,13 +31,16 @@ from .exact import Model, bias_forces, gravity_torques, inverse_dynamics, mass_m
 class RobotAlongPath:
     """A robot model following ``path`` in working mode ``mode``.
 
-    ``units`` only serves the words of an error (points in mm, times in s).
+    ``units`` only serves the words of an error (points in mm, times in s). ``checked``:
+    run the geometry checker on the coefficients' grid (False when the path was checked
+    already, e.g. by :func:`dextar.trajectory.check_path`).
     """
 
     model: Model
     path: Path
     mode: str = "+-"
     units: Units | None = None
+    checked: bool = True
 
     @property
     def length(self) -> float:
@@ -49,7 +52,8 @@ class RobotAlongPath:
         S = self.path.length
         # a unit-speed law makes t = s, qdot = q', qddot = q''
         jp = sample_trajectory(self.model.robot, self.path, UniformLaw(S, S), mode=self.mode,
-                               times=np.asarray(s, float), units=self.units)
+                               times=np.asarray(s, float), units=self.units,
+                               checked=self.checked)
         robot, ine = self.model.robot, self.model.inertia
         quiet = Model(robot, ine.frictionless(), jp.assembly)
         a = np.einsum("nij,nj->ni", mass_matrix(quiet, jp.q), jp.dq)

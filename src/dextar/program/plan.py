@@ -60,7 +60,7 @@ from ..units import SI
 #: Move types.
 MOVE_TYPES = ("line", "arc", "dwell", "joint")
 #: Fewest time-optimal grid segments across a blend.
-BLEND_SEGMENTS = 40
+BLEND_SEGMENTS = 20
 
 
 @dataclass(frozen=True)
@@ -294,8 +294,8 @@ def _plan_chain(robot: FiveBar, inertia: Inertia, group: list[Move], P0: Array, 
         return sample_trajectory(robot, path, law, mode=mode, times=times, samples=801,
                                  tolerances=tol, units=SI)
 
-    law = _law(first, path.length, RobotAlongPath(model, path, mode, SI), motors,
-               chain_grid(path, grid), traj, model, path)
+    along = RobotAlongPath(model, path, mode, SI, checked=False)  # checked above
+    law = _law(first, path.length, along, motors, chain_grid(path, grid), traj, model, path)
     tr = traj(law)
     d1, d2 = singularity_distances(robot, tr.q, tr.P)
     shift = np.round((q0 - tr.q[0]) / (2 * np.pi)) * 2 * np.pi
@@ -528,8 +528,8 @@ def _plan_move(robot: FiveBar, inertia: Inertia, mv: Move, P0: Array, q0: Array,
             return sample_trajectory(robot, path, law, mode=mode, times=times,
                                      samples=401, tolerances=tol, units=SI)
 
-        law = _law(mv, path.length, RobotAlongPath(model, path, mode, SI), motors, grid,
-                   traj, model, path)
+        along = RobotAlongPath(model, path, mode, SI, checked=False)  # checked above
+        law = _law(mv, path.length, along, motors, grid, traj, model, path)
         tr = traj(law)
         d1, d2 = singularity_distances(robot, tr.q, tr.P)
 
