@@ -54,9 +54,11 @@ from .base import Law
 #: Greatest number of solves (friction tangent updates and limit margins).
 MAX_SOLVES = 8
 #: The friction tangent has settled when no speed along the path moves by more than this
-#: fraction of the largest between two solves; the law's duration then moves by about its
-#: square (the tangent iteration converges quadratically).
-TANGENT_RTOL = 1e-3
+#: fraction of the largest between two solves. The iteration converges quadratically, so the
+#: law's duration is then within about the square of this of the settled one: over 96 designs
+#: of the pick-and-place sweep, 3e-2 moved the cycle times by at most 1.8e-5 relative against
+#: 1e-3, far below the grid's own loss (about 1e-3 at 400 segments).
+TANGENT_RTOL = 3e-2
 #: Where the output check samples each segment (fractions of its duration): both ends
 #: (the acceleration jumps at the knots) and seven interior points.
 CHECK_FRACTIONS = np.concatenate([[1e-9], np.linspace(0.125, 0.875, 7), [1.0 - 1e-9]])
