@@ -456,17 +456,16 @@ def _reachability(co: PathCoefficients, ds: Array, tmax: Array, wmax: Array,
         m_l, q_l = inv2 / cl, -bl / cl
         cu = -inv2 - au  # u >= (lo - x) / (2 ds) vs upper row: cu x <= bu - lo / (2 ds)
         m_u, q_u = -inv2 / cu, bu / cu
-    LH = _lists(*_compact(m_l, q_l, act_l & (cl > 0), np.inf))  # x <= m hi + q
-    LL = _lists(*_compact(m_l, q_l, act_l & (cl < 0), -np.inf))  # x >= m hi + q
-    uh_m, uh_q = _compact(m_u, q_u, act_u & (cu > 0), np.inf)  # x <= m lo + q
-    ul_m, ul_q = _compact(m_u, q_u, act_u & (cu < 0), -np.inf)  # x >= m lo + q
-    UH, UL = _lists(uh_m, uh_q), _lists(ul_m, ul_q)
-    AU, BU = _lists(au, bu)  # u <= a x + b
-    AL, BL = _lists(al, bl)  # u >= a x + b
+    LH = _lists(m_l, q_l, act_l & (cl > 0))  # x <= m hi + q
+    LL = _lists(m_l, q_l, act_l & (cl < 0))  # x >= m hi + q
+    uh, ul = act_u & (cu > 0), act_u & (cu < 0)
+    UH, UL = _lists(m_u, q_u, uh), _lists(m_u, q_u, ul)  # x <= m lo + q, x >= m lo + q
+    AU, BU = _lists(au, bu, act_u)  # u <= a x + b
+    AL, BL = _lists(al, bl, act_l)  # u >= a x + b
     XL, XH = x_lo.tolist(), x_hi.tolist()
     # with lo = 0 (rest is reachable, the usual case) the upper rows' bounds are constants
-    XL0 = np.maximum(x_lo, np.max(ul_q, axis=1, initial=-np.inf)).tolist()
-    XH0 = np.minimum(x_hi, np.min(uh_q, axis=1, initial=np.inf)).tolist()
+    XL0 = np.maximum(x_lo, np.where(ul, q_u, -np.inf).max(axis=1, initial=-np.inf)).tolist()
+    XH0 = np.minimum(x_hi, np.where(uh, q_u, np.inf).min(axis=1, initial=np.inf)).tolist()
     K_lo, K_hi = [0.0] * (n + 1), [0.0] * (n + 1)
     big = 1e300  # an unbounded hi stays finite, so that 0 * hi is 0
     for k in range(n - 1, -1, -1):
@@ -527,10 +526,14 @@ def _compact(m: Array, q: Array, active: Array, fill: float) -> tuple[Array, Arr
     return mm[:, :width], qq[:, :width]
 
 
-def _lists(m: Array, q: Array) -> tuple[list[list[float]], list[list[float]]]:
-    """The coefficients as Python lists, for the sequential passes (floats are faster there
-    than NumPy scalars)."""
-    return m.tolist(), q.tolist()
+def _lists(m: Array, q: Array, active: Array) -> tuple[list[list[float]], list[list[float]]]:
+    """Per stage (row of the arrays (N, w)), its active coefficients as Python lists, for the
+    sequential passes (floats are faster there than NumPy scalars)."""
+    ends = np.cumsum(active.sum(axis=1)).tolist()
+    mf, qf = m[active].tolist(), q[active].tolist()
+    starts = [0, *ends[:-1]]
+    return ([mf[a:b] for a, b in zip(starts, ends, strict=True)],
+            [qf[a:b] for a, b in zip(starts, ends, strict=True)])
 
 
 def _unreachable(co: PathCoefficients, k: int, tmax: Array, units: Units | None
