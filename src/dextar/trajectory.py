@@ -14,7 +14,13 @@ from ._arrays import Array
 from .errors import ParameterError
 from .geometry import FiveBar, assembly_mode_name, parse_working_mode, working_mode_name
 from .kinematics import assembly_mode, inverse_kinematics, joint_acceleration, joint_velocity
-from .kinematics.checker import DEFAULT_TOLERANCES, Tolerances, check_poses, check_reach
+from .kinematics.checker import (
+    DEFAULT_TOLERANCES,
+    PoseDistances,
+    Tolerances,
+    check_poses,
+    check_reach,
+)
 from .laws import Law
 from .paths import Path
 from .units import Units
@@ -151,12 +157,40 @@ def sample_trajectory(robot: FiveBar, path: Path, law: Law, *, mode: str = "+-",
                       p, dp, ddp, P, dP, ddP, q, dq, ddq)
 
 
+@dataclass(frozen=True)
+class CheckedPath:
+    """The poses at which :func:`check_path` checked a path.
+
+    Attributes
+    ----------
+    p : ndarray, shape (n,)
+        Path parameters, equally spaced from start to end.
+    P, q : ndarray, shape (n, 2)
+        Points and actuator angles (unwrapped along the path, from the principal angles at
+        its start).
+    distances : PoseDistances
+        Normalised distances to both singularity types, (n,) each.
+    """
+
+    p: Array
+    P: Array
+    q: Array
+    distances: PoseDistances
+
+
 def check_path(robot: FiveBar, path: Path, *, mode: str = "+-", samples: int = 2001,
-               tolerances: Tolerances = DEFAULT_TOLERANCES, units: Units | None = None) -> None:
+               tolerances: Tolerances = DEFAULT_TOLERANCES,
+               units: Units | None = None) -> CheckedPath:
     """Check a path before any law is planned on it: ``samples`` points equally spaced in the
     path parameter, within reach and clear of both singularity types in working mode ``mode``
     (the geometry checker). Errors name the path parameter and the point (in mm with
     ``units``).
+
+    Returns
+    -------
+    CheckedPath
+        The poses checked, with their distances to the singularities: a law along the path
+        passes the same poses, whatever its timing.
 
     Raises
     ------
@@ -169,8 +203,9 @@ def check_path(robot: FiveBar, path: Path, *, mode: str = "+-", samples: int = 2
     check_reach(robot, P, lambda i: f"the path leaves the workspace at p = {p[i]:.6g}",
                 words.point, words.length)
     q = inverse_kinematics(robot, P, mode, unwrap=True)
-    check_poses(robot, q, P, tolerances=tolerances, where=lambda i: f"at p = {p[i]:.6g}",
-                point=words.point, mode=mode)
+    d = check_poses(robot, q, P, tolerances=tolerances, where=lambda i: f"at p = {p[i]:.6g}",
+                    point=words.point, mode=mode)
+    return CheckedPath(p, P, q, d)
 
 
 @dataclass(frozen=True)

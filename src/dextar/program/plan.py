@@ -288,17 +288,16 @@ def _plan_chain(robot: FiveBar, inertia: Inertia, group: list[Move], P0: Array, 
     except ParameterError as exc:
         raise ConfigError(f"blend: {exc}") from None
     model = Model(robot, inertia, assembly, tol=tol.type2)
-    check_path(robot, path, mode=mode, tolerances=tol, units=SI)
+    poses = check_path(robot, path, mode=mode, tolerances=tol, units=SI)
 
     def traj(law: Law, times: Array | None = None) -> Trajectory:
         return sample_trajectory(robot, path, law, mode=mode, times=times, samples=801,
-                                 tolerances=tol, units=SI)
+                                 tolerances=tol, units=SI, checked=False)
 
     along = RobotAlongPath(model, path, mode, SI, checked=False)  # checked above
     law = _law(first, path.length, along, motors, chain_grid(path, grid), traj, model, path)
-    tr = traj(law)
-    d1, d2 = singularity_distances(robot, tr.q, tr.P)
-    shift = np.round((q0 - tr.q[0]) / (2 * np.pi)) * 2 * np.pi
+    shift = np.round((q0 - poses.q[0]) / (2 * np.pi)) * 2 * np.pi
+    q1 = poses.q[-1] + shift
     owners = np.array([group[o].index for o in owner])
 
     def sample(t: Array) -> tuple[Array, Array, Array, Array]:
@@ -316,9 +315,10 @@ def _plan_chain(robot: FiveBar, inertia: Inertia, group: list[Move], P0: Array, 
     t_at = [float(np.interp(v, ss, tt)) for v in starts_s] + [law.duration]
     members = tuple((mv.index, start_s + t_at[k], t_at[k + 1] - t_at[k])
                     for k, mv in enumerate(group))
-    pm = PlannedMove(first, law, start_s, law.duration, q0, tr.q[-1] + shift, sample,
-                     float(d1.min()), float(d2.min()), owner_of, members)
-    return pm, _target(group[-1]), tr.q[-1] + shift
+    pm = PlannedMove(first, law, start_s, law.duration, q0, q1, sample,
+                     float(poses.distances.type1.min()), float(poses.distances.type2.min()),
+                     owner_of, members)
+    return pm, _target(group[-1]), q1
 
 
 @functools.lru_cache(maxsize=32)
@@ -522,31 +522,31 @@ def _plan_move(robot: FiveBar, inertia: Inertia, mv: Move, P0: Array, q0: Array,
                             float(d2)), P0, q0, mode)
     if mv.type in ("line", "arc"):
         path: Path = Line(tuple(P0), tuple(_target(mv))) if mv.type == "line" else _arc(mv, P0)
-        check_path(robot, path, mode=mode, tolerances=tol, units=SI)
+        poses = check_path(robot, path, mode=mode, tolerances=tol, units=SI)
 
         def traj(law: Law, times: Array | None = None) -> Trajectory:
-            return sample_trajectory(robot, path, law, mode=mode, times=times,
-                                     samples=401, tolerances=tol, units=SI)
+            return sample_trajectory(robot, path, law, mode=mode, times=times, samples=401,
+                                     tolerances=tol, units=SI, checked=False)
 
         along = RobotAlongPath(model, path, mode, SI, checked=False)  # checked above
         law = _law(mv, path.length, along, motors, grid, traj, model, path)
-        tr = traj(law)
-        d1, d2 = singularity_distances(robot, tr.q, tr.P)
 
         def sample(t: Array) -> tuple[Array, Array, Array, Array]:
             s = traj(law, np.clip(t, 0.0, law.duration))
             return s.P, s.q, s.dq, s.ddq
 
         # keep the angles continuous with the previous move (unwrap by whole turns)
-        shift = np.round((q0 - tr.q[0]) / (2 * np.pi)) * 2 * np.pi
+        shift = np.round((q0 - poses.q[0]) / (2 * np.pi)) * 2 * np.pi
+        q1 = poses.q[-1] + shift
 
         def shifted(t: Array) -> tuple[Array, Array, Array, Array]:
             P, q, dq, ddq = sample(t)
             return P, q + shift, dq, ddq
 
         P1 = _target(mv)  # exactly where the move was sent (the next starts there)
-        return (PlannedMove(mv, law, start_s, law.duration, q0, tr.q[-1] + shift, shifted,
-                            float(d1.min()), float(d2.min())), P1, tr.q[-1] + shift, mode)
+        return (PlannedMove(mv, law, start_s, law.duration, q0, q1, shifted,
+                            float(poses.distances.type1.min()),
+                            float(poses.distances.type2.min())), P1, q1, mode)
     if mv.type == "joint":
         new_mode = canonical_working_mode(mv.working_mode or mode)
         if mv.to_deg is not None:
