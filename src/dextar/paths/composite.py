@@ -58,16 +58,23 @@ class Quintic(Path):
         c = self._coef
         return tuple(np.polynomial.polynomial.polyder(c, k) if k else c for k in range(4))
 
+    def _horner(self, order: int, u: Array) -> Array:
+        """The ``order``-th derivative at ``u`` (..., 1), shape (..., 2)."""
+        ck = self._derivative_coefs[order]
+        acc = ck[-1] * u + ck[-2]
+        for row in ck[-3::-1]:
+            acc = acc * u + row
+        return np.asarray(acc)
+
     def derivatives(self, p: object) -> tuple[Array, Array, Array, Array]:
         """The position and its first three derivatives at ``p``, each of shape (..., 2)."""
         u = self._check_parameter(p)[..., None]
-        out = []
-        for ck in self._derivative_coefs:  # Horner, both coordinates at once
-            acc = np.broadcast_to(ck[-1], u.shape[:-1] + (2,))
-            for row in ck[-2::-1]:
-                acc = acc * u + row
-            out.append(np.array(acc))
-        return out[0], out[1], out[2], out[3]
+        return self._horner(0, u), self._horner(1, u), self._horner(2, u), self._horner(3, u)
+
+    def speed(self, p: object) -> Array:
+        """``ds/dp = |r'(p)|`` (only the first derivative is evaluated)."""
+        r1 = self._horner(1, self._check_parameter(p)[..., None])
+        return np.asarray(np.hypot(r1[..., 0], r1[..., 1]))
 
 
 def _end_state(piece: Path, at_end: bool) -> tuple[Array, Array, float]:
