@@ -456,12 +456,13 @@ def _reachability(co: PathCoefficients, ds: Array, tmax: Array, wmax: Array,
         m_l, q_l = inv2 / cl, -bl / cl
         cu = -inv2 - au  # u >= (lo - x) / (2 ds) vs upper row: cu x <= bu - lo / (2 ds)
         m_u, q_u = -inv2 / cu, bu / cu
-    LH = _lists(m_l, q_l, act_l & (cl > 0))  # x <= m hi + q
-    LL = _lists(m_l, q_l, act_l & (cl < 0))  # x >= m hi + q
+    lhm, lhq, lhs = _flat(m_l, q_l, act_l & (cl > 0))  # x <= m hi + q
+    llm, llq, lls = _flat(m_l, q_l, act_l & (cl < 0))  # x >= m hi + q
     uh, ul = act_u & (cu > 0), act_u & (cu < 0)
-    UH, UL = _lists(m_u, q_u, uh), _lists(m_u, q_u, ul)  # x <= m lo + q, x >= m lo + q
-    AU, BU = _lists(au, bu, act_u)  # u <= a x + b
-    AL, BL = _lists(al, bl, act_l)  # u >= a x + b
+    uhm, uhq, uhs = _flat(m_u, q_u, uh)  # x <= m lo + q
+    ulm, ulq, uls = _flat(m_u, q_u, ul)  # x >= m lo + q
+    aum, auq, aus = _flat(au, bu, act_u)  # u <= a x + b
+    alm, alq, als = _flat(al, bl, act_l)  # u >= a x + b
     XL, XH = x_lo.tolist(), x_hi.tolist()
     # with lo = 0 (rest is reachable, the usual case) the upper rows' bounds are constants
     XL0 = np.maximum(x_lo, np.where(ul, q_u, -np.inf).max(axis=1, initial=-np.inf)).tolist()
@@ -474,20 +475,20 @@ def _reachability(co: PathCoefficients, ds: Array, tmax: Array, wmax: Array,
             xl, xh = XL0[k], XH0[k]
         else:
             xl, xh = XL[k], XH[k]
-            for m_, q_ in zip(UH[0][k], UH[1][k], strict=True):
-                v = m_ * lo + q_
+            for j in range(uhs[k], uhs[k + 1]):
+                v = uhm[j] * lo + uhq[j]
                 if v < xh:
                     xh = v
-            for m_, q_ in zip(UL[0][k], UL[1][k], strict=True):
-                v = m_ * lo + q_
+            for j in range(uls[k], uls[k + 1]):
+                v = ulm[j] * lo + ulq[j]
                 if v > xl:
                     xl = v
-        for m_, q_ in zip(LH[0][k], LH[1][k], strict=True):
-            v = m_ * hi + q_
+        for j in range(lhs[k], lhs[k + 1]):
+            v = lhm[j] * hi + lhq[j]
             if v < xh:
                 xh = v
-        for m_, q_ in zip(LL[0][k], LL[1][k], strict=True):
-            v = m_ * hi + q_
+        for j in range(lls[k], lls[k + 1]):
+            v = llm[j] * hi + llq[j]
             if v > xl:
                 xl = v
         if xl > xh + 1e-12 * (1.0 + abs(xh)):
@@ -501,12 +502,12 @@ def _reachability(co: PathCoefficients, ds: Array, tmax: Array, wmax: Array,
         xk = x[k]
         u_hi = (K_hi[k + 1] - xk) * half[k]
         u_lo = (K_lo[k + 1] - xk) * half[k]
-        for a_, b_ in zip(AU[k], BU[k], strict=True):
-            v = a_ * xk + b_
+        for j in range(aus[k], aus[k + 1]):
+            v = aum[j] * xk + auq[j]
             if v < u_hi:
                 u_hi = v
-        for a_, b_ in zip(AL[k], BL[k], strict=True):
-            v = a_ * xk + b_
+        for j in range(als[k], als[k + 1]):
+            v = alm[j] * xk + alq[j]
             if v > u_lo:
                 u_lo = v
         if u_lo > u_hi + 1e-9 * (1.0 + abs(u_hi)):
@@ -526,14 +527,12 @@ def _compact(m: Array, q: Array, active: Array, fill: float) -> tuple[Array, Arr
     return mm[:, :width], qq[:, :width]
 
 
-def _lists(m: Array, q: Array, active: Array) -> tuple[list[list[float]], list[list[float]]]:
-    """Per stage (row of the arrays (N, w)), its active coefficients as Python lists, for the
-    sequential passes (floats are faster there than NumPy scalars)."""
-    ends = np.cumsum(active.sum(axis=1)).tolist()
-    mf, qf = m[active].tolist(), q[active].tolist()
-    starts = [0, *ends[:-1]]
-    return ([mf[a:b] for a, b in zip(starts, ends, strict=True)],
-            [qf[a:b] for a, b in zip(starts, ends, strict=True)])
+def _flat(m: Array, q: Array, active: Array) -> tuple[list[float], list[float], list[int]]:
+    """The active coefficients of all stages (rows of the arrays (N, w)) as flat Python lists,
+    stage ``k``'s at indices ``starts[k]`` to ``starts[k + 1]``, for the sequential passes
+    (floats are faster there than NumPy scalars)."""
+    starts = np.concatenate([[0], np.cumsum(active.sum(axis=1))]).tolist()
+    return m[active].tolist(), q[active].tolist(), starts
 
 
 def _unreachable(co: PathCoefficients, k: int, tmax: Array, units: Units | None
