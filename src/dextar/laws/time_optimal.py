@@ -459,10 +459,8 @@ def _reachability(co: PathCoefficients, ds: Array, tmax: Array, wmax: Array,
     lhm, lhq, lhs = _flat(m_l, q_l, act_l & (cl > 0))  # x <= m hi + q
     llm, llq, lls = _flat(m_l, q_l, act_l & (cl < 0))  # x >= m hi + q
     uh, ul = act_u & (cu > 0), act_u & (cu < 0)
-    uhm, uhq, uhs = _flat(m_u, q_u, uh)  # x <= m lo + q
-    ulm, ulq, uls = _flat(m_u, q_u, ul)  # x >= m lo + q
+    upper: list[tuple[list[float], list[float], list[int]]] = []  # made when lo > 0 first
     aum, auq, aus = _flat(au, bu, act_u)  # u <= a x + b
-    alm, alq, als = _flat(al, bl, act_l)  # u >= a x + b
     XL, XH = x_lo.tolist(), x_hi.tolist()
     # with lo = 0 (rest is reachable, the usual case) the upper rows' bounds are constants
     XL0 = np.maximum(x_lo, np.where(ul, q_u, -np.inf).max(axis=1, initial=-np.inf)).tolist()
@@ -474,6 +472,9 @@ def _reachability(co: PathCoefficients, ds: Array, tmax: Array, wmax: Array,
         if lo == 0.0:
             xl, xh = XL0[k], XH0[k]
         else:
+            if not upper:  # x <= m lo + q, x >= m lo + q
+                upper += [_flat(m_u, q_u, uh), _flat(m_u, q_u, ul)]
+            (uhm, uhq, uhs), (ulm, ulq, uls) = upper
             xl, xh = XL[k], XH[k]
             for j in range(uhs[k], uhs[k + 1]):
                 v = uhm[j] * lo + uhq[j]
@@ -506,10 +507,8 @@ def _reachability(co: PathCoefficients, ds: Array, tmax: Array, wmax: Array,
             v = aum[j] * xk + auq[j]
             if v < u_hi:
                 u_hi = v
-        for j in range(als[k], als[k + 1]):
-            v = alm[j] * xk + alq[j]
-            if v > u_lo:
-                u_lo = v
+        # (the lower rows hold at the largest acceleration: x[k] is controllable, so some
+        # acceleration meets every row and reaches K[k + 1], and the largest one does)
         if u_lo > u_hi + 1e-9 * (1.0 + abs(u_hi)):
             raise _unreachable(co, k, tmax, units)
         x[k + 1] = min(max(xk + two_ds[k] * u_hi, K_lo[k + 1]), K_hi[k + 1])
