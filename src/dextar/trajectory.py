@@ -152,7 +152,7 @@ def sample_trajectory(robot: FiveBar, path: Path, law: Law, *, mode: str = "+-",
                     mode=mode)
     dq = joint_velocity(robot, q, P, dP, tol=0.0)
     ddq = joint_acceleration(robot, q, P, dq, dP, ddP, tol=0.0)
-    sig = assembly_mode(robot, q, P)
+    sig = assembly_mode(robot, q[:1], P[:1])  # the motion's, named by its first pose
     return Trajectory(robot, path, law, mode, assembly_mode_name(int(sig[0])), t, s, ds, dds,
                       p, dp, ddp, P, dP, ddP, q, dq, ddq)
 

@@ -171,19 +171,33 @@ class Composite(Path):
         k = np.clip(np.floor(p).astype(int), 0, len(self.pieces) - 1)
         return k, p - k
 
+    def _runs(self, k: Array) -> tuple[Array | None, list[tuple[int, slice]]]:
+        """The samples of each piece as runs: ``order`` (None when the piece indices ``k`` do
+        not decrease, the usual case along a motion) sorts them, and piece ``j`` then holds
+        the samples in its slice."""
+        order = None if bool(np.all(k[1:] >= k[:-1])) else np.argsort(k, kind="stable")
+        ks = k if order is None else k[order]
+        edges = np.searchsorted(ks, np.arange(len(self.pieces) + 1)).tolist()
+        return order, [(j, slice(edges[j], edges[j + 1])) for j in range(len(self.pieces))
+                       if edges[j + 1] > edges[j]]
+
     def derivatives(self, p: object) -> tuple[Array, Array, Array, Array]:
         """The position and its first three derivatives at ``p``, each of shape (..., 2)."""
         p = np.asarray(self._check_parameter(p), float)
         flat = p.reshape(-1)
         k, f = self._split(flat)
+        order, runs = self._runs(k)
+        fs = f if order is None else f[order]
         out = [np.empty((flat.size, 2)) for _ in range(4)]
-        for j, piece in enumerate(self.pieces):
-            sel = np.flatnonzero(k == j)
-            if sel.size:
-                span = piece.p1 - piece.p0
-                vals = piece.derivatives(piece.p0 + f[sel] * span)
-                for order in range(4):
-                    out[order][sel] = vals[order] * span**order
+        for j, run in runs:
+            piece = self.pieces[j]
+            span = piece.p1 - piece.p0
+            vals = piece.derivatives(piece.p0 + fs[run] * span)
+            for k_ in range(4):
+                out[k_][run] = vals[k_] * span**k_
+        if order is not None:
+            for k_ in range(4):
+                out[k_][order] = out[k_].copy()
         shape = p.shape + (2,)
         return (out[0].reshape(shape), out[1].reshape(shape), out[2].reshape(shape),
                 out[3].reshape(shape))
@@ -207,12 +221,15 @@ class Composite(Path):
         flat = sv.reshape(-1)
         k = np.clip(np.searchsorted(self._starts, flat, side="right") - 1, 0,
                     len(self.pieces) - 1)
+        order, runs = self._runs(k)
+        fs = flat if order is None else flat[order]
         p = np.empty(flat.size)
-        for j, piece in enumerate(self.pieces):
-            sel = np.flatnonzero(k == j)
-            if sel.size:
-                local = piece.parameter_at(flat[sel] - self._starts[j])
-                p[sel] = j + (local - piece.p0) / (piece.p1 - piece.p0)
+        for j, run in runs:
+            piece = self.pieces[j]
+            local = piece.parameter_at(fs[run] - self._starts[j])
+            p[run] = j + (local - piece.p0) / (piece.p1 - piece.p0)
+        if order is not None:
+            p[order] = p.copy()
         return p.reshape(sv.shape)
 
     def piece_at(self, s: Array) -> Array:
