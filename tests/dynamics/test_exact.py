@@ -177,3 +177,25 @@ def test_invalid_inertia_named():
         Inertia.uniform(ROBOT, proximal_mass=1, distal_mass=1, payload=float("nan"))
     with pytest.raises(dx.ParameterError, match="massless"):
         Inertia(proximal=(Rod(0.0, 0.5, 0.1),) * 2, distal=(Rod(1, 0.5, 0.1),) * 2)
+
+
+@pytest.mark.parametrize("seed", [3, 4])
+def test_path_dynamics_is_the_inverse_dynamics_along_a_path(seed):
+    """``tau = a sddot + b sdot^2 + g`` for the joint motion ``q(s(t))``: the one-pass
+    coefficients against the general inverse dynamics at random speeds and accelerations."""
+    from dextar.dynamics.exact import path_dynamics
+
+    model = Model(ROBOT, general_inertia(gravity=(0.3, -9.81)))
+    rng = np.random.default_rng(seed)
+    s = np.linspace(0.0, 1.0, 301)
+    q, dq_ds, ddq_ds = random_joint_motion(np.random.default_rng(seed), s)
+    a, b, g = path_dynamics(model, q, dq_ds, ddq_ds)
+    sdot, sddot = rng.uniform(-2.0, 2.0, len(s)), rng.uniform(-5.0, 5.0, len(s))
+    dq = dq_ds * sdot[:, None]
+    ddq = dq_ds * sddot[:, None] + ddq_ds * (sdot**2)[:, None]
+    tau = inverse_dynamics(model, q, dq, ddq)
+    pred = a * sddot[:, None] + b * (sdot**2)[:, None] + g
+    np.testing.assert_allclose(pred, tau, rtol=0, atol=1e-11 * np.abs(tau).max())
+    np.testing.assert_allclose(g, gravity_torques(model, q), rtol=1e-13, atol=1e-15)
+    np.testing.assert_allclose(a, np.einsum("nij,nj->ni", mass_matrix(model, q), dq_ds),
+                               rtol=0, atol=1e-12 * np.abs(a).max())

@@ -24,7 +24,7 @@ from ..laws.time_optimal import (
 from ..paths import Path
 from ..trajectory import JointLine, sample_trajectory
 from ..units import Units
-from .exact import Model, bias_forces, gravity_torques, inverse_dynamics, mass_matrix
+from .exact import Model, inverse_dynamics, path_dynamics
 
 
 @dataclass(frozen=True)
@@ -55,10 +55,7 @@ class RobotAlongPath:
                                times=np.asarray(s, float), units=self.units,
                                checked=self.checked)
         robot, ine = self.model.robot, self.model.inertia
-        quiet = Model(robot, ine.frictionless(), jp.assembly)
-        a = np.einsum("nij,nj->ni", mass_matrix(quiet, jp.q), jp.dq)
-        b = inverse_dynamics(quiet, jp.q, jp.dq, jp.ddq)
-        g = gravity_torques(Model(robot, ine, jp.assembly), jp.q)
+        a, b, g = path_dynamics(Model(robot, ine, jp.assembly), jp.q, jp.dq, jp.ddq)
         return PathCoefficients(jp.t, jp.P, a, b, g, jp.dq, np.array(ine.coulomb, float),
                                 np.array(ine.viscous, float))
 
@@ -104,10 +101,8 @@ class RobotAlongJointLine:
         q = self.line.at(s)
         u = np.broadcast_to(self.line.direction, q.shape).copy()
         robot, ine = self.model.robot, self.model.inertia
-        quiet = Model(robot, ine.frictionless(), self.model.assembly, tol=0.0)
-        a = np.einsum("nij,nj->ni", mass_matrix(quiet, q), u)
-        b = bias_forces(quiet, q, u)
-        g = gravity_torques(Model(robot, ine, self.model.assembly, tol=0.0), q)
+        a, b, g = path_dynamics(Model(robot, ine, self.model.assembly, tol=0.0), q, u,
+                                np.zeros_like(u))
         P = direct_kinematics(robot, q, self.model.assembly)
         return PathCoefficients(s, P, a, b, g, u, np.array(ine.coulomb, float),
                                 np.array(ine.viscous, float))

@@ -325,6 +325,32 @@ def mass_matrix(model: Model, q: object) -> Array:
     return M.reshape(q0.shape[:-1] + (2, 2))
 
 
+def path_dynamics(model: Model, q: Array, dq_ds: Array, ddq_ds: Array
+                  ) -> tuple[Array, Array, Array]:
+    """The dynamics along a path ``q(s)`` in one pass over the poses: ``a = M(q) q'``,
+    ``b = M(q) q'' + c(q, q')`` and the gravity torques ``g(q)``, each (n, 2), so that
+    ``tau = a sddot + b sdot^2 + g`` (friction aside) for ``q' = dq_ds``, ``q'' = ddq_ds``
+    (each (n, 2))."""
+    qf, w, v = (as_points(x, name) for x, name in ((q, "q"), (dq_ds, "dq_ds"),
+                                                  (ddq_ds, "ddq_ds")))
+    out = np.empty((3, len(qf), 2))
+    for blk in blocks(len(qf)):
+        zero = np.zeros(blk.stop - blk.start)
+        w1, w2, v1, v2 = w[blk, 0], w[blk, 1], v[blk, 0], v[blk, 1]
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            pose = _pose(model, qf[blk, 0], qf[blk, 1], _Np)
+            still = _rates(model, pose, zero, zero)
+            a = _loads(model, pose, still, zero, zero, w1, w2, gravity=False, friction=False)
+            b = _loads(model, pose, _rates(model, pose, w1, w2), w1, w2, v1, v2,
+                       gravity=False, friction=False)
+            g = _loads(model, pose, still, zero, zero, zero, zero, gravity=True,
+                       friction=False)
+        _check_state(model, pose, qf, blk.start, None)
+        for k, loads in enumerate((a, b, g)):
+            out[k, blk, 0], out[k, blk, 1] = loads.tau1, loads.tau2
+    return out[0], out[1], out[2]
+
+
 def bias_forces(model: Model, q: object, dq: object) -> Array:
     """Velocity-product torques ``c(q, qdot)`` (Coriolis and centrifugal), shape (..., 2)."""
     q = as_points(q, "q")
