@@ -368,3 +368,22 @@ def test_a_worker_that_dies_is_replaced_and_the_rows_are_complete(sweep2):
     expected = rows_of(out2)
     for i in range(64):
         assert got[i] == expected[i]
+
+
+def test_sweeps_one_after_another_on_one_cluster(tmp_path):
+    """Two sweeps in a row on the same two workers (as a script or the benchmark does): the
+    second one's task is not lost while the first one's copy is being released."""
+    from dextar.design.sweep import Cluster, run_sweep
+    from dextar.jobs import design_task
+
+    task, space = design_task(str(write_task(tmp_path)))
+    designs = space.designs()[:8]
+    results = []
+    with Cluster(workers=2) as cluster:
+        for _ in range(3):
+            rows: list[dict] = []
+            stats = run_sweep(cluster, task, designs, range(len(designs)), chunk=1,
+                              on_chunk=rows.extend)
+            assert stats.evaluated == len(designs)
+            results.append(sorted(rows, key=lambda r: r["design"]))
+    assert results[0] == results[1] == results[2]

@@ -133,7 +133,9 @@ def run_sweep(cluster: Cluster, task: Task, designs: Array, todo: Sequence[int],
     n_workers = cluster.workers
     done = 0
     if todo:
-        task_f = client.scatter(task, broadcast=True)
+        # a key of its own (hash=False): a sweep run right after another on the same client
+        # would otherwise share the key the first one is releasing, and lose the task
+        task_f = client.scatter(task, broadcast=True, hash=False)
         parts = iter(chunks_of(sorted(todo), chunk))
 
         def submit(p: list[int]) -> Any:
