@@ -389,13 +389,13 @@ def _rows(co: PathCoefficients, ds: Array, tmax: Array, wmax: Array,
     ``sqrt(x)`` bounded above by its tangent at ``max(x0, x_knee)``: conservative, and exact at
     the tangent point."""
     phi_lo, psi_lo, phi_hi, psi_hi = _friction_bounds(co, x0)
-    n1 = len(co.s)
     with np.errstate(divide="ignore"):
         xmax = np.min(np.where(co.dq_ds != 0, (wmax / np.abs(co.dq_ds)) ** 2, np.inf), axis=1)
-    # rows at each point over (u, X), X the squared speed at that point
-    pu = [co.a, -co.a, np.zeros((n1, 2))]
-    px = [co.b + psi_hi, -(co.b + psi_lo), np.ones((n1, 1)), -np.ones((n1, 1))]
-    ph = [tmax - co.g - phi_hi, tmax + co.g + phi_lo, xmax[:, None], np.zeros((n1, 1))]
+    # rows at each point over (u, X), X the squared speed at that point: the torque rows,
+    # then the speed-only ones (X <= xmax, X >= 0)
+    pu = [co.a, -co.a]
+    px = [co.b + psi_hi, -(co.b + psi_lo)]
+    ph = [tmax - co.g - phi_hi, tmax + co.g + phi_lo]
     if knee is not None and x0 is not None:
         sigma = tmax / (wmax - knee)
         qabs = np.abs(co.dq_ds)
@@ -409,16 +409,21 @@ def _rows(co: PathCoefficients, ds: Array, tmax: Array, wmax: Array,
         px += [co.b + psi_hi + slope, -(co.b + psi_lo) + slope]
         ph += [cap - co.g - phi_hi, cap + co.g + phi_lo]
     pu_, px_, ph_ = (np.concatenate(v, axis=1) for v in (pu, px, ph))
-    return _stage_rows(pu_, px_, ph_, ds)
+    return _stage_rows(pu_, px_, ph_, xmax, ds)
 
 
-def _stage_rows(pu: Array, px: Array, ph: Array, ds: Array) -> tuple[Array, Array, Array]:
-    """The rows of each stage from the rows at its two points (interpolation scheme); ``ds``
-    (N,) the stages' lengths."""
-    # stage k: rows at point k with X = x, rows at point k + 1 with X = x + 2 ds u
-    Gu = np.concatenate([pu[:-1], pu[1:] + 2 * ds[:, None] * px[1:]], axis=1)
-    Gx = np.concatenate([px[:-1], px[1:]], axis=1)
-    h = np.concatenate([ph[:-1], ph[1:]], axis=1)
+def _stage_rows(pu: Array, px: Array, ph: Array, xmax: Array, ds: Array
+                ) -> tuple[Array, Array, Array]:
+    """The rows of each stage from the rows at its two points (interpolation scheme): the
+    torque rows ``pu u + px X <= ph`` (N + 1, m) at point k with ``X = x`` and at point k + 1
+    with ``X = x + 2 ds u`` (``ds`` (N,) the stages' lengths), and ``0 <= x <= xmax`` at point
+    k (at point k + 1 the controllable set of the next stage holds them)."""
+    n = len(ds)
+    one = np.ones((n, 1))
+    Gu = np.concatenate([pu[:-1], np.zeros((n, 2)), pu[1:] + 2 * ds[:, None] * px[1:]],
+                        axis=1)
+    Gx = np.concatenate([px[:-1], one, -one, px[1:]], axis=1)
+    h = np.concatenate([ph[:-1], xmax[:-1, None], np.zeros((n, 1)), ph[1:]], axis=1)
     return Gu, Gx, h
 
 
