@@ -42,6 +42,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any, Protocol
 
 import numpy as np
@@ -138,6 +139,19 @@ class PathCoefficients:
     dq_ds: Array
     coulomb: Array
     viscous: Array
+
+    @cached_property
+    def friction_sides(self) -> tuple[Array, Array]:
+        """Where each joint's friction may push up (forward motion, or a reversal near) and
+        down: two arrays (N + 1, 2) of 1.0 and 0.0, both 0 at the two rest points (where
+        friction is exactly zero)."""
+        sg = np.sign(self.dq_ds)
+        steady = (sg == np.roll(sg, 1, axis=0)) & (sg == np.roll(sg, -1, axis=0)) & (sg != 0)
+        steady[[0, -1]] = (sg[[0, -1]] == sg[[1, -2]]) & (sg[[0, -1]] != 0)
+        up = ((steady & (sg > 0)) | ~steady).astype(float)
+        down = ((steady & (sg < 0)) | ~steady).astype(float)
+        up[[0, -1]] = down[[0, -1]] = 0.0
+        return up, down
 
 
 @dataclass(frozen=True)
@@ -357,27 +371,14 @@ def _friction_bounds(co: PathCoefficients, x0: Array | None
                      ) -> tuple[Array, Array, Array, Array]:
     """Friction ``f`` in ``[phi_lo + psi_lo x, phi_hi + psi_hi x]`` at each grid point,
     arrays (N + 1, 2)."""
-    sg = np.sign(co.dq_ds)
-    steady = (sg == np.roll(sg, 1, axis=0)) & (sg == np.roll(sg, -1, axis=0)) & (sg != 0)
-    steady[[0, -1]] = (sg[[0, -1]] == sg[[1, -2]]) & (sg[[0, -1]] != 0)
-    c = np.broadcast_to(co.coulomb, sg.shape)
+    up, down = co.friction_sides
     if x0 is None:
-        phi_v = psi_v = np.zeros_like(sg)
+        far_phi, far_psi = np.broadcast_to(co.coulomb, up.shape), np.zeros(up.shape)
     else:  # viscous |f| <= w sqrt(x) <= w (x + x0) / (2 sqrt(x0)), tangent at x0
         r = np.sqrt(np.maximum(x0, 1e-9 * max(float(x0.max()), 1e-300)))[:, None]
         w = co.viscous * np.abs(co.dq_ds)
-        phi_v, psi_v = 0.5 * w * r, 0.5 * w / r
-    far_phi, far_psi = c + phi_v, psi_v
-    pos = steady & (sg > 0)
-    neg = steady & (sg < 0)
-    both = ~steady
-    phi_hi = np.where(pos | both, far_phi, 0.0)
-    psi_hi = np.where(pos | both, far_psi, 0.0)
-    phi_lo = np.where(neg | both, -far_phi, 0.0)
-    psi_lo = np.where(neg | both, -far_psi, 0.0)
-    for arr in (phi_hi, psi_hi, phi_lo, psi_lo):  # at rest friction is exactly zero
-        arr[[0, -1]] = 0.0
-    return phi_lo, psi_lo, phi_hi, psi_hi
+        far_phi, far_psi = co.coulomb + 0.5 * w * r, 0.5 * w / r
+    return -down * far_phi, -down * far_psi, up * far_phi, up * far_psi
 
 
 def _rows(co: PathCoefficients, ds: Array, tmax: Array, wmax: Array,
