@@ -525,11 +525,13 @@ def _reachability(co: PathCoefficients, ds: Array, tmax: Array, wmax: Array,
 def _compact(m: Array, q: Array, active: Array, fill: float) -> tuple[Array, Array]:
     """Per stage (row of the arrays), the active entries first, cut to the largest number of
     active entries; padding ``(0, fill)`` never binds."""
-    order = np.argsort(~active, axis=1, kind="stable")
-    mm = np.take_along_axis(np.where(active, m, 0.0), order, axis=1)
-    qq = np.take_along_axis(np.where(active, q, fill), order, axis=1)
-    width = int(active.sum(axis=1).max()) if active.size else 0
-    return mm[:, :width], qq[:, :width]
+    counts = active.sum(axis=1)
+    width = int(counts.max()) if active.size else 0
+    rows = np.repeat(np.arange(len(active)), counts)
+    place = np.cumsum(active, axis=1)[active] - 1  # each active entry's place in its row
+    mm, qq = np.zeros((len(active), width)), np.full((len(active), width), fill)
+    mm[rows, place], qq[rows, place] = m[active], q[active]
+    return mm, qq
 
 
 def _flat(m: Array, q: Array, active: Array) -> tuple[list[float], list[float], list[int]]:
