@@ -423,22 +423,48 @@ def _law(mv: Move, length: float, dynamics: Any, motors: MotorLimits | None,
         tr, sp = motors.ratios(inverse_dynamics(model, tr_.q, tr_.dq, tr_.ddq), tr_.dq)
         return max(tr, sp)
 
-    ratio = _stretched_ratio(build, traj, model, motors) or sampled
+    return build(_shortest_within(_stretched_ratio(build, traj, model, motors) or sampled))
+
+
+def _shortest_within(ratio: Callable[[float], float]) -> float:
+    """The shortest duration ``T`` (s, to 1e-6 relative) with ``ratio(T) <= 1``: a bracket by
+    doubling (or halving), then regula falsi with the Illinois correction, keeping a bracket
+    ``ratio(lo) > 1 >= ratio(hi)`` and returning its ``hi``."""
+    seen: dict[float, float] = {}
+
+    def r(T: float) -> float:  # the excess over the limits, remembered
+        if T not in seen:
+            seen[T] = ratio(T) - 1.0
+        return seen[T]
+
     hi = 0.05
-    while ratio(hi) > 1.0:
+    while r(hi) > 0.0:
         hi *= 2.0
         if hi > 1e4:
             raise ConfigError("no duration up to 10^4 s keeps the law within the motors")
     lo = hi / 2.0
-    if ratio(lo) <= 1.0:  # even the first try fits: come down
-        while lo > 1e-4 and ratio(lo) <= 1.0:
+    if r(lo) <= 0.0:  # even the first try fits: come down
+        while lo > 1e-4 and r(lo) <= 0.0:
             hi, lo = lo, lo / 2.0
-    for _ in range(40):
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if ratio(mid) > 1.0 else (lo, mid)
+    r_lo, r_hi, side = r(lo), r(hi), 0
+    for _ in range(100):
         if hi - lo <= 1e-6 * hi:
             break
-    return build(hi)
+        if math.isfinite(r_lo) and r_lo > r_hi:  # the secant through the bracket's ends
+            mid = hi - r_hi * (hi - lo) / (r_hi - r_lo)
+            mid = min(max(mid, lo + 1e-3 * (hi - lo)), hi - 1e-3 * (hi - lo))
+        else:
+            mid = 0.5 * (lo + hi)
+        v = r(mid)
+        if v > 0.0:
+            lo, r_lo = mid, v
+            r_hi = r_hi * 0.5 if side < 0 else r_hi  # Illinois: the stale end's weight halves
+            side = -1
+        else:
+            hi, r_hi = mid, v
+            r_lo = r_lo * 0.5 if side > 0 else r_lo
+            side = 1
+    return hi
 
 
 def _stretched_ratio(build: Callable[[float], Law],
