@@ -332,3 +332,16 @@ def test_chain_grid_resolves_each_blend_and_keeps_the_joints():
             least = BLEND_SEGMENTS if isinstance(piece, Quintic) else 10
             share = int(np.ceil(grid * piece.length / path.length))
             assert inside == max(least, share)
+
+
+@pytest.mark.parametrize("T0", [3e-4, 0.0371, 0.05, 0.7, 123.0])
+def test_shortest_duration_within_the_limits_is_bracketed(T0):
+    """The fitted duration is the smallest T with ratio(T) <= 1 to 1e-6, on the feasible side,
+    for a smooth ratio, one with a kink and one infinite below a speed limit."""
+    from dextar.program.plan import _shortest_within
+
+    for ratio in (lambda T: (T0 / T) ** 2,
+                  lambda T: max((T0 / T) ** 2, 0.5 + 0.5 * T0 / T),
+                  lambda T: np.inf if T < 0.9 * T0 else (T0 / T) ** 3):
+        T = _shortest_within(ratio)
+        assert ratio(T) <= 1.0 and T0 <= T <= T0 * (1 + 2e-6), (T0, T)
