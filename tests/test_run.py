@@ -137,7 +137,9 @@ def test_killed_run_leaves_no_partial_file(tmp_path, sig):
     assert all(_complete(f) for f in files), [f.name for f in files if not _complete(f)]
     assert not (out / "summary.json").exists() or proc.returncode == 0
     if sig == signal.SIGTERM:
-        assert proc.returncode != 0 and b"Traceback" not in proc.stderr.read()
+        # on a loaded machine the run may end before the signal reaches it: then it is whole
+        assert proc.returncode != 0 or (out / "summary.json").exists()
+        assert b"Traceback" not in proc.stderr.read()
         assert not list(tmp_path.glob(".out.staging-*"))
 
 
