@@ -5,10 +5,12 @@
 * the pick-and-place program (time-optimal moves, blended corners, dwells, a fitted law)
   (issue floor: 20 designs/s per core),
 
-each the best of three runs (all three are printed: this machine's speed wanders), then each task on a Dask local cluster of 1, 2 and 4 workers, with the parallel efficiency
-(designs/s at N workers over N times that at 1; this machine's core count is printed).
+each the best of three runs (all three are printed: this machine's speed wanders), then each
+task on a Dask local cluster of 1, 2 and 4 workers (chunks of 64 and of 8 designs, the
+``[design]`` default), with the parallel efficiency (designs/s at N workers over N times that
+at 1; this machine's core count is printed).
 
-Run: python benchmarks/bench_design.py [--designs 48]
+Run: python benchmarks/bench_design.py [--designs 96]
 """
 
 from __future__ import annotations
@@ -69,7 +71,7 @@ def measure(name: str, path: Path, chunk: int) -> None:
 
 def main() -> None:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--designs", type=int, default=48)
+    ap.add_argument("--designs", type=int, default=96)
     args = ap.parse_args()
     import sys
 
@@ -80,7 +82,7 @@ def main() -> None:
                         {"motors": {"peak_torque": 1.0}})
         measure("run task (line, min-jerk; floor 200/s per core)", run, 64)
         prog = task_file(folder, "pick_place.toml", args.designs, {})
-        measure("pick-and-place program (time-optimal; floor 20/s per core)", prog, 2)
+        measure("pick-and-place program (time-optimal; floor 20/s per core)", prog, 8)
 
 
 if __name__ == "__main__":
