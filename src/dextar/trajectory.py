@@ -133,7 +133,7 @@ def sample_trajectory(robot: FiveBar, path: Path, law: Law, *, mode: str = "+-",
         The path meets a singularity for this working mode; names the first time and point.
     """
     mode = working_mode_name(parse_working_mode(mode))
-    if not np.isclose(law.distance, path.length, rtol=1e-9, atol=0.0):
+    if not abs(law.distance - path.length) <= 1e-9 * abs(path.length):
         raise ParameterError(f"the law covers a distance of {law.distance:.9g} but the path is "
                              f"{path.length:.9g} long")
     t = law.times(samples) if times is None else np.asarray(times, dtype=float)
@@ -272,7 +272,7 @@ def sample_joint_trajectory(robot: FiveBar, line: JointLine, law: Law, *, assemb
     from .geometry import parse_assembly_mode
     from .kinematics import direct_kinematics, task_acceleration, working_mode
 
-    if not np.isclose(law.distance, line.length, rtol=1e-9, atol=0.0):
+    if not abs(law.distance - line.length) <= 1e-9 * abs(line.length):
         raise ParameterError(f"the law covers {law.distance:.9g} but the joint line is "
                              f"{line.length:.9g} rad long")
     t = law.times(samples) if times is None else np.asarray(times, dtype=float)
