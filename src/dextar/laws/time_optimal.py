@@ -490,7 +490,9 @@ def _reachability(co: PathCoefficients, ds: Array, tmax: Array, wmax: Array,
     K_lo, K_hi = [0.0] * (n + 1), [0.0] * (n + 1)
     big = 1e300  # an unbounded hi stays finite, so that 0 * hi is 0
     for k in range(n - 1, -1, -1):
-        lo, hi = K_lo[k + 1], min(K_hi[k + 1], big)
+        lo, hi = K_lo[k + 1], K_hi[k + 1]
+        if hi > big:  # (comparisons inline: builtin min and max calls cost more here)
+            hi = big
         if lo == 0.0:
             xl, xh = XL0[k], XH0[k]
         else:
@@ -516,7 +518,8 @@ def _reachability(co: PathCoefficients, ds: Array, tmax: Array, wmax: Array,
                 xl = v
         if xl > xh + 1e-12 * (1.0 + abs(xh)):
             raise _unreachable(co, k, tmax, units)
-        K_lo[k], K_hi[k] = max(0.0, min(xl, xh)), max(0.0, xh)
+        v = xh if xh < xl else xl
+        K_lo[k], K_hi[k] = (v if v > 0.0 else 0.0), (xh if xh > 0.0 else 0.0)
     if K_lo[0] > 1e-12 * (1.0 + K_hi[0]):
         raise _unreachable(co, 0, tmax, units)
     x = [0.0] * (n + 1)
@@ -533,7 +536,10 @@ def _reachability(co: PathCoefficients, ds: Array, tmax: Array, wmax: Array,
         # acceleration meets every row and reaches K[k + 1], and the largest one does)
         if u_lo > u_hi + 1e-9 * (1.0 + abs(u_hi)):
             raise _unreachable(co, k, tmax, units)
-        x[k + 1] = min(max(xk + two_ds[k] * u_hi, K_lo[k + 1]), K_hi[k + 1])
+        v = xk + two_ds[k] * u_hi
+        if v < K_lo[k + 1]:
+            v = K_lo[k + 1]
+        x[k + 1] = K_hi[k + 1] if K_hi[k + 1] < v else v
     x[n] = 0.0
     return np.array(x)
 
