@@ -16,12 +16,15 @@ dynamics are affine in ``(x, u)`` up to friction:
 Friction is bounded, not linearised: the regularised Coulomb torque (see
 :mod:`dextar.dynamics.friction`) always lies between 0 and ``coulomb * sign(q')``, and the
 viscous torque ``viscous q' sqrt(x)`` between 0 and its tangent upper bound at the previous
-iterate's speed, so the limits are enforced for every friction value in that interval (both
-ends of the interval are rows of the linear programme). Where a joint reverses along the path
-the interval is ``[-coulomb, coulomb]``; at the two rest points friction is zero.
+iterate's speed (the first tangent at the motors' speed limits), so the limits are enforced
+for every friction value in that interval (both ends of the interval are rows of the linear
+programme); a torque-speed envelope is bounded by the same tangents. Where a joint reverses
+along the path the interval is ``[-coulomb, coulomb]``; at the two rest points friction is
+zero. The iterates are solved until the tangent settles (:data:`TANGENT_RTOL`).
 
 The solver is reachability analysis (TOPP-RA, Pham & Pham 2018) with the *interpolation*
-discretisation: on each segment ``[s_k, s_{k+1}]`` the acceleration ``u_k`` is constant and
+discretisation on a grid of arc lengths (equal segments, or finer where the dynamics change
+fast): on each segment ``[s_k, s_{k+1}]`` the acceleration ``u_k`` is constant and
 the limits are imposed at both ends, at ``(x_k, u_k)`` and at ``(x_k + 2 ds u_k, u_k)``, so
 they hold on both sides of every knot, and in between up to the curvature of the dynamics
 (second order in the grid step). A backward pass computes the controllable interval of ``x``
@@ -29,10 +32,10 @@ at each grid point (a two-variable linear programme solved exactly by Fourier-Mo
 elimination of ``u``, the static rows precomputed for all points at once), then a forward pass
 takes the largest admissible acceleration from rest.
 
-Output check and margin: the law is then sampled densely (both ends and seven interior points
-of every segment) through the exact model with friction; if a torque exceeds its limit by
-more than ``tol`` (default 1e-3) or a speed its limit, the limits are tightened by the excess
-and the problem solved again (a few iterations at most). The law reports ``status`` (0: the
+Output check and margin: the settled law is then sampled densely (both ends and seven
+interior points of every segment) through the exact model with friction; if a torque exceeds
+its limit by more than ``tol`` (default 1e-3) or a speed its limit, the limits are tightened
+by the excess and the problem solved again (a few iterations at most). The law reports ``status`` (0: the
 limits hold within ``tol`` on the check samples; 1: they do not after the iterations, with
 the excess in ``message``) and ``max_torque_ratio``. When no motion within the limits exists
 at all, :class:`~dextar.errors.InfeasibleError` names the point, the motor and the torque.
