@@ -11,9 +11,24 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._arrays import Array
-from .errors import ParameterError
-from .geometry import FiveBar, assembly_mode_name, parse_working_mode, working_mode_name
-from .kinematics import assembly_mode, inverse_kinematics, joint_acceleration, joint_velocity
+from .errors import AssemblyError, ParameterError, SingularityError
+from .geometry import (
+    FiveBar,
+    assembly_mode_name,
+    parse_assembly_mode,
+    parse_working_mode,
+    working_mode_name,
+)
+from .kinematics import (
+    assembly_mode,
+    direct_kinematics,
+    elbows,
+    inverse_kinematics,
+    joint_acceleration,
+    joint_velocity,
+    task_acceleration,
+    working_mode,
+)
 from .kinematics.checker import (
     DEFAULT_TOLERANCES,
     PoseDistances,
@@ -269,9 +284,6 @@ def sample_joint_trajectory(robot: FiveBar, line: JointLine, law: Law, *, assemb
     SingularityError
         The line meets a parallel singularity; names the time and the joint angles.
     """
-    from .geometry import parse_assembly_mode
-    from .kinematics import direct_kinematics, task_acceleration, working_mode
-
     if not abs(law.distance - line.length) <= 1e-9 * abs(line.length):
         raise ParameterError(f"the law covers {law.distance:.9g} but the joint line is "
                              f"{line.length:.9g} rad long")
@@ -282,13 +294,10 @@ def sample_joint_trajectory(robot: FiveBar, line: JointLine, law: Law, *, assemb
     dq, ddq = ds[:, None] * u, dds[:, None] * u
     words = _Words(units)
     sigma = parse_assembly_mode(assembly)
-    from .errors import AssemblyError, SingularityError
 
     def where(i: int) -> str:
         return (f"at {words.time(t[i])} (sample {i}), q = ({np.degrees(q[i, 0]):.6g}, "
                 f"{np.degrees(q[i, 1]):.6g}) deg")
-
-    from .kinematics import elbows
 
     B, C = elbows(robot, q)
     gap = np.linalg.norm(B - C, axis=-1)

@@ -329,12 +329,19 @@ def _speed_limits(co: PathCoefficients, wmax: Array) -> Array | None:
     iteration settles in about one solve fewer than from a first solve without those bounds
     (2.8 instead of 3.7 per move over the pick-and-place sweep, cycle times as close to the
     settled ones). None without a finite speed limit (the first solve then goes without)."""
-    with np.errstate(divide="ignore"):
-        x = np.min(np.where(co.dq_ds != 0, (wmax / np.abs(co.dq_ds)) ** 2, np.inf), axis=1)
+    x = _speed_cap(co, wmax)
     finite = np.isfinite(x)
     if not finite.any():
         return None
     return np.asarray(np.where(finite, x, x[finite].max()))
+
+
+def _speed_cap(co: PathCoefficients, wmax: Array) -> Array:
+    """The largest squared path speed (N + 1,) within both motors' speed limits (``inf``
+    where neither joint moves)."""
+    with np.errstate(divide="ignore"):
+        return np.asarray(np.min(np.where(co.dq_ds != 0, (wmax / np.abs(co.dq_ds)) ** 2,
+                                          np.inf), axis=1))
 
 
 def _grid(grid: int | Array, length: float) -> Array:
@@ -409,8 +416,7 @@ def _rows(co: PathCoefficients, ds: Array, tmax: Array, wmax: Array,
     ``sqrt(x)`` bounded above by its tangent at ``max(x0, x_knee)``: conservative, and exact at
     the tangent point."""
     phi_lo, psi_lo, phi_hi, psi_hi = _friction_bounds(co, x0)
-    with np.errstate(divide="ignore"):
-        xmax = np.min(np.where(co.dq_ds != 0, (wmax / np.abs(co.dq_ds)) ** 2, np.inf), axis=1)
+    xmax = _speed_cap(co, wmax)
     # rows at each point over (u, X), X the squared speed at that point: the torque rows,
     # then the speed-only ones (X <= xmax, X >= 0)
     pu = [co.a, -co.a]

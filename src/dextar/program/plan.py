@@ -14,9 +14,10 @@ A program starts at rest at ``start`` in a working mode. Its moves:
 Path moves joined by a blend (``blend > 0`` mm) are one motion: each corner is replaced by a
 quintic of continuous curvature that stays within ``blend`` of the corner
 (:mod:`dextar.paths.composite`), and the law of the first move of the chain runs over the
-whole of it, without stopping at the corners. Other moves start and end at rest. A law is ``time-optimal`` (the fastest within the motors) or a fixed-shape law
-(``uniform``, ``min-jerk``, ``trapezoid``, ``optimal``) with a duration in seconds or
-``"fit"``: the shortest duration for which the law stays within the motors (bisection).
+whole of it, without stopping at the corners. Other moves start and end at rest. A law is
+``time-optimal`` (the fastest within the motors) or a fixed-shape law (``uniform``,
+``min-jerk``, ``trapezoid``, ``optimal``) with a duration in seconds or ``"fit"``: the
+shortest duration for which the law stays within the motors (regula falsi on a bracket).
 The computation is in SI units (m, kg, s, N m).
 """
 
@@ -49,6 +50,7 @@ from ..params import to_run_units
 from ..paths import Arc, Line, Path
 from ..paths.composite import Composite, Quintic, blended
 from ..trajectory import (
+    CheckedPath,
     JointLine,
     Trajectory,
     check_path,
@@ -288,21 +290,9 @@ def _plan_chain(robot: FiveBar, inertia: Inertia, group: list[Move], P0: Array, 
     except ParameterError as exc:
         raise ConfigError(f"blend: {exc}") from None
     model = Model(robot, inertia, assembly, tol=tol.type2)
-    poses = check_path(robot, path, mode=mode, tolerances=tol, units=SI)
-
-    def traj(law: Law, times: Array | None = None) -> Trajectory:
-        return sample_trajectory(robot, path, law, mode=mode, times=times, samples=801,
-                                 tolerances=tol, units=SI, checked=False)
-
-    along = RobotAlongPath(model, path, mode, SI, checked=False)  # checked above
-    law = _law(first, path.length, along, motors, chain_grid(path, grid), traj, model, path)
-    shift = np.round((q0 - poses.q[0]) / (2 * np.pi)) * 2 * np.pi
-    q1 = poses.q[-1] + shift
+    law, sample, q1, poses = _along_path(robot, model, first, path, q0, mode, motors,
+                                         chain_grid(path, grid), tol, samples=801)
     owners = np.array([group[o].index for o in owner])
-
-    def sample(t: Array) -> tuple[Array, Array, Array, Array]:
-        st = traj(law, np.clip(t, 0.0, law.duration))
-        return st.P, st.q + shift, st.dq, st.ddq
 
     def owner_of(t: Array) -> Array:
         s_ = law.evaluate(np.clip(t, 0.0, law.duration))[0]
@@ -319,6 +309,31 @@ def _plan_chain(robot: FiveBar, inertia: Inertia, group: list[Move], P0: Array, 
                      float(poses.distances.type1.min()), float(poses.distances.type2.min()),
                      owner_of, members)
     return pm, _target(group[-1]), q1
+
+
+def _along_path(robot: FiveBar, model: Model, mv: Move, path: Path, q0: Array, mode: str,
+                motors: MotorLimits | None, grid: int | Array, tol: Tolerances, samples: int
+                ) -> tuple[Law, Callable[[Array], tuple[Array, Array, Array, Array]], Array,
+                           CheckedPath]:
+    """A task-space motion along ``path`` (a line, an arc or a blended chain): the path
+    checked, the law of ``mv`` on it, the sampling ``(P, q, dq, ddq)`` at local times with the
+    angles continuous with ``q0`` (unwrapped by whole turns), the end angles and the checked
+    poses (``samples``: the law's own sampling, for a fitted duration)."""
+    poses = check_path(robot, path, mode=mode, tolerances=tol, units=SI)
+
+    def traj(law: Law, times: Array | None = None) -> Trajectory:
+        return sample_trajectory(robot, path, law, mode=mode, times=times, samples=samples,
+                                 tolerances=tol, units=SI, checked=False)
+
+    along = RobotAlongPath(model, path, mode, SI, checked=False)  # checked above
+    law = _law(mv, path.length, along, motors, grid, traj, model, path)
+    shift = np.round((q0 - poses.q[0]) / (2 * np.pi)) * 2 * np.pi
+
+    def sample(t: Array) -> tuple[Array, Array, Array, Array]:
+        st = traj(law, np.clip(t, 0.0, law.duration))
+        return st.P, st.q + shift, st.dq, st.ddq
+
+    return law, sample, poses.q[-1] + shift, poses
 
 
 @functools.lru_cache(maxsize=32)
@@ -548,29 +563,10 @@ def _plan_move(robot: FiveBar, inertia: Inertia, mv: Move, P0: Array, q0: Array,
                             float(d2)), P0, q0, mode)
     if mv.type in ("line", "arc"):
         path: Path = Line(tuple(P0), tuple(_target(mv))) if mv.type == "line" else _arc(mv, P0)
-        poses = check_path(robot, path, mode=mode, tolerances=tol, units=SI)
-
-        def traj(law: Law, times: Array | None = None) -> Trajectory:
-            return sample_trajectory(robot, path, law, mode=mode, times=times, samples=401,
-                                     tolerances=tol, units=SI, checked=False)
-
-        along = RobotAlongPath(model, path, mode, SI, checked=False)  # checked above
-        law = _law(mv, path.length, along, motors, grid, traj, model, path)
-
-        def sample(t: Array) -> tuple[Array, Array, Array, Array]:
-            s = traj(law, np.clip(t, 0.0, law.duration))
-            return s.P, s.q, s.dq, s.ddq
-
-        # keep the angles continuous with the previous move (unwrap by whole turns)
-        shift = np.round((q0 - poses.q[0]) / (2 * np.pi)) * 2 * np.pi
-        q1 = poses.q[-1] + shift
-
-        def shifted(t: Array) -> tuple[Array, Array, Array, Array]:
-            P, q, dq, ddq = sample(t)
-            return P, q + shift, dq, ddq
-
+        law, sample, q1, poses = _along_path(robot, model, mv, path, q0, mode, motors, grid,
+                                             tol, samples=401)
         P1 = _target(mv)  # exactly where the move was sent (the next starts there)
-        return (PlannedMove(mv, law, start_s, law.duration, q0, q1, shifted,
+        return (PlannedMove(mv, law, start_s, law.duration, q0, q1, sample,
                             float(poses.distances.type1.min()),
                             float(poses.distances.type2.min())), P1, q1, mode)
     if mv.type == "joint":
