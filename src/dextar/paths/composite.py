@@ -207,12 +207,15 @@ class Composite(Path):
         p = np.asarray(self._check_parameter(p), float)
         flat = p.reshape(-1)
         k, f = self._split(flat)
+        order, runs = self._runs(k)
+        fs = f if order is None else f[order]
         s = np.empty(flat.size)
-        for j, piece in enumerate(self.pieces):
-            sel = np.flatnonzero(k == j)
-            if sel.size:
-                s[sel] = self._starts[j] + piece.arc_length(piece.p0 + f[sel] * (piece.p1
-                                                                                  - piece.p0))
+        for j, run in runs:
+            piece = self.pieces[j]
+            s[run] = self._starts[j] + piece.arc_length(piece.p0 + fs[run] * (piece.p1
+                                                                              - piece.p0))
+        if order is not None:
+            s[order] = s.copy()
         return s.reshape(p.shape)
 
     def parameter_at(self, s: object) -> Array:
