@@ -282,6 +282,271 @@ def _run(model: Model, q: object, dq: object, ddq: object, *, gravity: bool, fri
     return {k: v.reshape(shape) for k, v in out.items()}
 
 
+# --- the fused torque kernel ---------------------------------------------------------------
+#
+# The same Kane's equations, rearranged so that numpy makes as few passes over the samples as
+# it can: about 80 ufunc calls per block, each writing into a preallocated, 64-byte aligned
+# buffer, the two legs side by side in arrays of shape (2, block) so that one call serves
+# both. Three identities shorten it:
+#
+# * a distal rod (mass m, centre at lam L from its elbow, inertia I about its centre) is
+#   dynamically the point masses m (1 - lam) at its elbow and m lam at P plus the rotary inertia
+#   ``I_r = I - m lam (1 - lam) L^2`` (equimomental); an elbow mass turns with its proximal rod,
+#   so it only adds to that motor's inertia and gravity torque, and the masses at P are one;
+# * with ``a`` the proximal rod (motor to elbow) and ``U`` the distal rod (elbow to P) of a leg,
+#   ``b = a x U`` and ``c = a . U``; ``ue = u . e = (L1^2 + L2^2 - |B - C|^2) / 2`` and
+#   ``det = u x e = -sign |B - C|^2 hh`` (``hh`` the half-chord over ``|B - C|^2``);
+# * ``U x Pdot = T (b qdot)`` with ``T x = (L1^2 x2 - ue x1, ue x2 - L2^2 x1) / det``, so the
+#   rods turn at ``omega L^2 = T (b qdot) - c qdot``; the same ``T`` gives ``U x Pddot`` from
+#   ``A Pddot = b qddot + bias``, and ``A^-T F = (-(e x F), u x F) / det`` for a force at P.
+#
+# Then ``k = I_r alpha / L^2``, ``alpha L^2 = U x Pddot - c qddot - b qdot^2``, and
+#   ``tau = J qddot - G (a x g) + b lam - k c + friction``,
+#   ``lam = (-MP e x (Pddot - g) - ue k1 - L2^2 k2,  MP u x (Pddot - g) + L1^2 k1 + ue k2) / det``.
+# tests/dynamics/test_exact.py checks it against a straightforward per-body evaluation.
+
+#: Samples per block of the fused kernel: its ~25 buffers of 8192 samples stay in a 2 MiB L2
+#: cache while the ~0.5 us a ufunc call costs is spread over enough samples
+#: (benchmarks/bench_dynamics.py times 2048 to 32768).
+FUSED_BLOCK = 8192
+
+_mul, _add, _sub, _div = np.multiply, np.add, np.subtract, np.divide
+
+
+@dataclass(frozen=True)
+class _Lumped:
+    """The model's constants as the fused kernel uses them: per leg an array of shape (2, 1)
+    (or a float when both legs agree); ``None`` for a term that is zero."""
+
+    l: Any  # proximal lengths
+    two_l: Any
+    d: float  # distance between the motors
+    Lsq: Array  # L1^2, L2^2
+    iLsq: Array
+    L2sq: float
+    ue0: float  # (L1^2 + L2^2) / 2
+    cst: float  # (L2^2 - L1^2) / 2
+    sign: int  # assembly mode
+    J: Array  # motor-side inertia: rotor, proximal rod and elbow mass
+    MP: float  # every mass at P
+    cK: Array  # I_r / L^4
+    Gax: Array | None  # gravity torque = Gax a_x + Gay a_y
+    Gay: Array | None
+    MPgx: float  # MP g
+    MPgy: float
+    viscous: Array | None
+    coulomb: Array | None
+    inv_vs: float
+
+
+def _lumped(model: Model, gravity: bool, friction: bool) -> _Lumped:
+    r, ine = model.robot, model.inertia
+    l1, l2, L1, L2 = r.l1, r.l2, r.L1, r.L2
+    rod1, rod2 = ine.proximal
+    rod3, rod4 = ine.distal
+    lam3, lam4 = rod3.com / L1, rod4.com / L2
+    mE = (rod3.mass * (1.0 - lam3), rod4.mass * (1.0 - lam4))
+
+    def leg(v1: float, v2: float) -> Array:
+        return np.array([[v1], [v2]])
+
+    gx, gy = ine.gravity if gravity else (0.0, 0.0)
+    G = leg((rod1.mass * rod1.com + mE[0] * l1) / l1, (rod2.mass * rod2.com + mE[1] * l2) / l2)
+    MP = ine.point_mass + lam3 * rod3.mass + lam4 * rod4.mass
+    Ir = (rod3.inertia - rod3.mass * lam3 * (1.0 - lam3) * L1 * L1,
+          rod4.inertia - rod4.mass * lam4 * (1.0 - lam4) * L2 * L2)
+    fric = friction and ine.has_friction
+    lv: Any = l1 if l1 == l2 else leg(l1, l2)
+    return _Lumped(
+        l=lv, two_l=2.0 * lv, d=r.d, Lsq=leg(L1 * L1, L2 * L2),
+        iLsq=leg(1.0 / (L1 * L1), 1.0 / (L2 * L2)), L2sq=L2 * L2,
+        ue0=0.5 * (L1 * L1 + L2 * L2), cst=0.5 * (L2 * L2 - L1 * L1),
+        sign=parse_assembly_mode(model.assembly),
+        J=leg(ine.rotor[0] + rod1.about_joint + mE[0] * l1 * l1,
+              ine.rotor[1] + rod2.about_joint + mE[1] * l2 * l2),
+        MP=MP, cK=leg(Ir[0] / L1**4, Ir[1] / L2**4),
+        Gax=-G * gy if gy else None, Gay=G * gx if gx else None, MPgx=MP * gx, MPgy=MP * gy,
+        viscous=leg(*ine.viscous) if fric else None,
+        coulomb=leg(*ine.coulomb) if fric else None, inv_vs=1.0 / ine.coulomb_speed)
+
+
+class _Buffers:
+    """Scratch arrays for blocks of up to ``size`` samples, each starting on a 64-byte
+    boundary (unaligned operands cost numpy's SIMD loops about 2x): ``views(b)`` gives
+    ``PAIRS`` contiguous arrays of shape (2, b) and ``SINGLES`` of shape (b,)."""
+
+    PAIRS, SINGLES = 15, 8
+
+    def __init__(self, size: int) -> None:
+        self.stride = -(-size // 8) * 8
+        total = (2 * self.PAIRS + self.SINGLES) * self.stride
+        raw = np.empty(total + 8)
+        start = (-raw.ctypes.data) % 64 // 8
+        self.raw = raw[start:start + total]
+        self._views: dict[int, tuple[list[Array], list[Array]]] = {}
+
+    def views(self, b: int) -> tuple[list[Array], list[Array]]:
+        if b not in self._views:
+            s, base = self.stride, 2 * self.PAIRS * self.stride
+            self._views[b] = (
+                [self.raw[2 * k * s:2 * k * s + 2 * b].reshape(2, b) for k in range(self.PAIRS)],
+                [self.raw[base + k * s:base + k * s + b] for k in range(self.SINGLES)])
+        return self._views[b]
+
+
+def _fused_block(c: _Lumped, bufs: tuple[list[Array], list[Array]], q: Array, dq: Array,
+                 ddq: Array, out: Array) -> tuple[float, float]:
+    """Motor torques of one block ``q, dq, ddq`` (b, 2) into ``out`` (b, 2). Returns the
+    smallest ``(h / |B - C|^2)^2`` (negative when the rods cannot meet) and the largest
+    ``1 / |det A|`` of the block, for the checks."""
+    (T, T2, AX, AY, UX, UY, Bb, CU, W, R, X, Acc, Y, K, SD), \
+        (vx, vy, s1, s2, idel, hh, ue, s3) = bufs
+    ux, ex, uy, ey = UX[0], UX[1], UY[0], UY[1]
+    # proximal rods a = l (cos q, sin q) through t = tan(q / 2)
+    _mul(q.T, 0.5, T)
+    np.tan(T, T)
+    _mul(T, T, T2)
+    _add(T2, 1.0, T2)
+    _div(c.two_l, T2, T2)
+    _sub(T2, c.l, AX)
+    _mul(T2, T, AY)
+    # v = B - C, e = P - C = kk v + sign hh perp(v), u = P - B = e - v
+    _sub(AX[0], AX[1], vx)
+    _add(vx, c.d, vx)
+    _sub(AY[0], AY[1], vy)
+    _mul(vx, vx, s1)
+    _mul(vy, vy, s2)
+    _add(s1, s2, s1)
+    _mul(s1, 0.5, ue)
+    _sub(c.ue0, ue, ue)
+    _div(1.0, s1, idel)
+    kk: Any = 0.5
+    _mul(idel, c.L2sq, hh)
+    if c.cst == 0.0:
+        _sub(hh, 0.25, hh)
+    else:
+        kk = s2
+        _mul(idel, c.cst, kk)
+        _add(kk, 0.5, kk)
+        _mul(kk, kk, s3)
+        _sub(hh, s3, hh)
+    disc = float(hh.min()) if hh.size else 0.0
+    if disc < 0.0:
+        np.maximum(hh, 0.0, out=hh)
+    np.sqrt(hh, hh)
+    idet, nidet = SD[0], SD[1]
+    _div(idel, hh, idet)  # 1 / |det|
+    worst = float(idet.max()) if hh.size else 0.0
+    if c.sign > 0:
+        np.negative(idet, idet)
+    np.negative(idet, nidet)
+    _mul(hh, vy, s3)
+    _mul(vx, kk, ex)
+    (_sub if c.sign > 0 else _add)(ex, s3, ex)
+    _mul(hh, vx, s3)
+    _mul(vy, kk, ey)
+    (_add if c.sign > 0 else _sub)(ey, s3, ey)
+    _sub(ex, vx, ux)
+    _sub(ey, vy, uy)
+    _mul(AX, UY, Bb)  # b = a x U
+    _mul(AY, UX, T)
+    _sub(Bb, T, Bb)
+    _mul(AX, UX, CU)  # c = a . U
+    _mul(AY, UY, T)
+    _add(CU, T, CU)
+    # rates: omega L^2 = T (b qdot) - c qdot, bias = -omega^2 L^2 - qdot^2 c
+    np.copyto(W, dq.T)
+    _mul(Bb, W, R)
+    _mul(c.Lsq, R[::-1], X)
+    _mul(ue, R, T)
+    _sub(X, T, X)
+    _mul(X, SD, X)
+    _mul(W, CU, T)
+    _sub(X, T, X)
+    _mul(W, T, T)
+    _mul(X, X, X)
+    _mul(X, c.iLsq, X)
+    _add(X, T, X)  # -bias
+    # accelerations: rr = b qddot + bias = A Pddot, Y = U x Pddot = T rr
+    np.copyto(Acc, ddq.T)
+    _mul(Bb, Acc, T2)
+    _sub(T2, X, T2)
+    _mul(c.Lsq, T2[::-1], Y)
+    _mul(ue, T2, T)
+    _sub(Y, T, Y)
+    _mul(Y, SD, Y)
+    # the rods' couples k = I_r alpha / L^2 with alpha L^2 = Y - c qddot - b qdot^2
+    _mul(Acc, CU, K)
+    _sub(Y, K, K)
+    _mul(W, R, T)
+    _sub(K, T, K)
+    _mul(K, c.cK, K)
+    # MP (U x Pddot - U x g) + (L1^2 k1, L2^2 k2) + ue (k2, k1), then over det: lam reversed
+    _mul(Y, c.MP, Y)
+    if c.MPgy:
+        _mul(UX, c.MPgy, T)
+        _sub(Y, T, Y)
+    if c.MPgx:
+        _mul(UY, c.MPgx, T)
+        _add(Y, T, Y)
+    _mul(c.Lsq, K, T)
+    _add(Y, T, Y)
+    _mul(ue, K[::-1], T)
+    _add(Y, T, Y)
+    _mul(Y, SD, Y)
+    # tau = b lam - k c + J qddot + gravity + friction, the last sum into the output
+    tau = T2
+    _mul(Bb, Y[::-1], tau)
+    _mul(K, CU, T)
+    _sub(tau, T, tau)
+    _mul(Acc, c.J, T)
+    for coef, arm in ((c.Gax, AX), (c.Gay, AY)):
+        if coef is not None:
+            _add(tau, T, tau)
+            _mul(arm, coef, T)
+    if c.viscous is not None and c.coulomb is not None:
+        _add(tau, T, tau)
+        _mul(W, c.viscous, T)
+        _add(tau, T, tau)
+        _mul(W, c.inv_vs, T)
+        np.tanh(T, T)
+        _mul(T, c.coulomb, T)
+    _add(tau[0], T[0], out[:, 0])
+    _add(tau[1], T[1], out[:, 1])
+    return disc, worst
+
+
+def _torques(model: Model, q: object, dq: object, ddq: object, *, gravity: bool,
+             friction: bool, t: object = None, block: int = FUSED_BLOCK) -> Array:
+    """Motor torques (..., 2) by the fused kernel, checked like :func:`_run`."""
+    q0 = as_points(q, "q")
+    shape = q0.shape[:-1]
+    qf = q0.reshape(-1, 2)
+    dqf = as_points(dq, "dq").reshape(-1, 2)
+    ddqf = as_points(ddq, "ddq").reshape(-1, 2)
+    n = len(qf)
+    if not (len(dqf) == len(ddqf) == n):
+        raise ParameterError(f"q, dq, ddq must have the same number of samples, got "
+                             f"{n}, {len(dqf)}, {len(ddqf)}")
+    c = _lumped(model, gravity, friction)
+    r = model.robot
+    # _check_state runs (and names the sample) only on a block whose extremes come near its
+    # limits: rods that do not meet (a negative discriminant), 1 / |det| near 1 / (tol L1 L2)
+    sing_cap = 1.0 / (model.tol * r.L1 * r.L2) if model.tol > 0 else np.inf
+    tt = None if t is None else np.asarray(t, dtype=float).reshape(-1)
+    out = np.empty((n, 2))
+    bufs = _Buffers(min(block, max(n, 1)))
+    for blk in blocks(n, block):
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # checked below
+            disc, worst = _fused_block(c, bufs.views(blk.stop - blk.start), qf[blk], dqf[blk],
+                                       ddqf[blk], out[blk])
+        if disc < 0.0 or worst >= sing_cap * (1.0 - 1e-9):
+            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+                pose = _pose(model, qf[blk, 0], qf[blk, 1], _Np)
+            _check_state(model, pose, qf, blk.start, tt)
+    return out.reshape(shape + (2,))
+
+
 def inverse_dynamics(model: Model, q: object, dq: object, ddq: object, *,
                      t: object = None) -> Array:
     """Motor torques ``tau = M(q) qddot + c(q, qdot) + g(q) + friction``.
@@ -302,8 +567,7 @@ def inverse_dynamics(model: Model, q: object, dq: object, ddq: object, *,
     SingularityError
         Within ``model.tol`` of a parallel singularity (names the sample, time and q).
     """
-    out = _run(model, q, dq, ddq, gravity=True, friction=True, t=t)
-    return np.stack([out["tau1"], out["tau2"]], axis=-1)
+    return _torques(model, q, dq, ddq, gravity=True, friction=True, t=t)
 
 
 def mass_matrix(model: Model, q: object) -> Array:
@@ -354,16 +618,14 @@ def path_dynamics(model: Model, q: Array, dq_ds: Array, ddq_ds: Array
 def bias_forces(model: Model, q: object, dq: object) -> Array:
     """Velocity-product torques ``c(q, qdot)`` (Coriolis and centrifugal), shape (..., 2)."""
     q = as_points(q, "q")
-    out = _run(model, q, dq, np.zeros_like(q), gravity=False, friction=False)
-    return np.stack([out["tau1"], out["tau2"]], axis=-1)
+    return _torques(model, q, dq, np.zeros_like(q), gravity=False, friction=False)
 
 
 def gravity_torques(model: Model, q: object) -> Array:
     """Gravity torques ``g(q)``, shape (..., 2) (what the motors must hold at rest)."""
     q = as_points(q, "q")
     z = np.zeros_like(q)
-    out = _run(model, q, z, z, gravity=True, friction=False)
-    return np.stack([out["tau1"], out["tau2"]], axis=-1)
+    return _torques(model, q, z, z, gravity=True, friction=False)
 
 
 def kinetic_energy(model: Model, q: object, dq: object) -> Array:
