@@ -28,11 +28,10 @@ as the next guess. Failure raises :class:`ConvergenceError`: never a silent wron
 from __future__ import annotations
 
 import math
-import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from functools import lru_cache
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.polynomial import chebyshev as cheb
@@ -81,34 +80,309 @@ def line_solution(G: float, tau: Array) -> Array:
 #: ``sigma(tau, k)``: the k-th derivative of the normalised law at normalised times.
 SigmaFn = Callable[[Array, int], Array]
 
+#: ``K, K_sigma, K_sigma_sigma`` of the dimensionless curvature at ``sigma`` on one element.
+CurvatureFn = Callable[[Array], tuple[Array, Array, Array]]
 
-#: Wall-clock budget of the continuation on paths of varying curvature (s): a path whose
-#: curvature is so wild that it takes longer gets a ConvergenceError, not a hang.
-TIME_BUDGET_S = 20.0
+#: Bounds of the solvers, in iterations rather than seconds so that a result never depends on
+#: the machine's speed: Newton iterations per solve, solves of a continuation (in ``G`` on
+#: constant curvature, in the curvature's scale on other paths) and re-placements of the
+#: elements' edges on the curvature's breaks.
+MAX_NEWTON = 40
+MAX_CONTINUATION_SOLVES = 60
+MAX_EDGE_UPDATES = 8
+
+# Chebyshev coefficients (in x = 2 xi - 1) of xi^m, m = 0..3: the Taylor part of an element
+_XI = tuple(cheb.poly2cheb(np.polynomial.polynomial.polypow([0.5, 0.5], m)) for m in range(4))
 
 
 @dataclass(frozen=True)
 class _Ops:
-    """Chebyshev collocation operators for ``N + 1`` Lobatto points on ``tau`` in [0, 1]."""
+    """Chebyshev collocation operators for ``N + 1`` Lobatto points on ``xi`` in [0, 1]."""
 
-    x: Array  # nodes in [-1, 1], x_0 = 1 (tau = 1)
-    tau: Array
+    x: Array  # nodes in [-1, 1], x_0 = 1 (xi = 1, the element's right end)
+    tau: Array  # the nodes in [0, 1]
     to_coef: Array  # values -> Chebyshev coefficients
-    Q: tuple[Array, ...]  # k-fold integration from tau = 0 in coefficient space, k = 1..4
+    Q: tuple[Array, ...]  # k-fold integration from xi = 0 in coefficient space, k = 1..4
     M: tuple[Array, ...]  # the same from node values to node values
+    between: Array  # 4 N points between the nodes, in [-1, 1], for the residual
+    gauss: tuple[Array, Array]  # 2 N + 8 Gauss-Legendre points in [-1, 1] and their weights
 
 
 @lru_cache(maxsize=16)
-def _ops(N: int) -> _Ops:
+def _lobatto(N: int) -> tuple[Array, Array]:
+    """The ``N + 1`` Chebyshev-Lobatto points in [-1, 1] (``x_0 = 1``) and the matrix from
+    values there to Chebyshev coefficients."""
     j = np.arange(N + 1)
     x = np.cos(np.pi * j / N)
     gamma = np.ones(N + 1)
     gamma[[0, N]] = 2.0
-    to_coef = (2.0 / N) * np.cos(np.pi * np.outer(j, j) / N) / np.outer(gamma, gamma)
+    return x, (2.0 / N) * np.cos(np.pi * np.outer(j, j) / N) / np.outer(gamma, gamma)
+
+
+@lru_cache(maxsize=16)
+def _ops(N: int) -> _Ops:
+    x, to_coef = _lobatto(N)
     eye = np.eye(N + 1)
     Q = tuple(cheb.chebint(eye, m=k, lbnd=-1, scl=0.5, axis=0) for k in range(1, 5))
     M = tuple(cheb.chebvander(x, N + k) @ Q[k - 1] @ to_coef for k in range(1, 5))
-    return _Ops(x, 0.5 * (x + 1.0), to_coef, Q, M)
+    m = 4 * N
+    between = np.cos(np.pi * (np.arange(m) + 0.5) / m)
+    gauss = np.polynomial.legendre.leggauss(2 * N + 8)
+    return _Ops(x, 0.5 * (x + 1.0), to_coef, Q, M, between, gauss)
+
+
+class _Mesh:
+    """Elements ``[edges[e], edges[e + 1]]`` of ``[0, 1]``, each with ``N + 1`` Lobatto nodes.
+
+    The unknowns ``z`` are ``u = sigma''''`` at every node and the two constants ``c2, c3``
+    of ``sigma = c2 tau^2 + c3 tau^3 + (4-fold integral of u)`` on the first element; each next
+    element starts from the values of ``sigma`` to ``sigma'''`` where the previous one ends (so
+    ``sigma`` is C3 and the rest at ``tau = 0`` holds exactly). ``E[j] @ z`` is ``sigma^(j)``
+    at the nodes (j = 0..3), ``ends[j] @ z`` at ``tau = 1`` and ``lefts[e][j] @ z`` at the
+    start of element ``e``."""
+
+    def __init__(self, edges: Array, N: int) -> None:
+        ops = _ops(N)
+        self.ops, self.N, self.edges = ops, N, np.asarray(edges, dtype=float)
+        self.h = np.diff(self.edges)
+        n = N + 1
+        self.nu = len(self.h) * n
+        nz = self.nu + 2
+        E = np.zeros((4, self.nu, nz))
+        C = np.zeros((4, nz))
+        C[2, nz - 2], C[3, nz - 1] = 2.0, 6.0
+        self.lefts: list[Array] = []
+        for e, h in enumerate(self.h):
+            rows = slice(e * n, (e + 1) * n)
+            d = h * ops.tau
+            self.lefts.append(C)
+            for j in range(4):
+                block = np.zeros((n, nz))
+                for k in range(j, 4):
+                    block += np.outer(d ** (k - j) / math.factorial(k - j), C[k])
+                block[:, rows] += h ** (4 - j) * ops.M[3 - j]
+                E[j, rows] = block
+            C = E[:, e * n, :].copy()  # node 0 is the element's right end
+        self.E, self.ends = E, C
+
+    def nodes(self) -> Array:
+        """The nodes in [0, 1], element after element, shape (nu,)."""
+        return np.concatenate([a + h * self.ops.tau for a, h in zip(self.edges, self.h,
+                                                                     strict=False)])
+
+    def coefficients(self, z: Array) -> list[tuple[Array, ...]]:
+        """Per element, the Chebyshev coefficients (in the element's x) of ``sigma^(k)``,
+        k = 0..4."""
+        ops, n = self.ops, self.N + 1
+        out = []
+        for e, h in enumerate(self.h):
+            a = ops.to_coef @ z[e * n:(e + 1) * n]
+            c = self.lefts[e] @ z
+            coefs = []
+            for j in range(4):
+                series = h ** (4 - j) * (ops.Q[3 - j] @ a)
+                for m in range(4 - j):
+                    series[:m + 1] += c[j + m] * h**m / math.factorial(m) * _XI[m]
+                coefs.append(series)
+            coefs.append(a)
+            out.append(tuple(coefs))
+        return out
+
+
+def _piecewise(edges: Array, coefs: list[tuple[Array, ...]]) -> SigmaFn:
+    """``sigma(tau, k)`` from per-element Chebyshev coefficients."""
+    if len(coefs) == 1:
+        c0 = coefs[0]
+
+        def one(tau: Array, k: int) -> Array:
+            return np.asarray(cheb.chebval(2.0 * np.asarray(tau, dtype=float) - 1.0, c0[k]))
+
+        return one
+
+    def many(tau: Array, k: int) -> Array:
+        t = np.asarray(tau, dtype=float)
+        e = np.clip(np.searchsorted(edges, t, side="right") - 1, 0, len(coefs) - 1)
+        out = np.empty(t.shape)
+        for i, c in enumerate(coefs):
+            sel = e == i
+            if sel.any():
+                x = 2.0 * (t[sel] - edges[i]) / (edges[i + 1] - edges[i]) - 1.0
+                out[sel] = cheb.chebval(x, c[k])
+        return out
+
+    return many
+
+
+@dataclass
+class _Spectral:
+    """A spectral solution: the law, its residual, nodes per element, the integrals
+    ``Int sigma'^2`` and ``Int sigma''^2 + K^2 sigma'^4`` over ``tau`` in [0, 1] (once
+    converged), the mesh and the unknowns."""
+
+    sigma: SigmaFn
+    residual: float
+    nodes: int
+    velocity2: float
+    acceleration2: float
+    mesh: _Mesh
+    z: Array
+
+
+class _Collocation:
+    """Newton's method on the integral-form Chebyshev collocation equations, on one element
+    (constant curvature) or on one element per smooth piece of the curvature."""
+
+    def __init__(self, curvature: list[CurvatureFn], tol: float, tail: float = 1e-12) -> None:
+        self.curv, self.tol, self.tail = curvature, tol, tail
+        self.iterations = 0
+        self.scale = 1.0  # continuation in the curvature: K -> scale K
+        self.damped = False  # halve Newton's steps that do not reduce the residual
+
+    def _rhs(self, G2: float, K: Array, Ks: Array, Kss: Array, s1: Array, s2: Array,
+             jac: bool) -> Any:
+        lam = self.scale
+        if lam != 1.0:
+            K, Ks, Kss = lam * K, lam * Ks, lam * Kss
+        s1sq = s1 * s1
+        KK = K * K
+        KKs = K * Ks
+        F2 = G2 + 6.0 * KK * s1sq
+        F = F2 * s2 + 3.0 * KKs * s1sq * s1sq
+        if not jac:
+            return F
+        F1 = 12.0 * KK * s1 * s2 + 12.0 * KKs * s1sq * s1
+        F0 = 12.0 * KKs * s1sq * s2 + 3.0 * (Ks * Ks + K * Kss) * s1sq * s1sq
+        return F, F0, F1, F2
+
+    def rhs(self, G2: float, mesh: _Mesh, s: Array, s1: Array, s2: Array) -> Any:
+        """``F(sigma, sigma', sigma'')`` at the nodes and its partial derivatives."""
+        if len(self.curv) == 1:
+            K, Ks, Kss = self.curv[0](s)
+        else:
+            K, Ks, Kss = (np.empty_like(s) for _ in range(3))
+            n = mesh.N + 1
+            for e, fn in enumerate(self.curv):
+                sl = slice(e * n, (e + 1) * n)
+                K[sl], Ks[sl], Kss[sl] = fn(s[sl])
+        return self._rhs(G2, K, Ks, Kss, s1, s2, True)
+
+    def newton(self, G2: float, mesh: _Mesh, z: Array, max_iter: int = MAX_NEWTON
+               ) -> Array | None:
+        """Solve the collocation equations from ``z`` in at most ``max_iter`` iterations;
+        None when Newton fails."""
+        E0, E1, E2 = mesh.E[0], mesh.E[1], mesh.E[2]
+        nu = mesh.nu
+        J = np.empty((nu + 2, nu + 2))
+        J[nu], J[nu + 1] = mesh.ends[0], mesh.ends[1]
+        R = np.empty(nu + 2)
+        diag = np.arange(nu)
+        best = np.inf
+
+        def residual(z: Array) -> tuple[Array, Any, float]:
+            d = self.rhs(G2, mesh, E0 @ z, E1 @ z, E2 @ z)
+            R[:nu] = z[:nu] - d[0]
+            R[nu], R[nu + 1] = mesh.ends[0] @ z - 1.0, mesh.ends[1] @ z
+            norm = np.abs(R[:nu]).max() / (1.0 + np.abs(d[0]).max()) + np.abs(R[nu:]).max()
+            return R, d, float(norm)
+
+        R, derivs, norm = residual(z)
+        for _ in range(max_iter):
+            self.iterations += 1
+            F, F0, F1, F2 = derivs
+            if not np.isfinite(R).all():
+                return None
+            Jn = J[:nu]
+            np.multiply(-F0[:, None], E0, out=Jn)
+            Jn -= F1[:, None] * E1
+            Jn -= F2[:, None] * E2
+            Jn[diag, diag] += 1.0
+            try:
+                dz = np.linalg.solve(J, -R)
+            except np.linalg.LinAlgError:
+                return None
+            if norm > 10 * best:  # diverging
+                return None
+            best = min(best, norm)
+            step = 1.0
+            znew = z + dz
+            R, derivs, new = residual(znew)
+            # damped: halve the step while it does not decrease the residual (far from it)
+            while self.damped and not new < norm and new > 1e-8 and step > 1.0 / 64:
+                step *= 0.5
+                znew = z + step * dz
+                R, derivs, new = residual(znew)
+            z, norm = znew, new
+            if np.abs(step * dz[:nu]).max() <= (1e-14 * (1.0 + np.abs(z[:nu]).max())
+                                                * (mesh.N + 1)):
+                return z
+        # accept if the last residual is tiny even without a clean step criterion
+        return z if best < 1e-12 else None
+
+    def check(self, G2: float, mesh: _Mesh, coefs: list[tuple[Array, ...]]
+              ) -> tuple[float, float]:
+        """Largest ODE residual between the nodes (relative to ``1 + max |u|``) and the
+        largest relative size of the last Chebyshev coefficients of ``u`` of an element."""
+        x = mesh.ops.between
+        worst, top, tail = 0.0, 0.0, 0.0
+        for e, c in enumerate(coefs):
+            s, s1, s2, _, u = (cheb.chebval(x, ck) for ck in c)
+            K, Ks, Kss = self.curv[e](s)
+            F = self._rhs(G2, K, Ks, Kss, s1, s2, False)
+            worst = max(worst, float(np.abs(u - F).max()))
+            top = max(top, float(np.abs(u).max()))
+            a = c[4]
+            tail = max(tail, float(np.abs(a[-4:]).max() / max(np.abs(a).max(), 1e-300)))
+        return worst / (1.0 + top), tail
+
+    def cost(self, mesh: _Mesh, coefs: list[tuple[Array, ...]]) -> tuple[float, float]:
+        """``Int sigma'^2`` and ``Int sigma''^2 + K^2 sigma'^4`` over [0, 1] (Gauss-Legendre
+        on each element, exact for constant curvature)."""
+        xg, wg = mesh.ops.gauss
+        v2 = a2 = 0.0
+        for e, c in enumerate(coefs):
+            s, s1, s2 = (cheb.chebval(xg, c[k]) for k in range(3))
+            K = self.curv[e](s)[0]
+            half = 0.5 * mesh.h[e]
+            v2 += half * float(wg @ (s1 * s1))
+            a2 += half * float(wg @ (s2 * s2 + K * K * s1**4))
+        return v2, a2
+
+    def solve(self, G: float, edges: Array, N: int, guess: _Spectral | None, max_nodes: int,
+              *, refine: bool = True, retry: bool = True, max_iter: int = MAX_NEWTON
+              ) -> _Spectral | None:
+        """Solve at ``G`` on elements with ``edges``, from ``N`` nodes per element, doubling
+        ``N`` up to ``max_nodes`` until the residual and the coefficients' tail are small
+        (``refine``; else the first Newton solution at ``N`` is returned unchecked). When
+        Newton fails, try again with more nodes only if ``retry``. None on failure."""
+        G2 = G * G
+        while True:
+            mesh = _Mesh(edges, N)
+            tau = mesh.nodes()
+            if guess is None:
+                g = line_solution(G, tau)
+                g0 = line_solution(G, np.zeros(1))
+                z = np.concatenate([G2 * g[2], [0.5 * g0[2, 0], g0[3, 0] / 6.0]])
+            else:
+                zero = np.zeros(1)
+                z = np.concatenate([guess.sigma(tau, 4), [0.5 * guess.sigma(zero, 2)[0],
+                                                          guess.sigma(zero, 3)[0] / 6.0]])
+            zz = self.newton(G2, mesh, z, max_iter)
+            if zz is None and not retry:
+                return None
+            if zz is not None:
+                coefs = mesh.coefficients(zz)
+                sol = _Spectral(_piecewise(mesh.edges, coefs), np.inf, N + 1, 0.0, 0.0, mesh,
+                                zz)
+                if not refine:
+                    return sol
+                sol.residual, tail = self.check(G2, mesh, coefs)
+                if sol.residual <= self.tol and tail <= self.tail:
+                    sol.velocity2, sol.acceleration2 = self.cost(mesh, coefs)
+                    return sol
+                guess = sol
+            if 2 * N > max_nodes:
+                return None
+            N *= 2
 
 
 @dataclass(frozen=True)
@@ -166,6 +440,19 @@ class OptimalLaw(Law):
         return self.distance / self.duration**4 * self._sigma(t, 4)
 
 
+class _Solution(NamedTuple):
+    """What a solver hands back: the law (None when it failed), its residual, nodes,
+    Newton iterations or solves, the method's words and, for the spectral solvers, the
+    integrals ``Int sigma'^2`` and ``Int sigma''^2 + K^2 sigma'^4`` (else None)."""
+
+    sigma: SigmaFn | None
+    residual: float
+    nodes: int
+    iterations: int
+    method: str
+    integrals: tuple[float, float] | None = None
+
+
 def solve_optimal_law(path: Path, *, duration: float = 1.0, eta: float = 0.1, mass: float = 1.0,
                       tol: float = 1e-10, max_nodes: int = 1024) -> OptimalLaw:
     """Solve the paper's optimal law of motion along ``path``.
@@ -183,7 +470,7 @@ def solve_optimal_law(path: Path, *, duration: float = 1.0, eta: float = 0.1, ma
     tol : float
         Target for the ODE residual between the nodes, relative to ``1 + max |s''''|``.
     max_nodes : int
-        Largest number of Chebyshev nodes tried.
+        Largest number of Chebyshev nodes tried (per element).
 
     Returns
     -------
@@ -192,7 +479,8 @@ def solve_optimal_law(path: Path, *, duration: float = 1.0, eta: float = 0.1, ma
     Raises
     ------
     ConvergenceError
-        When neither the direct solve nor continuation in ``eta`` converges.
+        When neither the direct solve nor a continuation converges within its bounds
+        (:data:`MAX_NEWTON`, :data:`MAX_CONTINUATION_SOLVES`, ``max_nodes``).
     """
     T = _positive("duration", duration)
     eta = _positive("eta", eta)
@@ -204,17 +492,25 @@ def solve_optimal_law(path: Path, *, duration: float = 1.0, eta: float = 0.1, ma
                              f"boundary layers of relative width {1 / G:.1e} (need "
                              f"T / sqrt(eta m) <= 1e4)")
     if path.constant_curvature is not None:
-        sigma, resid, nodes, iters, method = _solve_spectral(path, S, G, tol, max_nodes)
+        sol = _solve_spectral(path.constant_curvature * S, G, tol, max_nodes)
     else:
-        sigma, resid, nodes, iters, method = _solve_local(path, S, G, max(tol, 1e-8))
-    if sigma is None:
+        sol = _solve_pieces(path, S, G, tol, min(max_nodes, 256))
+        if sol.sigma is None:  # curvature not smooth on known pieces, or too wild
+            sol = _solve_local(path, S, G, max(tol, 1e-8))
+    if sol.sigma is None:
         raise ConvergenceError(
             f"optimal law did not converge for eta = {eta:g}, mass = {m:g}, duration {T:g} on "
-            f"a path of length {S:.6g} (G = T/sqrt(eta m) = {G:.4g}) with {method}")
-    law = OptimalLaw(distance=S, duration=T, eta=eta, mass=m, sigma=sigma, residual=resid,
-                     nodes=nodes, iterations=iters,
-                     message=f"converged ({method}): residual {resid:.1e} with {nodes} nodes")
-    kin, inert = law_cost(law, path, m, eta, nodes=max(64, 2 * nodes))
+            f"a path of length {S:.6g} (G = T/sqrt(eta m) = {G:.4g}) with {sol.method}")
+    resid, nodes = sol.residual, sol.nodes
+    law = OptimalLaw(distance=S, duration=T, eta=eta, mass=m, sigma=sol.sigma, residual=resid,
+                     nodes=nodes, iterations=sol.iterations,
+                     message=f"converged ({sol.method}): residual {resid:.1e} with {nodes} "
+                             "nodes")
+    if sol.integrals is not None:
+        v2, a2 = sol.integrals
+        kin, inert = 0.5 * m * S * S / T * v2, 0.5 * eta * m * m * S * S / T**3 * a2
+    else:
+        kin, inert = law_cost(law, path, m, eta, nodes=max(64, 2 * nodes))
     law = replace(law, kinetic=kin, inertial=inert)
     bc = law.evaluate(np.array([0.0, T]))
     bc_err = max(abs(bc[0, 0]), abs(bc[0, 1] - S), abs(bc[1, 0]) * T, abs(bc[1, 1]) * T) / S
@@ -223,34 +519,174 @@ def solve_optimal_law(path: Path, *, duration: float = 1.0, eta: float = 0.1, ma
     return law
 
 
-def _solve_spectral(path: Path, S: float, G: float, tol: float, max_nodes: int
-                    ) -> tuple[SigmaFn | None, float, int, int, str]:
-    """Constant curvature: Chebyshev collocation (spectral accuracy, milliseconds)."""
-    solver = _Collocation(path, S, tol)
-    # start with enough nodes to see the boundary layers (width 1/G)
-    N = int(min(max_nodes, 2 ** math.ceil(math.log2(max(32.0, 6.0 * math.sqrt(G))))))
-    state = solver.solve(G, N, None, max_nodes)
+def _first_nodes(G: float, max_nodes: int) -> int:
+    """Enough nodes to see the boundary layers (width 1 / G)."""
+    return int(min(max_nodes, 2 ** math.ceil(math.log2(max(32.0, 6.0 * math.sqrt(G))))))
+
+
+def _spectral_solution(sol: _Spectral, iterations: int, method: str) -> _Solution:
+    return _Solution(sol.sigma, sol.residual, sol.nodes * len(sol.mesh.h), iterations, method,
+                     (sol.velocity2, sol.acceleration2))
+
+
+def _solve_spectral(Kc: float, G: float, tol: float, max_nodes: int) -> _Solution:
+    """Constant curvature ``K = kappa S``: Chebyshev collocation on one element (spectral
+    accuracy, about a millisecond), by continuation in ``G`` when the direct solve fails."""
+
+    def curvature(s: Array) -> tuple[Array, Array, Array]:
+        z = np.zeros_like(s)
+        return np.full_like(s, Kc), z, z
+
+    solver = _Collocation([curvature], tol)
+    edges = np.array([0.0, 1.0])
+    N = _first_nodes(G, max_nodes)
+    state = solver.solve(G, edges, N, None, max_nodes)
     if state is None:  # continuation in G from an easy problem
         for Gv in np.geomspace(min(3.0, G), G, 10):
-            state = solver.solve(float(Gv), N, state, max_nodes)
+            state = solver.solve(float(Gv), edges, N, state, max_nodes)
             if state is None:
                 break
-    method = f"Chebyshev collocation, up to {max_nodes} nodes, direct and by continuation in eta"
     if state is None:
-        return None, np.inf, 0, solver.iterations, method
-    coef, resid, N = state
-
-    def sigma(tau: Array, k: int) -> Array:
-        return np.asarray(cheb.chebval(2.0 * tau - 1.0, coef[k]))
-
-    return sigma, resid, N + 1, solver.iterations, "Chebyshev collocation"
+        return _Solution(None, np.inf, 0, solver.iterations,
+                         f"Chebyshev collocation, up to {max_nodes} nodes, direct and by "
+                         "continuation in eta")
+    return _spectral_solution(state, solver.iterations, "Chebyshev collocation")
 
 
-def _solve_local(path: Path, S: float, G: float, tol: float
-                 ) -> tuple[SigmaFn | None, float, int, int, str]:
-    """Varying curvature: collocation with local mesh refinement (scipy's solve_bvp), by
-    continuation in the curvature (``kappa -> lam kappa``, ``lam`` from 0, the straight line
-    whose solution is exact, to 1) with adaptive steps."""
+def _breaks(path: Path, S: float) -> Array:
+    """Where the curvature may lose smoothness, in normalised arc length (with 0 and 1): a
+    B-spline path's interior knots, a composite path's joints."""
+    p: list[float] = []
+    spl = getattr(path, "_spl", None)  # Spline: its B-spline's knots
+    knots = getattr(spl, "t", None)
+    if knots is not None:
+        p = [float(v) for v in np.unique(knots) if path.p0 < v < path.p1]
+        s = path.arc_length(np.array(p)) / S if p else np.empty(0)
+    else:
+        starts = getattr(path, "starts", None)  # Composite: arc length at its joints
+        s = np.asarray(starts, dtype=float)[1:-1] / S if starts is not None else np.empty(0)
+    return np.concatenate([[0.0], np.sort(s[(s > 1e-9) & (s < 1 - 1e-9)]), [1.0]])
+
+
+def _curvature_pieces(path: Path, S: float, breaks: Array) -> list[CurvatureFn] | None:
+    """On each piece between the breaks, ``K = kappa S`` as a function of the normalised arc
+    length, by Chebyshev interpolation until its coefficients have decayed to 1e-13 (and its
+    derivatives by differentiating the series); None when some piece's curvature is not
+    smooth enough for that within 513 points."""
+    fns: list[CurvatureFn] = []
+    pieces = list(zip(breaks[:-1], breaks[1:], strict=True))
+    series: list[tuple[float, float, Array]] = []
+    for a, b in pieces:
+        for deg in (32, 64, 128, 256, 512):
+            x, to_coef = _lobatto(deg)
+            sig = a + 0.5 * (b - a) * (x + 1.0)
+            K = path.curvature(path.parameter_at(np.clip(sig, 0.0, 1.0) * S))[0] * S
+            coef = to_coef @ K
+            if np.abs(coef[-3:]).max() <= 1e-13 * max(1.0, float(np.abs(K).max())):
+                series.append((float(a), float(b), coef))
+                break
+        else:
+            return None
+    for a, b, coef in series:
+        scale = 2.0 / (b - a)
+        d1 = cheb.chebder(coef) * scale
+        C = np.zeros((coef.size, 3))
+        C[:, 0], C[:-1, 1], C[:-2, 2] = coef, d1, cheb.chebder(d1) * scale
+
+        def fn(s: Array, a: float = a, b: float = b, C: Array = C
+               ) -> tuple[Array, Array, Array]:
+            # a little beyond the piece while Newton iterates, never far
+            x = np.clip((2.0 * s - (a + b)) / (b - a), -1.1, 1.1)
+            K = cheb.chebvander(x, C.shape[0] - 1) @ C
+            return K[..., 0], K[..., 1], K[..., 2]
+
+        fns.append(fn)
+    return fns
+
+
+def _edges_at(sigma: SigmaFn, breaks: Array, edges: Array) -> Array:
+    """The times where the law crosses the breaks (Newton from the current ``edges``)."""
+    t = edges[1:-1].copy()
+    target = breaks[1:-1]
+    for _ in range(20):
+        step = (sigma(t, 0) - target) / np.maximum(sigma(t, 1), 1e-300)
+        t = np.clip(t - step, 0.0, 1.0)
+        if np.abs(step).max(initial=0.0) <= 1e-15:
+            break
+    return np.concatenate([[0.0], t, [1.0]])
+
+
+def _solve_pieces(path: Path, S: float, G: float, tol: float, max_nodes: int) -> _Solution:
+    """Varying curvature, smooth on pieces (a spline between its knots, an analytic path in
+    one piece): one Chebyshev element per piece, whose edges follow the times at which the
+    law crosses the pieces' ends. The full curvature is reached on a coarse mesh, directly or
+    by continuation in its scale (from the straight line, whose solution is exact); there the
+    edges settle, then the nodes double until the residual is below ``tol``."""
+    method = "Chebyshev collocation on the curvature's smooth pieces"
+    breaks = _breaks(path, S)
+    curvature = _curvature_pieces(path, S, breaks)
+    if curvature is None:
+        return _Solution(None, np.inf, 0, 0, method + " (curvature not smooth on them)")
+    # the residual is the criterion here; the coefficients' tail only guards it
+    solver = _Collocation(curvature, tol, tail=max(1e-12, tol))
+    solver.damped = True
+
+    def line(tau: Array, k: int) -> Array:
+        return np.asarray(line_solution(G, tau)[k])
+
+    edges = _edges_at(line, breaks, breaks.copy())
+    N = _first_nodes(G, max_nodes)
+    state = _continued(solver, G, edges, N, max_nodes)
+    refine = False  # coarse while the edges move, then refined
+    for _ in range(2 * MAX_EDGE_UPDATES):
+        if state is None:
+            break
+        new = _edges_at(state.sigma, breaks, edges)
+        moved = float(np.abs(new - edges).max())
+        # an edge off its break by d changes the curvature its element sees by about
+        # jump(K''') d^3 / 6 on a spline (C2 curvature), jump(K') d^2 / 2 on a G2 chain
+        if refine and moved <= 1e-8:
+            return _Solution(state.sigma, state.residual, state.nodes * len(state.mesh.h),
+                             solver.iterations, f"{method}, {len(breaks) - 1} of them",
+                             (state.velocity2, state.acceleration2))
+        edges = new
+        refine = refine or moved <= 1e-8
+        state = solver.solve(G, edges, state.nodes - 1, state, max_nodes, refine=refine,
+                             retry=False)
+    return _Solution(None, np.inf, 0, solver.iterations, method)
+
+
+def _continued(solver: _Collocation, G: float, edges: Array, N: int, max_nodes: int
+               ) -> _Spectral | None:
+    """A Newton solution at the full curvature on ``N`` nodes per element, from the line's
+    law or, when that fails, by continuation in the curvature's scale from 0 with adaptive
+    steps (at most MAX_CONTINUATION_SOLVES solves)."""
+    # from the line's law Newton converges in a few iterations or not at all
+    sol = solver.solve(G, edges, N, None, max_nodes, refine=False, retry=False, max_iter=12)
+    if sol is not None:
+        return sol
+    lam, step, state = 0.0, 0.25, None
+    for _ in range(MAX_CONTINUATION_SOLVES):
+        target = min(1.0, lam + step)
+        solver.scale = target
+        trial = solver.solve(G, edges, N, state, max_nodes, refine=False, retry=False)
+        solver.scale = 1.0
+        if trial is None:
+            step *= 0.5
+            if step < 1.0 / 256:
+                return None
+            continue
+        if target == 1.0:
+            return trial
+        lam, step, state = target, min(1.0, 2.0 * step), trial
+    return None
+
+
+def _solve_local(path: Path, S: float, G: float, tol: float) -> _Solution:
+    """Varying curvature that is not smooth on known pieces: collocation with local mesh
+    refinement (scipy's solve_bvp), by continuation in the curvature (``kappa -> lam kappa``,
+    ``lam`` from 0, the straight line whose solution is exact, to 1) with adaptive steps, at
+    most MAX_CONTINUATION_SOLVES solves."""
     # curvature along the normalised arc length, tabulated once at 4097 nodes and interpolated
     # by a quintic spline (smooth, so the mesh refinement does not chase interpolation kinks)
     grid = np.linspace(0.0, 1.0, 4097)
@@ -283,12 +719,7 @@ def _solve_local(path: Path, S: float, G: float, tol: float
     res: Any = None
     guess = line_solution(G, mesh)
     lam, step, solves = 0.0, 1.0, 0
-    started = time.perf_counter()
     while lam < 1.0:
-        if time.perf_counter() - started > TIME_BUDGET_S:
-            return None, np.inf, 0, solves, (
-                f"collocation with mesh refinement and continuation in curvature (stopped at "
-                f"{lam:.3g} of the curvature after {TIME_BUDGET_S:g} s)")
         target = min(1.0, lam + step)
         trial = solve_bvp(make(target), bc, mesh, guess, tol=tol if target == 1.0 else 1e-5,
                           max_nodes=50_000)
@@ -299,10 +730,10 @@ def _solve_local(path: Path, S: float, G: float, tol: float
             step = min(1.0, 2 * step)
         else:
             step *= 0.5
-            if step < 1.0 / 256 or solves > 60:
-                return None, np.inf, 0, solves, ("collocation with mesh refinement and "
-                                                 f"continuation in curvature (stopped at "
-                                                 f"{lam:.3g} of the curvature: {trial.message})")
+            if step < 1.0 / 256 or solves >= MAX_CONTINUATION_SOLVES:
+                return _Solution(None, np.inf, 0, solves, (
+                    "collocation with mesh refinement and continuation in curvature (stopped "
+                    f"at {lam:.3g} of the curvature after {solves} solves: {trial.message})"))
     sol = res.sol
 
     def sigma(tau: Array, k: int) -> Array:
@@ -310,141 +741,8 @@ def _solve_local(path: Path, S: float, G: float, tol: float
         vals = sol(flat, 1)[3] if k == 4 else sol(flat)[k]
         return np.asarray(vals).reshape(np.shape(tau))
 
-    return (sigma, float(np.max(res.rms_residuals)), int(res.x.size), solves,
-            "collocation with mesh refinement (solve_bvp)")
-
-
-class _Collocation:
-    """Newton's method on the integral-form Chebyshev collocation equations."""
-
-    def __init__(self, path: Path, S: float, tol: float) -> None:
-        self.path, self.S, self.tol = path, S, tol
-        kc = path.constant_curvature
-        self.Kc = None if kc is None else kc * S
-        self.iterations = 0
-
-    def curvature(self, sig: Array) -> tuple[Array, Array, Array]:
-        """``K, K_sigma, K_sigma_sigma`` at ``sigma`` (clipped to the path)."""
-        if self.Kc is not None:
-            z = np.zeros_like(sig)
-            return np.full_like(sig, self.Kc), z, z
-
-        def k_and_dk(sg: Array) -> tuple[Array, Array]:
-            p = self.path.parameter_at(np.clip(sg, 0.0, 1.0) * self.S)
-            k, dk = self.path.curvature(p)
-            return k * self.S, dk * self.S**2
-
-        K, Ks = k_and_dk(sig)
-        h = 1e-5
-        Kss = (k_and_dk(sig + h)[1] - k_and_dk(sig - h)[1]) / (2 * h)
-        return K, Ks, Kss
-
-    def rhs(self, G2: float, s: Array, s1: Array, s2: Array, jac: bool = False) -> Any:
-        K, Ks, Kss = self.curvature(s)
-        s1sq = s1 * s1
-        F = (G2 + 6.0 * K * K * s1sq) * s2 + 3.0 * K * Ks * s1sq * s1sq
-        if not jac:
-            return F
-        F2 = G2 + 6.0 * K * K * s1sq
-        F1 = 12.0 * K * K * s1 * s2 + 12.0 * K * Ks * s1sq * s1
-        F0 = 12.0 * K * Ks * s1sq * s2 + 3.0 * (Ks * Ks + K * Kss) * s1sq * s1sq
-        return F, F0, F1, F2
-
-    def solve(self, G: float, N: int, guess: tuple[Any, ...] | None, max_nodes: int
-              ) -> tuple[tuple[Array, ...], float, int] | None:
-        """Solve at ``G`` starting with ``N`` nodes; returns (coef, residual, N, u-evaluator)
-        or None."""
-        G2 = G * G
-        while True:
-            ops = _ops(N)
-            tau = ops.tau
-            if guess is None:
-                g = line_solution(G, tau)
-                g0 = line_solution(G, np.zeros(1))
-                u, c2, c3 = G2 * g[2], 0.5 * g0[2, 0], g0[3, 0] / 6.0
-            else:
-                coef_prev = guess[0]
-                u = cheb.chebval(ops.x, coef_prev[4])
-                c2 = 0.5 * cheb.chebval(-1.0, coef_prev[2])
-                c3 = cheb.chebval(-1.0, coef_prev[3]) / 6.0
-            out = self._newton(G2, ops, u, c2, c3)
-            if out is not None:
-                u, c2, c3 = out
-                coef = self._coefficients(ops, u, c2, c3)
-                resid, tail = self._residual(G2, coef, N)
-                if resid <= self.tol and tail <= 1e-12:
-                    return coef, resid, N
-                guess = (coef,)
-            if 2 * N > max_nodes:
-                return None
-            N *= 2
-
-    def _newton(self, G2: float, ops: _Ops, u: Array, c2: float, c3: float
-                ) -> tuple[Array, float, float] | None:
-        M1, M2, M3, M4 = ops.M
-        tau = ops.tau
-        n = tau.size
-        J = np.zeros((n + 2, n + 2))
-        eye = np.eye(n)
-        scale_prev = np.inf
-        for _ in range(40):
-            self.iterations += 1
-            s = M4 @ u + c2 * tau**2 + c3 * tau**3
-            s1 = M3 @ u + 2 * c2 * tau + 3 * c3 * tau**2
-            s2 = M2 @ u + 2 * c2 + 6 * c3 * tau
-            F, F0, F1, F2 = self.rhs(G2, s, s1, s2, jac=True)
-            R = np.concatenate([u - F, [s[0] - 1.0, s1[0]]])
-            if not np.isfinite(R).all():
-                return None
-            J[:n, :n] = eye - F0[:, None] * M4 - F1[:, None] * M3 - F2[:, None] * M2
-            J[:n, n] = -(F0 * tau**2 + F1 * 2 * tau + F2 * 2)
-            J[:n, n + 1] = -(F0 * tau**3 + F1 * 3 * tau**2 + F2 * 6 * tau)
-            J[n, :n], J[n, n], J[n, n + 1] = M4[0], 1.0, 1.0
-            J[n + 1, :n], J[n + 1, n], J[n + 1, n + 1] = M3[0], 2.0, 3.0
-            try:
-                dz = np.linalg.solve(J, -R)
-            except np.linalg.LinAlgError:
-                return None
-            norm = np.abs(R[:n]).max() / (1.0 + np.abs(F).max()) + np.abs(R[n:]).max()
-            if norm > 10 * scale_prev:  # diverging
-                return None
-            scale_prev = min(scale_prev, norm)
-            u = u + dz[:n]
-            c2 += dz[n]
-            c3 += dz[n + 1]
-            if np.abs(dz[:n]).max() <= 1e-14 * (1.0 + np.abs(u).max()) * n:
-                return u, c2, c3
-        # accept if the last residual is tiny even without a clean step criterion
-        return (u, c2, c3) if scale_prev < 1e-12 else None
-
-    @staticmethod
-    def _coefficients(ops: _Ops, u: Array, c2: float, c3: float) -> tuple[Array, ...]:
-        a = ops.to_coef @ u
-        # polynomial part c2 tau^2 + c3 tau^3 in x = 2 tau - 1, and its derivatives in tau
-        p = np.polynomial.Polynomial([0.0, 0.0, c2, c3], domain=[0, 1], window=[0, 1])
-        coefs = []
-        for k in range(4):
-            integral = ops.Q[3 - k] @ a  # (4 - k)-fold integral of u
-            pk = p.deriv(k) if k else p
-            # express pk(tau) with tau = (x + 1)/2 as a Chebyshev series in x
-            pc = cheb.Chebyshev.cast(pk, domain=[0, 1], window=[-1, 1]).coef
-            n = max(integral.size, pc.size)
-            c = np.zeros(n)
-            c[: integral.size] += integral
-            c[: pc.size] += pc
-            coefs.append(c)
-        coefs.append(a)
-        return tuple(coefs)
-
-    def _residual(self, G2: float, coef: tuple[Array, ...], N: int) -> tuple[float, float]:
-        m = 4 * N
-        x = np.cos(np.pi * (np.arange(m) + 0.5) / m)
-        s, s1, s2, _, u = (cheb.chebval(x, c) for c in coef)
-        F = self.rhs(G2, s, s1, s2)
-        resid = float(np.abs(u - F).max() / (1.0 + np.abs(u).max()))
-        a = coef[4]
-        tail = float(np.abs(a[-4:]).max() / max(np.abs(a).max(), 1e-300))
-        return resid, tail
+    return _Solution(sigma, float(np.max(res.rms_residuals)), int(res.x.size), solves,
+                     "collocation with mesh refinement (solve_bvp)")
 
 
 def _register() -> None:
