@@ -104,8 +104,8 @@ class _Ops:
     to_coef: Array  # values -> Chebyshev coefficients
     Q: tuple[Array, ...]  # k-fold integration from xi = 0 in coefficient space, k = 1..4
     M: tuple[Array, ...]  # the same from node values to node values
-    between: Array  # 4 N points between the nodes, in [-1, 1], for the residual
-    gauss: tuple[Array, Array]  # 2 N + 8 Gauss-Legendre points in [-1, 1] and their weights
+    between: Array  # Chebyshev polynomials 0..N+4 at 4 N points between the nodes
+    gauss: tuple[Array, Array]  # the same at 2 N + 8 Gauss-Legendre points, and the weights
 
 
 @lru_cache(maxsize=16)
@@ -126,9 +126,9 @@ def _ops(N: int) -> _Ops:
     Q = tuple(cheb.chebint(eye, m=k, lbnd=-1, scl=0.5, axis=0) for k in range(1, 5))
     M = tuple(cheb.chebvander(x, N + k) @ Q[k - 1] @ to_coef for k in range(1, 5))
     m = 4 * N
-    between = np.cos(np.pi * (np.arange(m) + 0.5) / m)
-    gauss = np.polynomial.legendre.leggauss(2 * N + 8)
-    return _Ops(x, 0.5 * (x + 1.0), to_coef, Q, M, between, gauss)
+    between = cheb.chebvander(np.cos(np.pi * (np.arange(m) + 0.5) / m), N + 4)
+    xg, wg = np.polynomial.legendre.leggauss(2 * N + 8)
+    return _Ops(x, 0.5 * (x + 1.0), to_coef, Q, M, between, (cheb.chebvander(xg, N + 4), wg))
 
 
 class _Mesh:
@@ -157,11 +157,11 @@ class _Mesh:
             d = h * ops.tau
             self.lefts.append(C)
             for j in range(4):
-                block = np.zeros((n, nz))
+                taylor = np.zeros((n, 4))
                 for k in range(j, 4):
-                    block += np.outer(d ** (k - j) / math.factorial(k - j), C[k])
-                block[:, rows] += h ** (4 - j) * ops.M[3 - j]
-                E[j, rows] = block
+                    taylor[:, k] = d ** (k - j) / math.factorial(k - j)
+                E[j, rows] = taylor @ C
+                E[j, rows, rows] += h ** (4 - j) * ops.M[3 - j]
             C = E[:, e * n, :].copy()  # node 0 is the element's right end
         self.E, self.ends = E, C
 
@@ -189,13 +189,51 @@ class _Mesh:
         return out
 
 
+def _chebyshev_matrix(x: Array, degree: int) -> Array:
+    """``T_k(x)``, k = 0..degree, shape (x.size, degree + 1): ``Re z^k`` with
+    ``z = x + i sqrt(1 - x^2)`` by one cumulative product (Clenshaw's and chebvander's loops
+    over k cost ~1 us a degree, and ``cos(k arccos x)`` twice as much), and
+    ``sign(x)^k cosh(k arccosh |x|)`` outside [-1, 1] (a Newton iterate a little beyond its
+    piece)."""
+    x = np.asarray(x, dtype=float).reshape(-1)
+    k = np.arange(degree + 1)
+    inside = np.clip(x, -1.0, 1.0)
+    powers = np.empty((x.size, degree + 1), dtype=complex)
+    powers[:, 0] = 1.0
+    powers[:, 1:] = (inside + 1j * np.sqrt(1.0 - inside * inside))[:, None]
+    np.cumprod(powers, axis=1, out=powers)
+    T: Array = np.ascontiguousarray(powers.real)
+    out = np.abs(x) > 1.0
+    if out.any():  # T_k(x) = sign(x)^k cosh(k arccosh |x|)
+        xo = x[out]
+        T[out] = np.where(xo[:, None] < 0, (-1.0) ** k, 1.0) * np.cosh(
+            np.arccosh(np.abs(xo))[:, None] * k)
+    return T
+
+
+def _chebval(x: Array, c: Array) -> Array:
+    """The Chebyshev series ``c`` at ``x``: through :func:`_chebyshev_matrix` for a few
+    points, Clenshaw's recurrence for many."""
+    x = np.asarray(x, dtype=float)
+    if x.size * c.size > 40_000:
+        return np.asarray(cheb.chebval(x, c))
+    values: Array = _chebyshev_matrix(x, c.size - 1) @ c
+    return values.reshape(x.shape)
+
+
+@lru_cache(maxsize=16)
+def _unit_mesh(N: int) -> _Mesh:
+    """One element on [0, 1] (constant curvature), built once per ``N``."""
+    return _Mesh(np.array([0.0, 1.0]), N)
+
+
 def _piecewise(edges: Array, coefs: list[tuple[Array, ...]]) -> SigmaFn:
     """``sigma(tau, k)`` from per-element Chebyshev coefficients."""
     if len(coefs) == 1:
         c0 = coefs[0]
 
         def one(tau: Array, k: int) -> Array:
-            return np.asarray(cheb.chebval(2.0 * np.asarray(tau, dtype=float) - 1.0, c0[k]))
+            return _chebval(2.0 * np.asarray(tau, dtype=float) - 1.0, c0[k])
 
         return one
 
@@ -207,7 +245,7 @@ def _piecewise(edges: Array, coefs: list[tuple[Array, ...]]) -> SigmaFn:
             sel = e == i
             if sel.any():
                 x = 2.0 * (t[sel] - edges[i]) / (edges[i + 1] - edges[i]) - 1.0
-                out[sel] = cheb.chebval(x, c[k])
+                out[sel] = _chebval(x, c[k])
         return out
 
     return many
@@ -322,10 +360,10 @@ class _Collocation:
               ) -> tuple[float, float]:
         """Largest ODE residual between the nodes (relative to ``1 + max |u|``) and the
         largest relative size of the last Chebyshev coefficients of ``u`` of an element."""
-        x = mesh.ops.between
+        V = mesh.ops.between
         worst, top, tail = 0.0, 0.0, 0.0
         for e, c in enumerate(coefs):
-            s, s1, s2, _, u = (cheb.chebval(x, ck) for ck in c)
+            s, s1, s2, u = (V[:, :c[k].size] @ c[k] for k in (0, 1, 2, 4))
             K, Ks, Kss = self.curv[e](s)
             F = self._rhs(G2, K, Ks, Kss, s1, s2, False)
             worst = max(worst, float(np.abs(u - F).max()))
@@ -337,10 +375,10 @@ class _Collocation:
     def cost(self, mesh: _Mesh, coefs: list[tuple[Array, ...]]) -> tuple[float, float]:
         """``Int sigma'^2`` and ``Int sigma''^2 + K^2 sigma'^4`` over [0, 1] (Gauss-Legendre
         on each element, exact for constant curvature)."""
-        xg, wg = mesh.ops.gauss
+        V, wg = mesh.ops.gauss
         v2 = a2 = 0.0
         for e, c in enumerate(coefs):
-            s, s1, s2 = (cheb.chebval(xg, c[k]) for k in range(3))
+            s, s1, s2 = (V[:, :c[k].size] @ c[k] for k in range(3))
             K = self.curv[e](s)[0]
             half = 0.5 * mesh.h[e]
             v2 += half * float(wg @ (s1 * s1))
@@ -356,7 +394,7 @@ class _Collocation:
         Newton fails, try again with more nodes only if ``retry``. None on failure."""
         G2 = G * G
         while True:
-            mesh = _Mesh(edges, N)
+            mesh = _unit_mesh(N) if len(edges) == 2 and edges[1] == 1.0 else _Mesh(edges, N)
             tau = mesh.nodes()
             if guess is None:
                 g = line_solution(G, tau)
@@ -595,10 +633,10 @@ def _curvature_pieces(path: Path, S: float, breaks: Array) -> list[CurvatureFn] 
 
         def fn(s: Array, a: float = a, b: float = b, C: Array = C
                ) -> tuple[Array, Array, Array]:
-            # a little beyond the piece while Newton iterates, never far
+            # a little beyond the piece while the edges settle, never far
             x = np.clip((2.0 * s - (a + b)) / (b - a), -1.1, 1.1)
-            K = cheb.chebvander(x, C.shape[0] - 1) @ C
-            return K[..., 0], K[..., 1], K[..., 2]
+            K = _chebyshev_matrix(x, C.shape[0] - 1) @ C
+            return K[:, 0], K[:, 1], K[:, 2]
 
         fns.append(fn)
     return fns
@@ -650,9 +688,14 @@ def _solve_pieces(path: Path, S: float, G: float, tol: float, max_nodes: int) ->
                              solver.iterations, f"{method}, {len(breaks) - 1} of them",
                              (state.velocity2, state.acceleration2))
         edges = new
-        refine = refine or moved <= 1e-8
-        state = solver.solve(G, edges, state.nodes - 1, state, max_nodes, refine=refine,
-                             retry=False)
+        N = state.nodes - 1
+        if not refine and moved <= 1e-8:
+            refine = True
+            coefs = state.mesh.coefficients(state.z)
+            resid, tail = solver.check(G * G, state.mesh, coefs)
+            if not (resid <= solver.tol and tail <= solver.tail) and 2 * N <= max_nodes:
+                N *= 2  # the coarse mesh does not resolve the law: start finer
+        state = solver.solve(G, edges, N, state, max_nodes, refine=refine, retry=False)
     return _Solution(None, np.inf, 0, solver.iterations, method)
 
 
