@@ -30,7 +30,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from functools import lru_cache
+from functools import lru_cache, partial
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -270,8 +270,9 @@ class _Collocation:
     """Newton's method on the integral-form Chebyshev collocation equations, on one element
     (constant curvature) or on one element per smooth piece of the curvature."""
 
-    def __init__(self, curvature: list[CurvatureFn], tol: float, tail: float = 1e-12) -> None:
-        self.curv, self.tol, self.tail = curvature, tol, tail
+    def __init__(self, curvature: list[CurvatureFn], tol: float, tail: float = 1e-12,
+                 every: CurvatureFn | None = None) -> None:
+        self.curv, self.tol, self.tail, self.every = curvature, tol, tail, every
         self.iterations = 0
         self.scale = 1.0  # continuation in the curvature: K -> scale K
         self.damped = False  # halve Newton's steps that do not reduce the residual
@@ -296,6 +297,8 @@ class _Collocation:
         """``F(sigma, sigma', sigma'')`` at the nodes and its partial derivatives."""
         if len(self.curv) == 1:
             K, Ks, Kss = self.curv[0](s)
+        elif self.every is not None:  # the elements' nodes at once, (elements, N + 1)
+            K, Ks, Kss = (k.reshape(-1) for k in self.every(s.reshape(len(self.curv), -1)))
         else:
             K, Ks, Kss = (np.empty_like(s) for _ in range(3))
             n = mesh.N + 1
@@ -606,12 +609,13 @@ def _breaks(path: Path, S: float) -> Array:
     return np.concatenate([[0.0], np.sort(s[(s > 1e-9) & (s < 1 - 1e-9)]), [1.0]])
 
 
-def _curvature_pieces(path: Path, S: float, breaks: Array) -> list[CurvatureFn] | None:
+def _curvature_pieces(path: Path, S: float, breaks: Array
+                      ) -> tuple[list[CurvatureFn], CurvatureFn] | None:
     """On each piece between the breaks, ``K = kappa S`` as a function of the normalised arc
     length, by Chebyshev interpolation until its coefficients have decayed to 1e-13 (and its
     derivatives by differentiating the series); None when some piece's curvature is not
-    smooth enough for that within 513 points."""
-    fns: list[CurvatureFn] = []
+    smooth enough for that within 513 points. Returns the function of each piece and the
+    function of all of them at once (on ``sigma`` of shape (pieces, n))."""
     pieces = list(zip(breaks[:-1], breaks[1:], strict=True))
     series: list[tuple[float, float, Array]] = []
     for a, b in pieces:
@@ -625,21 +629,25 @@ def _curvature_pieces(path: Path, S: float, breaks: Array) -> list[CurvatureFn] 
                 break
         else:
             return None
-    for a, b, coef in series:
+    size = max(coef.size for _, _, coef in series)
+    C = np.zeros((len(series), size, 3))  # K, K_sigma, K_sigma_sigma of each piece
+    for e, (a, b, coef) in enumerate(series):
         scale = 2.0 / (b - a)
         d1 = cheb.chebder(coef) * scale
-        C = np.zeros((coef.size, 3))
-        C[:, 0], C[:-1, 1], C[:-2, 2] = coef, d1, cheb.chebder(d1) * scale
+        C[e, :coef.size, 0], C[e, :coef.size - 1, 1] = coef, d1
+        C[e, :coef.size - 2, 2] = cheb.chebder(d1) * scale
+    mid = np.array([[a + b] for a, b, _ in series])
+    width = np.array([[b - a] for a, b, _ in series])
 
-        def fn(s: Array, a: float = a, b: float = b, C: Array = C
-               ) -> tuple[Array, Array, Array]:
-            # a little beyond the piece while the edges settle, never far
-            x = np.clip((2.0 * s - (a + b)) / (b - a), -1.1, 1.1)
-            K = _chebyshev_matrix(x, C.shape[0] - 1) @ C
-            return K[:, 0], K[:, 1], K[:, 2]
+    def on(e: int | slice, s: Array) -> tuple[Array, Array, Array]:
+        # a little beyond the piece while the edges settle, never far
+        x = np.clip((2.0 * s - mid[e]) / width[e], -1.1, 1.1)
+        T = _chebyshev_matrix(x, size - 1).reshape(x.shape + (size,))
+        K = T @ C[e]
+        return K[..., 0], K[..., 1], K[..., 2]
 
-        fns.append(fn)
-    return fns
+    fns: list[CurvatureFn] = [partial(on, e) for e in range(len(series))]
+    return fns, partial(on, slice(None))
 
 
 def _edges_at(sigma: SigmaFn, breaks: Array, edges: Array) -> Array:
@@ -649,7 +657,7 @@ def _edges_at(sigma: SigmaFn, breaks: Array, edges: Array) -> Array:
     for _ in range(20):
         step = (sigma(t, 0) - target) / np.maximum(sigma(t, 1), 1e-300)
         t = np.clip(t - step, 0.0, 1.0)
-        if np.abs(step).max(initial=0.0) <= 1e-15:
+        if np.abs(step).max(initial=0.0) <= 1e-13:  # quadratic: the next step is ~1e-26
             break
     return np.concatenate([[0.0], t, [1.0]])
 
@@ -662,11 +670,11 @@ def _solve_pieces(path: Path, S: float, G: float, tol: float, max_nodes: int) ->
     edges settle, then the nodes double until the residual is below ``tol``."""
     method = "Chebyshev collocation on the curvature's smooth pieces"
     breaks = _breaks(path, S)
-    curvature = _curvature_pieces(path, S, breaks)
-    if curvature is None:
+    fits = _curvature_pieces(path, S, breaks)
+    if fits is None:
         return _Solution(None, np.inf, 0, 0, method + " (curvature not smooth on them)")
     # the residual is the criterion here; the coefficients' tail only guards it
-    solver = _Collocation(curvature, tol, tail=max(1e-12, tol))
+    solver = _Collocation(fits[0], tol, tail=max(1e-12, tol), every=fits[1])
     solver.damped = True
 
     def line(tau: Array, k: int) -> Array:
