@@ -163,3 +163,82 @@ def test_hard_path_converges_and_satisfies_the_euler_lagrange_equation():
     y = law.evaluate(np.array([0.0, 1.0]))
     assert abs(y[0, 0]) < 1e-9 and y[0, 1] == pytest.approx(hard.length, rel=1e-9)
     assert abs(y[1, 0]) < 1e-6 * hard.length and abs(y[1, 1]) < 1e-6 * hard.length
+
+
+SPLINE = Spline(((0.0, 1.0), (0.3, 1.2), (0.6, 1.0), (1.0, 1.3)))
+
+
+def euler_lagrange_residual(path, law, n=1001):
+    """s'''' against the Euler-Lagrange equation with the path's own curvature at s(t)."""
+    t = np.linspace(0.0, law.duration, n)
+    s, ds, dds, _ = law.evaluate(t)
+    kappa, dkappa = path.curvature(path.parameter_at(s))
+    rhs = (1 / (law.eta * law.mass) + 6 * kappa**2 * ds**2) * dds + 3 * kappa * dkappa * ds**4
+    s4 = law.fourth_derivative(t)
+    return np.abs(s4 - rhs).max() / (1 + np.abs(s4).max())
+
+
+def test_spline_law_by_pieces_is_spectrally_accurate():
+    """A spline's law comes from one Chebyshev element per spline piece: the Euler-Lagrange
+    residual on 1001 times reaches 5e-12 (bound 1e-9), the law agrees with solve_bvp's at tol
+    1e-8 to 2e-11 of its range (bound 1e-7; solve_bvp's own error is ~1e-8 residual), and a
+    law read for an eta 1e-4 larger fails the same check (residual 1e-4)."""
+    from dextar.laws.optimal import OptimalLaw, _solve_local
+
+    eta = 0.01
+    law = solve_optimal_law(SPLINE, eta=eta)
+    assert "smooth pieces, 3 of them" in law.message and law.residual <= 1e-10
+    assert euler_lagrange_residual(SPLINE, law) < 1e-9
+    S = SPLINE.length
+    bvp = _solve_local(SPLINE, S, 1 / np.sqrt(eta), 1e-8)
+    ref = OptimalLaw(distance=S, duration=1.0, eta=eta, mass=1.0, sigma=bvp.sigma)
+    t = np.linspace(0, 1, 501)
+    a, b = law.evaluate(t)[:3], ref.evaluate(t)[:3]
+    for k in range(3):
+        assert np.abs(a[k] - b[k]).max() <= 1e-7 * np.ptp(b[k])
+    # the stored cost parts are those of the quadrature on fine panels
+    kin, inert = law_cost(law, SPLINE, 1.0, eta, nodes=4000)
+    assert law.kinetic == pytest.approx(kin, rel=1e-10)
+    assert law.inertial == pytest.approx(inert, rel=1e-10)
+    # the check can fail: the same law read as the solution for an eta 1e-4 larger
+    off = OptimalLaw(distance=S, duration=1.0, eta=eta * (1 + 1e-4), mass=1.0, sigma=law.sigma)
+    assert euler_lagrange_residual(SPLINE, off) > 1e-5
+
+
+def test_curvature_jump_is_left_to_mesh_refinement():
+    """A curvature that jumps between pieces (a line into an arc) puts a jump in s''': the
+    spectral elements, which join with s C3, must not take such a path."""
+    from dextar.laws.optimal import _breaks, _curvature_pieces
+    from dextar.paths.composite import Composite
+
+    jump = Composite((Line((0.0, 0.0), (1.0, 0.0)), Arc(0.5, -np.pi / 2, 0.0, center=(1.0, 0.5))))
+    S = jump.length
+    breaks = _breaks(jump, S)
+    assert breaks.size == 3  # the joint is seen
+    assert _curvature_pieces(jump, S, breaks) is None
+    assert _curvature_pieces(SPLINE, SPLINE.length, _breaks(SPLINE, SPLINE.length)) is not None
+
+
+@pytest.mark.parametrize("path", [
+    SPLINE,  # Chebyshev elements on the spline's pieces
+    ExpressionPath("p", "0.1*sqrt(p**2 + 1e-4)**3", -1.0, 1.0),  # solve_bvp (not smooth enough)
+])
+def test_result_does_not_depend_on_the_clock(monkeypatch, path):
+    """The solvers are bounded by iterations, not seconds: with a clock that jumps 1000 s at
+    every reading (a machine a million times slower) the law is the same."""
+    import time
+
+    law = solve_optimal_law(path, eta=0.01)
+    now = [time.perf_counter()]
+
+    def slow() -> float:
+        now[0] += 1000.0
+        return now[0]
+
+    for name in ("perf_counter", "monotonic", "time", "process_time"):
+        monkeypatch.setattr(time, name, slow)
+    again = solve_optimal_law(path, eta=0.01)
+    assert again.success and again.message == law.message and again.nodes == law.nodes
+    t = np.linspace(0, 1, 201)
+    np.testing.assert_allclose(again.evaluate(t), law.evaluate(t), rtol=0, atol=1e-12)
+    assert again.cost == pytest.approx(law.cost, rel=1e-12)

@@ -614,7 +614,7 @@ def _curvature_pieces(path: Path, S: float, breaks: Array
     """On each piece between the breaks, ``K = kappa S`` as a function of the normalised arc
     length, by Chebyshev interpolation until its coefficients have decayed to 1e-13 (and its
     derivatives by differentiating the series); None when some piece's curvature is not
-    smooth enough for that within 513 points. Returns the function of each piece and the
+    smooth enough for that within 513 points, or not continuous across a break. Returns the function of each piece and the
     function of all of them at once (on ``sigma`` of shape (pieces, n))."""
     pieces = list(zip(breaks[:-1], breaks[1:], strict=True))
     series: list[tuple[float, float, Array]] = []
@@ -629,6 +629,12 @@ def _curvature_pieces(path: Path, S: float, breaks: Array
                 break
         else:
             return None
+    # the elements join with sigma C3, right only where the curvature is continuous (a jump
+    # in K puts a jump in sigma''': solve_bvp's smoothed curvature takes those paths)
+    ends = [(float(cheb.chebval(-1.0, c)), float(cheb.chebval(1.0, c))) for _, _, c in series]
+    scale_K = max(1.0, max(abs(v) for pair in ends for v in pair))
+    if any(abs(ends[e][1] - ends[e + 1][0]) > 1e-9 * scale_K for e in range(len(ends) - 1)):
+        return None
     size = max(coef.size for _, _, coef in series)
     C = np.zeros((len(series), size, 3))  # K, K_sigma, K_sigma_sigma of each piece
     for e, (a, b, coef) in enumerate(series):
