@@ -22,7 +22,19 @@ differentiation matrices). Newton's method with an exact Jacobian solves the col
 equations from the closed-form solution of the straight line; ``N`` doubles until the
 Chebyshev coefficients have decayed and the residual between the nodes is below tolerance.
 When Newton fails, the solver continues in ``G`` from an easy problem, reusing each solution
-as the next guess. Failure raises :class:`ConvergenceError`: never a silent wrong answer.
+as the next guess.
+
+Varying curvature: one such element per piece on which the curvature is smooth (a spline
+between its knots, a G2 chain between its joints, an analytic curve in one piece), ``sigma``
+C3 across the elements' edges, which follow the times at which the law crosses the pieces'
+ends; ``K`` and its derivatives come from a Chebyshev fit of each piece in arc length. Newton
+is damped there and, when it fails from the line's law, continues in the curvature's scale.
+A path whose curvature is not smooth on known pieces (or jumps across one) goes to scipy's
+``solve_bvp`` with mesh refinement and continuation in the curvature.
+
+Every loop is bounded by a count (Newton iterations, continuation solves, nodes), never by
+the clock, so a result does not depend on the machine's speed. Failure raises
+:class:`ConvergenceError`: never a silent wrong answer.
 """
 
 from __future__ import annotations
