@@ -631,7 +631,7 @@ def _curvature_pieces(path: Path, S: float, breaks: Array
     pieces = list(zip(breaks[:-1], breaks[1:], strict=True))
     series: list[tuple[float, float, Array]] = []
     for a, b in pieces:
-        for deg in (32, 64, 128, 256, 512):
+        for deg in (64, 128, 256, 512):
             x, to_coef = _lobatto(deg)
             sig = a + 0.5 * (b - a) * (x + 1.0)
             K = path.curvature(path.parameter_at(np.clip(sig, 0.0, 1.0) * S))[0] * S
