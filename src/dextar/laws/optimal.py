@@ -709,18 +709,23 @@ def _solve_pieces(path: Path, S: float, G: float, tol: float, max_nodes: int) ->
         moved = float(np.abs(new - edges).max())
         # an edge off its break by d changes the curvature its element sees by about
         # jump(K''') d^3 / 6 on a spline (C2 curvature), jump(K') d^2 / 2 on a G2 chain
-        if refine and moved <= 1e-8:
+        N = state.nodes - 1
+        if not refine and moved <= 1e-8:  # the edges have settled: is the coarse law enough?
+            refine = True
+            coefs = state.mesh.coefficients(state.z)
+            state.residual, tail = solver.check(G * G, state.mesh, coefs)
+            if state.residual <= solver.tol and tail <= solver.tail:
+                state.velocity2, state.acceleration2 = solver.cost(state.mesh, coefs)
+            elif 2 * N <= max_nodes:
+                N *= 2  # it does not resolve the law: refine from twice the nodes
+                state.residual = np.inf
+            else:
+                break
+        if refine and moved <= 1e-8 and state.residual <= solver.tol:
             return _Solution(state.sigma, state.residual, state.nodes * len(state.mesh.h),
                              solver.iterations, f"{method}, {len(breaks) - 1} of them",
                              (state.velocity2, state.acceleration2))
         edges = new
-        N = state.nodes - 1
-        if not refine and moved <= 1e-8:
-            refine = True
-            coefs = state.mesh.coefficients(state.z)
-            resid, tail = solver.check(G * G, state.mesh, coefs)
-            if not (resid <= solver.tol and tail <= solver.tail) and 2 * N <= max_nodes:
-                N *= 2  # the coarse mesh does not resolve the law: start finer
         state = solver.solve(G, edges, N, state, max_nodes, refine=refine, retry=False)
     return _Solution(None, np.inf, 0, solver.iterations, method)
 
