@@ -11,7 +11,6 @@ from dextar.cli import main
 from dextar.config import load_scenario
 from dextar.dynamics.regressor import standard_parameters
 from dextar.identification.base import base_parameters
-from dextar.jobs import si_model
 
 from ..program.test_program import EXAMPLES, read
 
@@ -64,7 +63,7 @@ def test_identify_writes_a_config_that_reproduces_the_base_parameters(excite_csv
     head, *_ = (out / "parameters.csv").read_text().splitlines()
     assert head == "name,meaning,value,std,rel_std_percent,unit"
     # the identified config loads and its model has exactly the identified base parameters
-    model = si_model(load_scenario(out / "identified.toml"))
+    model = load_scenario(out / "identified.toml").si_model
     base = base_parameters(model)
     beta = np.array([p["value"] for p in s["base_parameters"]])
     assert np.allclose(base.of(standard_parameters(model.inertia)), beta, rtol=1e-9)

@@ -17,9 +17,7 @@ from dextar.cli import main
 from dextar.config import load_scenario
 from dextar.design.evaluate import Task, evaluate_design
 from dextar.design.pareto import closest_to_ideal, pareto_mask
-from dextar.jobs import si_model
 from dextar.output.design import parse_line
-from dextar.units import SI
 
 pytest.importorskip("distributed")
 
@@ -83,10 +81,9 @@ def test_rows_are_the_single_design_function(sweep2):
     rows = rows_of(out)
     assert [r["design"] for r in rows] == list(range(64))
     sc = load_scenario(task_path)
-    prog = sc.table("program")
-    mt = sc.table("motors")
-    task = Task(tuple(sc.moves), prog.start, sc.mode, sc.assembly, mt.limits(SI),
-                mt.rms_torque, si_model(sc).inertia, (0.4, 0.3), 30, sc.tolerances)
+    task = Task(tuple(sc.moves), sc.program_start, sc.mode, sc.assembly, sc.si_motors,
+                sc.motors_table.rms_torque, sc.si_model.inertia, (0.4, 0.3), 30,
+                sc.tolerances)
     for i in (0, 7, 21, 42, 63):
         direct = evaluate_design(task, [rows[i][k] for k in ("l1", "l2", "L1", "L2", "d")])
         for k, v in direct.items():
@@ -220,7 +217,6 @@ def test_a_run_task_sweeps_its_path_and_law(tmp_path):
     """A dextar run config (one path, one law) is a task too: geometry and torque metrics
     along its path; its rows are the single-design function's."""
     from dextar.config import load_toml
-    from dextar.jobs import design_task
 
     from ..program.test_program import EXAMPLES
     from ..robustness.harness import toml_text
@@ -234,7 +230,7 @@ def test_a_run_task_sweeps_its_path_and_law(tmp_path):
     out = tmp_path / "o"
     assert main(["design", str(path), "--out", str(out), "--workers", "1", "--quiet"]) == 0
     rows = rows_of(out)
-    task, space = design_task(str(path))
+    task, space = load_scenario(path).design_task()
     assert task.kind == "run"
     for i in (0, 9, 31):
         direct = evaluate_design(task, space.designs()[i])
@@ -277,7 +273,6 @@ def test_random_design_tables_are_read_or_refused_by_name(tmp_path_factory):
 
     from dextar.design.evaluate import evaluate_chunk
     from dextar.errors import ConfigError
-    from dextar.jobs import design_task
     from dextar.output.design import row_line
 
     from ..robustness.harness import toml_text
@@ -292,7 +287,7 @@ def test_random_design_tables_are_read_or_refused_by_name(tmp_path_factory):
         path = folder / "t.toml"
         path.write_text(toml_text({**base, "design": table}))
         try:
-            task, space = design_task(str(path))
+            task, space = load_scenario(path).design_task()
         except ConfigError as exc:
             assert "design" in str(exc) or "samples" in str(exc) or "seed" in str(exc), exc
             return
@@ -346,10 +341,9 @@ def test_a_worker_that_dies_is_replaced_and_the_rows_are_complete(sweep2):
     """One of two workers is killed after the first chunk: Dask reruns its chunks elsewhere
     and the sweep ends with every row, equal to the uninterrupted sweep's."""
     from dextar.design.sweep import Cluster, run_sweep
-    from dextar.jobs import design_task
 
     task_path, out2 = sweep2
-    task, space = design_task(str(task_path))
+    task, space = load_scenario(task_path).design_task()
     designs = space.designs()
     got: dict[int, dict] = {}
     killed = []
@@ -374,9 +368,8 @@ def test_sweeps_one_after_another_on_one_cluster(tmp_path):
     """Two sweeps in a row on the same two workers (as a script or the benchmark does): the
     second one's task is not lost while the first one's copy is being released."""
     from dextar.design.sweep import Cluster, run_sweep
-    from dextar.jobs import design_task
 
-    task, space = design_task(str(write_task(tmp_path)))
+    task, space = load_scenario(write_task(tmp_path)).design_task()
     designs = space.designs()[:8]
     results = []
     with Cluster(workers=2) as cluster:

@@ -161,10 +161,9 @@ PROGRAM = ('[motors]\npeak_torque = 0.5\nmax_speed_rpm = 120\n[gravity]\nvector 
      "move 0 (arc): the start, 'via' and 'to' points are collinear"),
     ('[[move]]\ntype = "jump"\n', "[[move]] 0 (jump).type must be one of line, arc, dwell, "
      "joint"),
-    ('', "the program has no move"),
+    ('', "the task has no move"),
     ('[[move]]\ntype = "line"\nto = [10.0, 110.0]\nblend = 5.0\n[[move]]\ntype = "line"\n'
-     'to = [0.0, 100.0]\n', "move 0 (line) (blended with moves 1-1): blend: the path turns "
-     "back"),
+     'to = [0.0, 100.0]\n', "move 0 (line), blended with move 1: blend: the path turns back"),
     ('[[move]]\ntype = "joint"\nto_deg = [0.0, 180.0]\nlaw = "min-jerk"\n',
      "move 0 (joint): at t = "),
     ('[[move]]\ntype = "joint"\nto_deg = [0.0, 180.0]\nlaw = "min-jerk"\n',
@@ -280,17 +279,16 @@ def test_fit_by_time_scaling_equals_resampling():
     shortcut declines a law whose shape changes with the duration (the optimal law)."""
     from dextar.config import load_scenario
     from dextar.dynamics import Model, inverse_dynamics
-    from dextar.jobs import si_model
     from dextar.laws import LawRequest, law_type
     from dextar.paths import Line
-    from dextar.program.plan import _stretched_ratio
+    from dextar.program.laws import stretched_ratio
     from dextar.trajectory import sample_trajectory
     from dextar.units import SI
 
     sc = load_scenario(EXAMPLES / "pick_place.toml")
-    m = si_model(sc)
+    m = sc.si_model
     model = Model(m.robot, m.inertia, "up")
-    motors = sc.table("motors").limits(SI)
+    motors = sc.si_motors
     path = Line((-0.04, 0.09), (0.04, 0.12))
 
     def traj(law):
@@ -301,7 +299,7 @@ def test_fit_by_time_scaling_equals_resampling():
             return law_type(name).build(LawRequest(path, {"duration": T, **extra}, 0.13, None,
                                                    SI))
 
-        fast = _stretched_ratio(build, traj, model, motors)
+        fast = stretched_ratio(build, traj, model, motors)
         if name == "optimal":
             assert fast is None
             continue
@@ -338,10 +336,10 @@ def test_chain_grid_resolves_each_blend_and_keeps_the_joints():
 def test_shortest_duration_within_the_limits_is_bracketed(T0):
     """The fitted duration is the smallest T with ratio(T) <= 1 to 1e-6, on the feasible side,
     for a smooth ratio, one with a kink and one infinite below a speed limit."""
-    from dextar.program.plan import _shortest_within
+    from dextar.program.laws import shortest_within
 
     for ratio in (lambda T: (T0 / T) ** 2,
                   lambda T: max((T0 / T) ** 2, 0.5 + 0.5 * T0 / T),
                   lambda T: np.inf if T < 0.9 * T0 else (T0 / T) ** 3):
-        T = _shortest_within(ratio)
+        T = shortest_within(ratio)
         assert ratio(T) <= 1.0 and T0 <= T <= T0 * (1 + 2e-6), (T0, T)

@@ -22,9 +22,10 @@ from ..geometry import FiveBar
 from ..kinematics import jacobian, workspace_map
 from ..kinematics.checker import Tolerances, pose_distances
 from ..kinematics.workspace import inverse_condition
-from ..laws import Law, LawRequest, MotorLimits, law_type
+from ..laws import Law, LawRequest, law_type
+from ..motors import MotorLimits
 from ..paths import Path
-from ..program import Move, ProgramResult, plan_program, sizing
+from ..program import Move, ProgramRequest, ProgramResult, sizing
 from ..trajectory import check_path, sample_trajectory
 from ..units import SI
 from .space import LENGTHS, METRICS
@@ -42,7 +43,8 @@ class Task:
     Attributes
     ----------
     moves : tuple of Move
-    start_mm : (float, float)
+    start : (float, float)
+        The start point (m).
     working_mode, assembly : str
     motors : MotorLimits, optional
     rms_limit : (float, float), optional
@@ -67,7 +69,7 @@ class Task:
     """
 
     moves: tuple[Move, ...]
-    start_mm: tuple[float, float]
+    start: tuple[float, float]
     working_mode: str
     assembly: str
     motors: MotorLimits | None
@@ -150,7 +152,8 @@ def evaluate_design(task: Task, lengths: Sequence[float]) -> dict[str, Any]:
     except DextarError as exc:
         row["reason"] = str(exc)
         return row
-    motors, violations = sizing(res)
+    size = sizing(res)
+    mA, mD = size.motors
     d = pose_distances(robot, res.q, res.P)
     J = jacobian(robot, res.q, res.P, tol=0.0)
     dex = inverse_condition(J[:, 0, 0], J[:, 0, 1], J[:, 1, 0], J[:, 1, 1])
@@ -158,17 +161,16 @@ def evaluate_design(task: Task, lengths: Sequence[float]) -> dict[str, Any]:
         "cycle_time_s": res.cycle_time_s,
         "min_type1_distance": float(d.type1.min()), "min_type2_distance": float(d.type2.min()),
         "gci": float(np.mean(dex)),
-        "peak_torque_A_Nm": motors[0]["peak_torque_Nm"],
-        "peak_torque_D_Nm": motors[1]["peak_torque_Nm"],
-        "rms_torque_A_Nm": motors[0]["rms_torque_Nm"],
-        "rms_torque_D_Nm": motors[1]["rms_torque_Nm"],
-        "workspace_area_mm2": usable_area_mm2(robot_mm, task.working_mode, task.start_mm,
+        "peak_torque_A_Nm": mA.peak_torque_Nm, "peak_torque_D_Nm": mD.peak_torque_Nm,
+        "rms_torque_A_Nm": mA.rms_torque_Nm, "rms_torque_D_Nm": mD.rms_torque_Nm,
+        "workspace_area_mm2": usable_area_mm2(robot_mm, task.working_mode,
+                                              [1e3 * v for v in task.start],
                                               task.tolerances.type2)})
-    if violations:
-        v = violations[0]
-        where = f" at t = {v['t_s']:.4g} s in move {v['move']}" if v["t_s"] is not None else ""
-        row["reason"] = (f"motors exceeded: motor {v['motor']} {v['quantity']} "
-                         f"{v['value']:.4g} above {v['limit']:.4g}{where}")
+    if size.violations:
+        v = size.violations[0]
+        where = f" at t = {v.t_s:.4g} s in move {v.move}" if v.t_s is not None else ""
+        row["reason"] = (f"motors exceeded: motor {v.motor} {v.quantity} "
+                         f"{v.value:.4g} above {v.limit:.4g}{where}")
         return row
     for k in METRICS:
         if not math.isfinite(float(row[k])):
@@ -183,11 +185,9 @@ def _plan(task: Task, robot: FiveBar) -> ProgramResult:
     one-move result with the same fields)."""
     inertia = inertia_of(task, robot)
     if task.path is None:
-        return plan_program(robot, inertia, task.moves, start=task.start_mm,
-                            working_mode=task.working_mode, assembly=task.assembly,
-                            motors=task.motors, rms_limit=task.rms_limit,
-                            servo_rate_hz=SWEEP_RATE_HZ, grid=task.grid,
-                            tolerances=task.tolerances)
+        return ProgramRequest(robot, inertia, task.moves, task.start, task.working_mode,
+                              task.assembly, task.motors, task.rms_limit, SWEEP_RATE_HZ,
+                              task.grid, task.tolerances).plan()
     model = Model(robot, inertia, task.assembly, tol=task.tolerances.type2)
     law = task.law
     if law is None:  # a law planned on the robot (time-optimal)

@@ -115,6 +115,11 @@ class DesignSpace:
                 out[:, c] = lo + (hi - lo) * u[:, j]
         return out
 
+    @property
+    def varied_columns(self) -> list[int]:
+        """The columns of :data:`LENGTHS` the sweep varies."""
+        return sorted({c for *_, cs in self.dims for c in cs})
+
     def objective_values(self, rows: list[dict[str, float]]) -> Array:
         """The objectives of ``rows`` to minimise, shape (n, n_objectives)."""
         F = np.empty((len(rows), len(self.objectives)))

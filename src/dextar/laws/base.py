@@ -10,12 +10,14 @@ from __future__ import annotations
 import math
 from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
 from .._arrays import Array
 from ..errors import ParameterError
 from ..paths import Path
+from ..units import Units
 
 
 def _positive(name: str, value: float) -> float:
@@ -48,6 +50,22 @@ class Law(ABC):
     def breakpoints(self) -> Array:
         """Times inside ``(0, duration)`` where the acceleration jumps (none by default)."""
         return np.empty(0)
+
+    @property
+    def torque_limit(self) -> tuple[float, float] | None:
+        """The motors' torque limits the law was planned within (run units; None for a law
+        that does not plan on the dynamics)."""
+        return None
+
+    def report(self, units: Units) -> dict[str, Any]:
+        """The law's own quantities for a run's summary (run units unless the key says
+        otherwise); none by default."""
+        return {}
+
+    def cost_report(self) -> dict[str, float] | None:
+        """The paper's functional when the law minimises it (``total``, ``kinetic``,
+        ``inertial``); None for the other laws."""
+        return None
 
     @abstractmethod
     def _evaluate(self, t: Array) -> Array:
@@ -157,6 +175,10 @@ class TrapezoidalLaw(Law):
     def __repr__(self) -> str:
         return (f"TrapezoidalLaw(distance={self.distance!r}, vmax={self.vmax!r}, "
                 f"amax={self.amax!r}, duration={self.duration!r})")
+
+    def report(self, units: Units) -> dict[str, Any]:
+        """The limits and the cruise speed (run units)."""
+        return {"vmax": self.vmax, "amax": self.amax, "cruise_speed": self.cruise}
 
     def breakpoints(self) -> Array:
         """The ends of the acceleration and deceleration phases."""

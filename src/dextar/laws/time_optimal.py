@@ -108,6 +108,11 @@ class TimeOptimalLaw(Law):
         """The grid points, where the acceleration jumps."""
         return self.knots_t[1:-1]
 
+    def report(self, units: Units) -> dict[str, Any]:
+        """The torque limits (N m) and the largest torque ratio on the check samples."""
+        return {"torque_limit_Nm": [float(units.torque_in_nm(v)) for v in self.torque_limit],
+                "max_torque_ratio_check_samples": self.max_torque_ratio}
+
     def _evaluate(self, t: Array) -> Array:
         k = np.clip(np.searchsorted(self.knots_t, t, side="right") - 1, 0, self.accel.size - 1)
         tau = t - self.knots_t[k]

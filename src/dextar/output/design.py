@@ -9,20 +9,29 @@ import io
 import json
 import os
 from collections.abc import Mapping, Sequence
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 from matplotlib.figure import Figure
 
 from .._arrays import Array
+from ..design.pareto import Choice
 from ..design.space import LENGTHS, METRICS
 from ..errors import ConfigError
-from .files import write_text
+from ..geometry import FiveBar
+from ..kinematics import workspace_map
+from .figures import plot_workspace
+from .files import OutputDir, write_text
 from .html_page import figures, page
 
 #: Columns of designs.csv and pareto.csv.
 COLUMNS = ("design", *(f"{k}_mm" for k in LENGTHS), "feasible", "reason", *METRICS)
+
+
+#: Every file a sweep may write.
+DESIGN_FILES = ("designs.csv", "sweep.json", "pareto.csv", "best.toml", "summary.json",
+                "report.html", *(f"{n}.{e}" for n in ("pareto", "designs", "best_workspace")
+                                 for e in ("png", "svg")))
 
 
 def header() -> str:
@@ -138,51 +147,51 @@ def design_report(summary: Mapping[str, Any], pareto_rows: Sequence[Mapping[str,
 
 
 class DesignsFile:
-    """``designs.csv`` of a sweep in ``outdir``, with ``sweep.json`` (the sweep's signature).
+    """``designs.csv`` of a sweep in an output directory, with ``sweep.json`` (the sweep's
+    signature).
 
-    Opened fresh (refused over a non-empty folder without ``force``) or to ``resume`` (the
-    complete rows of the same sweep kept, a line cut short by a kill dropped). Rows are
-    appended as chunks finish (flushed to disk each time); :meth:`finish` rewrites the file
-    in design order, atomically."""
+    Opened fresh, or to ``resume`` (the complete rows of the same sweep kept, a line cut
+    short by a kill dropped); the directory's own checks (empty, ``--force``) are
+    :class:`~dextar.output.files.OutputDir`'s. Rows are appended as chunks finish (flushed to
+    disk each time); :meth:`finish` rewrites the file in design order, atomically."""
 
-    def __init__(self, outdir: Path, designs: Array, signature: str, *, resume: bool,
-                 force: bool, label: str) -> None:
-        """Check the folder (and read the rows to resume); nothing is written yet.
+    def __init__(self, od: OutputDir, designs: Array, signature: str, *, resume: bool,
+                 label: str) -> None:
+        """Read the rows to resume; nothing is written yet.
 
         Raises
         ------
         ConfigError
-            A non-empty folder without ``force`` or ``resume``; ``resume`` without a sweep
-            of the same signature, or with rows of other lengths.
+            ``resume`` without a sweep of the same signature, or with rows of other lengths.
         """
-        self.outdir, self.designs, self.signature = outdir, designs, signature
-        self.csv, self.meta = outdir / "designs.csv", outdir / "sweep.json"
+        self.od, self.designs, self.signature = od, designs, signature
+        self.csv, self.meta = od.path / "designs.csv", od.path / "sweep.json"
         self.rows: dict[int, dict[str, Any]] = {}
         self._fh: Any = None
-        n = len(designs)
         if resume:
-            if not (self.csv.is_file() and self.meta.is_file()):
-                raise ConfigError(f"--resume: {label} holds no sweep to resume (designs.csv "
-                                  "and sweep.json)")
-            try:
-                same = json.loads(self.meta.read_text()).get("signature") == signature
-            except (ValueError, OSError):
-                same = False
-            if not same:
-                raise ConfigError(f"--resume: the sweep in {label} was made with another task, "
-                                  "[design] or --samples/--seed; rerun without --resume (and "
-                                  "--force to overwrite it)")
-            for line in self.csv.read_text().splitlines(keepends=True)[1:]:
-                r = parse_line(line)
-                if r is None or not 0 <= r["design"] < n:
-                    continue
-                if not np.allclose([r[k] for k in LENGTHS], designs[r["design"]], rtol=1e-12):
-                    raise ConfigError(f"--resume: design {r['design']} in {self.csv} has other "
-                                      "lengths than this sweep's")
-                self.rows[r["design"]] = r
-        elif outdir.exists() and (not outdir.is_dir() or any(outdir.iterdir())) and not force:
-            raise ConfigError(f"output directory {label!r} exists and is not empty; use "
-                              "--force to overwrite it or --resume to complete its sweep")
+            self._resume(label)
+
+    def _resume(self, label: str) -> None:
+        designs, n = self.designs, len(self.designs)
+        if not (self.csv.is_file() and self.meta.is_file()):
+            raise ConfigError(f"--resume: {label} holds no sweep to resume (designs.csv and "
+                              "sweep.json)")
+        try:
+            same = json.loads(self.meta.read_text()).get("signature") == self.signature
+        except (ValueError, OSError):
+            same = False
+        if not same:
+            raise ConfigError(f"--resume: the sweep in {label} was made with another task, "
+                              "[design] or --samples/--seed; rerun without --resume (and "
+                              "--force to overwrite it)")
+        for line in self.csv.read_text().splitlines(keepends=True)[1:]:
+            r = parse_line(line)
+            if r is None or not 0 <= r["design"] < n:
+                continue
+            if not np.allclose([r[k] for k in LENGTHS], designs[r["design"]], rtol=1e-12):
+                raise ConfigError(f"--resume: design {r['design']} in {self.csv} has other "
+                                  "lengths than this sweep's")
+            self.rows[r["design"]] = r
 
     @property
     def missing(self) -> list[int]:
@@ -190,11 +199,12 @@ class DesignsFile:
         return [i for i in range(len(self.designs)) if i not in self.rows]
 
     def __enter__(self) -> DesignsFile:
-        self.outdir.mkdir(parents=True, exist_ok=True)
         write_text(self.meta, json.dumps({"signature": self.signature,
                                           "designs": len(self.designs)}) + "\n")
         write_text(self.csv, header() + "".join(row_line(self.rows[i]) for i in
                                                 sorted(self.rows)))
+        self.od.record("sweep.json")
+        self.od.record("designs.csv")
         self._fh = open(self.csv, "a", encoding="utf-8")  # noqa: SIM115 - closed in __exit__
         return self
 
@@ -214,3 +224,56 @@ class DesignsFile:
         ordered = [self.rows[i] for i in range(len(self.designs))]
         write_text(self.csv, header() + "".join(row_line(r) for r in ordered))
         return ordered
+
+
+def reason_counts(rows: Sequence[Mapping[str, Any]]) -> dict[str, int]:
+    """How many designs failed for each kind of reason."""
+    kinds = (("geometry", "geometry"), ("motors exceeded", "motors exceeded"),
+             ("singularity", "singularity"), ("out of reach", "unreachable"),
+             ("internal error", "internal error"))
+    out: dict[str, int] = {}
+    for r in rows:
+        if not r["feasible"]:
+            text = str(r["reason"])
+            kind = next((name for key, name in kinds if key in text), "other")
+            out[kind] = out.get(kind, 0) + 1
+    return out
+
+
+def best_workspace_figure(robot_mm: FiveBar, mode: str, P: Array) -> Figure:
+    """The chosen design's workspace with the task's path."""
+    ws = workspace_map(robot_mm, mode, resolution=241)
+    fig: Figure = plot_workspace(ws, path=P, unit="mm")
+    fig.axes[0].set_title(f"chosen design: l1 = {robot_mm.l1:.4g}, l2 = {robot_mm.l2:.4g}, "
+                          f"L1 = {robot_mm.L1:.4g}, L2 = {robot_mm.L2:.4g}, d = "
+                          f"{robot_mm.d:.4g} mm", fontsize=9)
+    return fig
+
+
+def write_sweep_outputs(od: OutputDir, summary: Mapping[str, Any], choice: Choice,
+                        rows: Sequence[Mapping[str, Any]], varied: Sequence[int],
+                        best_toml: str | None, best_figure: Figure | None, *,
+                        with_figures: bool = True) -> None:
+    """Write ``best.toml`` (with a feasible design), ``pareto.csv``, the figures (PNG and
+    SVG), ``report.html`` and ``summary.json`` into the sweep's directory."""
+    pngs: dict[str, bytes] = {}
+    if best_toml is not None:
+        od.write_text("best.toml", best_toml)
+    if with_figures and choice.best >= 0 and best_figure is not None:
+        from .figures import png_bytes, svg_bytes
+
+        X = np.array([[r[k] for k in LENGTHS] for r in rows])
+        names = list(summary["objectives"])
+        for name, fig in (
+                ("pareto", pareto_figure(choice.F, choice.pareto, choice.best, names)),
+                ("designs", scatter_matrix(X[:, list(varied)],
+                                           np.array([r["feasible"] for r in rows]),
+                                           [f"{LENGTHS[c]} [mm]" for c in varied])),
+                ("best_workspace", best_figure)):
+            pngs[name] = png_bytes(fig)
+            od.write_bytes(f"{name}.png", pngs[name])
+            od.write_bytes(f"{name}.svg", svg_bytes(fig))
+    od.write_text("pareto.csv", header() + "".join(row_line(r) for r in choice.pareto_rows))
+    if with_figures:
+        od.write_text("report.html", design_report(summary, choice.pareto_rows, pngs))
+    od.write_text("summary.json", json.dumps(summary, indent=2, allow_nan=False) + "\n")

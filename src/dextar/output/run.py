@@ -13,8 +13,12 @@ from typing import Any
 from ..analysis import Analysis
 from ..errors import DextarError
 from ..trajectory import Trajectory
-from .outdir import OutputDir
+from .files import OutputDir
 from .tables import csv_text, run_columns
+
+#: Every file a run may write.
+RUN_FILES = ("trajectory.csv", "summary.json", "report.html", "animation.gif", "workspace.png",
+             *(f"fig{k}.{ext}" for k in range(3, 10) for ext in ("png", "svg")))
 
 
 class Progress:
