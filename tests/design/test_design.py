@@ -68,11 +68,13 @@ def rows_of(out: Path) -> list[dict]:
 
 
 @pytest.fixture(scope="module")
-def sweep2(tmp_path_factory):
+def sweep2(tmp_path_factory, scheduler):
+    """The task swept on the session's two workers."""
     folder = tmp_path_factory.mktemp("sweep")
     task = write_task(folder)
     out = folder / "two"
-    assert main(["design", str(task), "--out", str(out), "--workers", "2", "--quiet"]) == 0
+    assert main(["design", str(task), "--out", str(out), "--scheduler", scheduler,
+                 "--quiet"]) == 0
     return task, out
 
 
@@ -128,11 +130,12 @@ def test_one_worker_gives_the_same_file(sweep2, tmp_path):
     assert (out1 / "pareto.csv").read_bytes() == (out2 / "pareto.csv").read_bytes()
 
 
-def test_a_killed_sweep_resumes_to_the_same_file(sweep2, tmp_path):
+def test_a_killed_sweep_resumes_to_the_same_file(sweep2, tmp_path, scheduler):
     task, out2 = sweep2
     out = tmp_path / "killed"
     proc = subprocess.Popen([sys.executable, "-m", "dextar", "design", str(task), "--out",
-                             str(out), "--workers", "1", "--quiet"], start_new_session=True)
+                             str(out), "--scheduler", scheduler, "--quiet"],
+                            start_new_session=True)
     csv_path = out / "designs.csv"
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline:
@@ -148,7 +151,8 @@ def test_a_killed_sweep_resumes_to_the_same_file(sweep2, tmp_path):
     assert 0 < done < 64, done  # killed half-way
     # a line cut short by the kill is dropped on resume
     csv_path.write_text(partial + "64,1.0,2.")
-    assert main(["design", str(task), "--out", str(out), "--resume", "--quiet"]) == 0
+    assert main(["design", str(task), "--out", str(out), "--resume", "--scheduler", scheduler,
+                 "--quiet"]) == 0
     assert csv_path.read_bytes() == (out2 / "designs.csv").read_bytes()
     s = json.loads((out / "summary.json").read_text())
     assert s["resumed"] == done and s["evaluated"] == 64 - done
@@ -169,11 +173,11 @@ def test_bad_design_tables_exit_2(tmp_path, capsys, design, message):
     assert not (tmp_path / "o").exists()
 
 
-def test_geometries_that_cannot_assemble_are_rows(tmp_path):
+def test_geometries_that_cannot_assemble_are_rows(tmp_path, scheduler):
     """Rods too short for the base: every design is a row with its reason, no crash."""
     task = write_task(tmp_path, design='[design]\nl = [5.0, 10.0]\nL = [5.0, 10.0]\n'
                                        'd = [60.0, 100.0]\nsamples = 8\ngrid = 30\n')
-    assert main(["design", str(task), "--out", str(tmp_path / "o"), "--workers", "1",
+    assert main(["design", str(task), "--out", str(tmp_path / "o"), "--scheduler", scheduler,
                  "--quiet"]) == 0
     rows = rows_of(tmp_path / "o")
     assert len(rows) == 8 and not any(r["feasible"] for r in rows)
@@ -182,7 +186,10 @@ def test_geometries_that_cannot_assemble_are_rows(tmp_path):
     assert s["feasible"] == 0 and s["best"] is None
 
 
-def test_unreachable_scheduler_is_named_within_10_s(tmp_path, capsys):
+def test_unreachable_scheduler_is_named_within_10_s(tmp_path, capsys, monkeypatch):
+    from dextar.design import sweep
+
+    monkeypatch.setattr(sweep, "CONNECT_TIMEOUT_S", 2)  # the default 8 s, shortened
     task = write_task(tmp_path)
     t0 = time.monotonic()
     assert main(["design", str(task), "--out", str(tmp_path / "o"), "--scheduler",
@@ -213,7 +220,7 @@ def test_resume_refuses_another_sweep(sweep2, tmp_path, capsys):
     assert "--resume" in capsys.readouterr().err
 
 
-def test_a_run_task_sweeps_its_path_and_law(tmp_path):
+def test_a_run_task_sweeps_its_path_and_law(tmp_path, scheduler):
     """A dextar run config (one path, one law) is a task too: geometry and torque metrics
     along its path; its rows are the single-design function's."""
     from dextar.config import load_toml
@@ -228,7 +235,8 @@ def test_a_run_task_sweeps_its_path_and_law(tmp_path):
     path = tmp_path / "run.toml"
     path.write_text(toml_text(doc))
     out = tmp_path / "o"
-    assert main(["design", str(path), "--out", str(out), "--workers", "1", "--quiet"]) == 0
+    assert main(["design", str(path), "--out", str(out), "--scheduler", scheduler,
+                 "--quiet"]) == 0
     rows = rows_of(out)
     task, space = load_scenario(path).design_task()
     assert task.kind == "run"
@@ -364,7 +372,7 @@ def test_a_worker_that_dies_is_replaced_and_the_rows_are_complete(sweep2):
         assert got[i] == expected[i]
 
 
-def test_sweeps_one_after_another_on_one_cluster(tmp_path):
+def test_sweeps_one_after_another_on_one_cluster(tmp_path, scheduler):
     """Two sweeps in a row on the same two workers (as a script or the benchmark does): the
     second one's task is not lost while the first one's copy is being released."""
     from dextar.design.sweep import Cluster, run_sweep
@@ -372,7 +380,7 @@ def test_sweeps_one_after_another_on_one_cluster(tmp_path):
     task, space = load_scenario(write_task(tmp_path)).design_task()
     designs = space.designs()[:8]
     results = []
-    with Cluster(workers=2) as cluster:
+    with Cluster(scheduler=scheduler) as cluster:
         for _ in range(3):
             rows: list[dict] = []
             stats = run_sweep(cluster, task, designs, range(len(designs)), chunk=1,

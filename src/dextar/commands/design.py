@@ -56,7 +56,7 @@ def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
         DESIGN_FILES,
         DesignsFile,
         best_workspace_figure,
-        reason_counts,
+        sweep_summary,
         write_sweep_outputs,
     )
     from ..output.files import OutputDir
@@ -76,17 +76,7 @@ def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
         rows = store.finish()
         choice = choose(rows, space)
         best = choice.best_row
-        summary: dict[str, Any] = {
-            "task": args.config, "task_kind": task.kind, "designs": n,
-            "feasible": len(choice.feasible), "feasible_fraction": len(choice.feasible) / n,
-            "objectives": list(space.objectives), "sampling": space.sampling,
-            "seed": space.seed, "varied": [name for name, *_ in space.dims],
-            "mass_per_length_kg_m": (list(space.mass_per_length) if space.mass_per_length
-                                     else None),
-            "evaluated": stats.evaluated, "resumed": n - stats.evaluated,
-            "workers": stats.workers, "wall_time_s": stats.wall_s,
-            "designs_per_second": stats.evaluated / stats.wall_s if stats.wall_s > 0 else 0.0,
-            "pareto": len(choice.pareto_rows), "best": best, "reasons": reason_counts(rows)}
+        summary = sweep_summary(args.config, task.kind, space, stats, choice, rows)
         best_toml = best_fig = None
         if best is not None:
             robot_mm = FiveBar(*(best[k] for k in LENGTHS))

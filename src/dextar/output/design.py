@@ -16,7 +16,8 @@ from matplotlib.figure import Figure
 
 from .._arrays import Array
 from ..design.pareto import Choice
-from ..design.space import LENGTHS, METRICS
+from ..design.space import LENGTHS, METRICS, DesignSpace
+from ..design.sweep import SweepStats
 from ..errors import ConfigError
 from ..geometry import FiveBar
 from ..kinematics import workspace_map
@@ -238,6 +239,25 @@ def reason_counts(rows: Sequence[Mapping[str, Any]]) -> dict[str, int]:
             kind = next((name for key, name in kinds if key in text), "other")
             out[kind] = out.get(kind, 0) + 1
     return out
+
+
+def sweep_summary(task_file: str, kind: str, space: DesignSpace, stats: SweepStats,
+                  choice: Choice, rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
+    """``summary.json`` of a sweep: counts, the sampling, the run's figures, the chosen
+    design and the reasons designs failed."""
+    n = len(rows)
+    return {
+        "task": task_file, "task_kind": kind, "designs": n,
+        "feasible": len(choice.feasible), "feasible_fraction": len(choice.feasible) / n,
+        "objectives": list(space.objectives), "sampling": space.sampling, "seed": space.seed,
+        "varied": [name for name, *_ in space.dims],
+        "mass_per_length_kg_m": (list(space.mass_per_length) if space.mass_per_length
+                                 else None),
+        "evaluated": stats.evaluated, "resumed": n - stats.evaluated,
+        "workers": stats.workers, "wall_time_s": stats.wall_s,
+        "designs_per_second": stats.evaluated / stats.wall_s if stats.wall_s > 0 else 0.0,
+        "pareto": len(choice.pareto_rows), "best": choice.best_row,
+        "reasons": reason_counts(rows)}
 
 
 def best_workspace_figure(robot_mm: FiveBar, mode: str, P: Array) -> Figure:
