@@ -394,7 +394,7 @@ def _plan_chain(ctx: PlanContext, group: list[tuple[int, Move]], state: PlanStat
         kind = move_type(mv.type)
         assert kind.path is not None  # a chain holds path moves only (_chains)
         pieces.append(kind.path(mv, P))
-        P = np.asarray(mv.get("to"), float)
+        P = _end(mv, pieces[-1])
     try:
         path, owner = _blended(tuple(pieces), tuple(float(mv.blend) for _, mv in group[:-1]))
     except ParameterError as exc:
@@ -421,7 +421,14 @@ def _plan_chain(ctx: PlanContext, group: list[tuple[int, Move]], state: PlanStat
     pm = PlannedMove(group[0][0], first, law, start_s, law.duration, state.q, q1, sample,
                      float(poses.distances.type1.min()), float(poses.distances.type2.min()),
                      owner_of, members)
-    return pm, PlanState(np.asarray(group[-1][1].get("to"), float), q1, state.mode)
+    return pm, PlanState(P, q1, state.mode)
+
+
+def _end(mv: Move, path: Path) -> Array:
+    """Where a path move ends: exactly its ``to`` when it has one (so the next move's path
+    is the same on every robot), else its path's last point."""
+    to = mv.get("to")
+    return np.asarray(to if to is not None else path.position(path.p1), float)
 
 
 def _blame_piece(ctx: PlanContext, pieces: list[Path], state: PlanState,
