@@ -102,39 +102,46 @@ def test_dwell_holds_still_against_gravity(pick_place):
 
 
 def test_pd_loop_on_our_forward_dynamics_tracks_the_setpoints(tmp_path):
+    """A drive with the setpoints' feedforward torques and a soft PD loop (which cannot hide
+    a wrong feedforward) tracks the mode-change program on our forward dynamics; the same
+    loop with the feedforward 10 % off does not."""
     from dextar.config import load_scenario
-    from dextar.config.tables import FrictionTable, GravityTable, InertiaTable
     from dextar.dynamics import Model
     from dextar.dynamics.forward import forward_dynamics
-    from dextar.units import SI
 
     out = tmp_path / "mc"
     cfg = EXAMPLES / "mode_change.toml"
     assert main(["program", str(cfg), "--out", str(out), "--quiet"]) == 0
     head, data = read(out / "setpoints.csv")
     c = dict(zip(head, data.T, strict=True))
-    sc = load_scenario(str(cfg))
-    ine = sc._get(InertiaTable).build(SI, sc.robot_mm, sc._get(FrictionTable),
-                                      sc._get(GravityTable))
-    model = Model(sc.robot_mm.scaled(1e-3), ine, "up", tol=0.0)
+    m = load_scenario(str(cfg)).si_model
+    model = Model(m.robot, m.inertia, "up", tol=0.0)
     t = c["t_s"]
     q_sp = np.stack([c["phi_rad"], c["psi_rad"]], -1)
     dq_sp = np.stack([c["dphi_rad_s"], c["dpsi_rad_s"]], -1)
     tau_sp = np.stack([c["tau1_Nm"], c["tau2_Nm"]], -1)
-    kp, kd = 2000.0, 60.0  # N m/rad, N m s/rad: a stiff position loop
+    kp, kd = 20.0, 0.3  # N m/rad, N m s/rad: a soft position loop (~70 Hz on the rods)
 
-    def torque(time, q, dq):
-        # the drive interpolates between the 1 kHz setpoints (feedforward and references)
-        k = min(int(time * 1000.0), len(t) - 2)
-        f = (time - t[k]) / (t[k + 1] - t[k])
-        qs, dqs = q_sp[k] + f * (q_sp[k + 1] - q_sp[k]), dq_sp[k] + f * (dq_sp[k + 1] - dq_sp[k])
-        ff = tau_sp[k] + f * (tau_sp[k + 1] - tau_sp[k])
-        return ff + kp * (qs - q) + kd * (dqs - dq)
+    def error(gain):
+        def torque(time, q, dq):
+            # the drive interpolates between the 1 kHz setpoints (feedforward and references)
+            k = min(int(time * 1000.0), len(t) - 2)
+            f = (time - t[k]) / (t[k + 1] - t[k])
+            qs = q_sp[k] + f * (q_sp[k + 1] - q_sp[k])
+            dqs = dq_sp[k] + f * (dq_sp[k + 1] - dq_sp[k])
+            ff = tau_sp[k] + f * (tau_sp[k + 1] - tau_sp[k])
+            return gain * ff + kp * (qs - q) + kd * (dqs - dq)
 
-    res = forward_dynamics(model, torque, q_sp[0], dq_sp[0], t, rtol=1e-8, atol=1e-10,
-                           max_step=1e-3)
-    assert res.success
-    assert np.abs(res.q - q_sp).max() < 1e-3
+        res = forward_dynamics(model, torque, q_sp[0], dq_sp[0], t, rtol=1e-5, atol=1e-10,
+                               method="RK45", max_step=1e-3)
+        assert res.success
+        return np.abs(res.q - q_sp).max()
+
+    # measured: 5.4e-4 rad with the setpoints' feedforward (the 1 ms interpolation), 2.8e-3
+    # rad with it 10 % off (the loop alone holds 2.6e-3 rad of the error); both to 1e-6 of
+    # the integrator's tolerance, deterministic
+    assert error(1.0) < 1e-3
+    assert error(1.1) > 2e-3
 
 
 def test_mode_change_crosses_a_serial_singularity_smoothly(tmp_path):

@@ -8,7 +8,7 @@ ratios of a law through the exact model with gravity and friction.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -51,17 +51,21 @@ class RobotAlongPath:
         jp = sample_trajectory(self.model.robot, self.path, UniformLaw(S, S), mode=self.mode,
                                times=np.asarray(s, float), units=self.units,
                                checked=self.checked)
-        robot, ine = self.model.robot, self.model.inertia
-        a, b, g = path_dynamics(Model(robot, ine, jp.assembly), jp.q, jp.dq, jp.ddq)
+        ine = self.model.inertia
+        a, b, g = path_dynamics(self._model(jp.assembly), jp.q, jp.dq, jp.ddq)
         return PathCoefficients(jp.t, jp.P, a, b, g, jp.dq, np.array(ine.coulomb, float),
                                 np.array(ine.viscous, float))
+
+    def _model(self, assembly: str) -> Model:
+        """The model in the assembly mode the path's poses are in (its own tolerance)."""
+        return self.model if assembly == self.model.assembly else replace(self.model,
+                                                                          assembly=assembly)
 
     def samples(self, law: Law, times: Array) -> JointSamples:
         """``law`` at ``times`` through the exact model."""
         tr = sample_trajectory(self.model.robot, self.path, law, mode=self.mode, times=times,
                                checked=False)  # the path was checked by coefficients()
-        tau = inverse_dynamics(Model(self.model.robot, self.model.inertia, tr.assembly), tr.q,
-                               tr.dq, tr.ddq)
+        tau = inverse_dynamics(self._model(tr.assembly), tr.q, tr.dq, tr.ddq)
         return JointSamples(tau, tr.dq)
 
 
@@ -98,8 +102,7 @@ class RobotAlongJointLine:
         q = self.line.at(s)
         u = np.broadcast_to(self.line.direction, q.shape).copy()
         robot, ine = self.model.robot, self.model.inertia
-        a, b, g = path_dynamics(Model(robot, ine, self.model.assembly, tol=0.0), q, u,
-                                np.zeros_like(u))
+        a, b, g = path_dynamics(self._free, q, u, np.zeros_like(u))
         P = direct_kinematics(robot, q, self.model.assembly)
         return PathCoefficients(s, P, a, b, g, u, np.array(ine.coulomb, float),
                                 np.array(ine.viscous, float))
@@ -109,5 +112,10 @@ class RobotAlongJointLine:
         s, ds, dds, _ = law.evaluate(times)
         u = self.line.direction
         q, dq, ddq = self.line.at(s), ds[:, None] * u, dds[:, None] * u
-        model = Model(self.model.robot, self.model.inertia, self.model.assembly, tol=0.0)
-        return JointSamples(inverse_dynamics(model, q, dq, ddq), dq)
+        return JointSamples(inverse_dynamics(self._free, q, dq, ddq), dq)
+
+    @property
+    def _free(self) -> Model:
+        """The model without a singularity tolerance: a joint line may pass serial
+        singularities, and its parallel-singularity check is the trajectory's."""
+        return replace(self.model, tol=0.0)
