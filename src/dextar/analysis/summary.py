@@ -128,7 +128,11 @@ def run_summary(an: Analysis, checks: dict[str, Any], uniform: Trajectory) -> di
         s["torques"]["paper"] = _stats(p.tau)
         s["paper_model"] = {
             "beta0_deg": math.degrees(pm.beta0), "lambda": pm.lam, "C1": pm.C1, "C2": pm.C2,
-            "C3": pm.C3, "C4": pm.C4, "error_vs_exact": p.error}
+            "C3": pm.C3, "C4": pm.C4, "error_vs_exact": p.error,
+            "leaves_out": list(p.leaves_out),
+            "error_note": ("against the exact torques without "
+                           f"{' and '.join(p.leaves_out)}, which (42) leaves out"
+                           if p.leaves_out else "against the exact torques")}
         s["beta_range_deg"] = [float(np.degrees(p.beta.min())), float(np.degrees(p.beta.max()))]
         peakT = float(p.T_exact.max())
         s["energies"] = {

@@ -52,5 +52,11 @@ def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
     lines = rep.lines()
     lines.append(f"wrote {shown(args.out, 'identified.toml')}, parameters.csv, summary.json"
                  + (", fit.png, report.html" if figures else ""))
-    return Result(rep.summary, "\n".join(lines),
-                  [f"dextar identify: warning: {w}" for w in res.warnings])
+    warnings = [f"dextar identify: warning: {w}" for w in res.warnings]
+    if args.config is None:
+        g = sc.robot_mm
+        warnings.insert(0, f"dextar identify: note: no --config: the robot is assumed to be "
+                        f"the DexTAR (l1 = {g.l1:g}, l2 = {g.l2:g}, L1 = {g.L1:g}, L2 = "
+                        f"{g.L2:g}, d = {g.d:g} mm, working mode {sc.mode}) without gravity; "
+                        "give the robot's config with --config")
+    return Result(rep.summary, "\n".join(lines), warnings)

@@ -39,11 +39,18 @@ def run(args: argparse.Namespace) -> Result:
         torque_limit=c["torque_limit"], initial_error=c["initial_error"])
     report = write_tracking(args.out, tr, res, sc.units, c, force=args.force)
     warnings = []
-    if report["saturated_fraction"] > 0:
+    if not res.success:
+        warnings.append(f"dextar simulate: the controlled robot left the motion at "
+                        f"{sc.units.time_text(res.t[-1])} of {tr.t[-1] * sc.units.time_s:.6g} "
+                        f"s ({res.message}) after the torque limit saturated a motor during "
+                        f"{report['saturated_fraction']:.1%} of it; the files hold the motion "
+                        "up to there")
+    elif report["saturated_fraction"] > 0:
         warnings.append(f"dextar simulate: warning: the torque limit {c['torque_limit_nm']:g} "
                         f"N m saturates a motor during {report['saturated_fraction']:.1%} of "
                         "the motion; tracking is not guaranteed")
     files = ", ".join(shown(args.out, n) for n in TRACKING_FILES)
     return Result(report, f"wrote {files}: max task error {report['max_task_error_mm']:.4g} "
                   f"mm, max joint error {report['max_joint_error_deg']:.4g} deg, torque "
-                  f"saturated {report['saturated_fraction']:.1%} of the time", warnings)
+                  f"saturated {report['saturated_fraction']:.1%} of the time", warnings,
+                  code=0 if res.success else 1)

@@ -53,8 +53,11 @@ def run(args: argparse.Namespace) -> Result:
             f"({units_note(sc)})")
     if an.paper is not None:
         payload["paper_model_error"] = an.paper.error
+        left = an.paper.leaves_out
         text += (f"\npaper model (42) error: max {an.paper.error['max_relative']:.1%}, RMS "
-                 f"{an.paper.error['rms_relative']:.1%} of the peak exact torque")
+                 f"{an.paper.error['rms_relative']:.1%} of the peak exact torque"
+                 + (f" (against the exact torques without {' and '.join(left)}, which (42) "
+                    "leaves out)" if left else ""))
     else:
         why = paper_model_limits(sc.robot, sc.inertia)
         text += f"\nno paper-model columns: the paper's simplified model does not apply ({why})"

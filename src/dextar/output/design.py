@@ -24,6 +24,7 @@ from ..kinematics import workspace_map
 from .figures import plot_workspace
 from .files import OutputDir, write_text
 from .html_page import figures, page
+from .tables import number
 
 #: Columns of designs.csv and pareto.csv.
 COLUMNS = ("design", *(f"{k}_mm" for k in LENGTHS), "feasible", "reason", *METRICS)
@@ -44,9 +45,9 @@ def row_line(row: Mapping[str, Any]) -> str:
     """One design's CSV line: numbers to 17 digits, an empty cell for a metric that does not
     exist (the plan failed first), ``true``/``false`` for ``feasible``."""
     cells: list[str] = [str(int(row["design"]))]
-    cells += [repr(float(row[k])) for k in LENGTHS]
+    cells += [number(row[k]) for k in LENGTHS]
     cells += ["true" if row["feasible"] else "false", str(row["reason"])]
-    cells += ["" if row[k] is None else repr(float(row[k])) for k in METRICS]
+    cells += ["" if row[k] is None else number(row[k]) for k in METRICS]
     buf = io.StringIO()
     csv.writer(buf, lineterminator="\n").writerow(cells)
     return buf.getvalue()

@@ -107,7 +107,8 @@ def _results(s: dict[str, Any]) -> list[tuple[str, Any]]:
                  ("beta0 [deg]", pm["beta0_deg"]),
                  (f"C1, C2, C3, C4 of (40) [{M} {L}^2]", [pm["C1"], pm["C2"], pm["C3"],
                                                          pm["C4"]]),
-                 ("paper torque error: max / RMS (fraction of the peak exact torque)",
+                 ("paper torque error: max / RMS (fraction of the peak exact torque; "
+                  f"{pm['error_note']})",
                   [pm["error_vs_exact"]["max_relative"], pm["error_vs_exact"]["rms_relative"]])]
     if "not_applicable" in pm:
         rows.append(("paper's simplified model", "not applicable: " + pm["not_applicable"]))

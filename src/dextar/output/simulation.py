@@ -23,7 +23,8 @@ def write_tracking(out: str, tr: Trajectory, res: ControlResult, units: Units,
     """Write the simulation's files into ``out``; returns the summary (``tracking.json``)."""
     mm = units.length_mm
     u = unit_tokens(units)
-    cols = {f"t_{u['time']}": res.t, "phi_des_rad": tr.q[:, 0], "psi_des_rad": tr.q[:, 1],
+    n = len(res.t)  # up to where the simulation stopped
+    cols = {f"t_{u['time']}": res.t, "phi_des_rad": tr.q[:n, 0], "psi_des_rad": tr.q[:n, 1],
             "phi_rad": res.q[:, 0], "psi_rad": res.q[:, 1], "err_phi_rad": res.joint_error[:, 0],
             "err_psi_rad": res.joint_error[:, 1], "task_error_mm": res.task_error * mm,
             f"tau1_{u['torque']}": res.tau[:, 0], f"tau2_{u['torque']}": res.tau[:, 1],
