@@ -80,10 +80,17 @@ def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
         best_toml = best_fig = None
         if best is not None:
             robot_mm = FiveBar(*(best[k] for k in LENGTHS))
+            rods = (f"uniform rods of {space.mass_per_length[0]:g} and "
+                    f"{space.mass_per_length[1]:g} kg/m" if space.mass_per_length else
+                    "each rod of the task's robot keeps its linear density and shape on its "
+                    "new length (mass and centre of mass scale with the length, the inertia "
+                    "about the centre with its cube); the effector, payload and rotors as "
+                    "given")
             best_toml = sc.model_file(
                 robot_mm, task.working_mode, inertia_of(task, robot_mm.scaled(1e-3)),
                 f"the Pareto design closest to the ideal point of dextar design {args.config} "
-                f"(design {best['design']} of {n}; objectives {', '.join(space.objectives)})")
+                f"(design {best['design']} of {n}; objectives {', '.join(space.objectives)})\n"
+                f"rods: {rods}")
             if figures:
                 best_fig = best_workspace_figure(robot_mm, task.working_mode,
                                                  evaluate_path(task, [best[k]

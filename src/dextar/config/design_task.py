@@ -25,7 +25,8 @@ def design_task(sc: Scenario, *, samples: int | None = None,
     motors, rms = sc.si_motors, sc.motors_table.rms_torque
     if sc.moves:  # a program task
         return Task(sc.moves, sc.program_start, sc.program_mode, sc.assembly, motors, rms,
-                    inertia, space.mass_per_length, sc.design.grid, sc.tolerances), space
+                    inertia, space.mass_per_length, sc.design.grid, sc.tolerances,
+                    robot=sc.si_model.robot), space
     path = sc.path_table.build(SI)  # a run task: one path and law
     kind = sc.law_table.kind
     values = sc.law_table.run_values(SI)
@@ -35,5 +36,5 @@ def design_task(sc: Scenario, *, samples: int | None = None,
     task = Task((), (float(start[0]), float(start[1])), sc.mode, sc.assembly, motors, rms,
                 inertia, space.mass_per_length, sc.design.grid, sc.tolerances, path=path,
                 law=law, law_type=kind.name if law is None else None,
-                law_values=values if law is None else None)
+                law_values=values if law is None else None, robot=sc.si_model.robot)
     return task, space

@@ -49,10 +49,10 @@ class Task:
     motors : MotorLimits, optional
     rms_limit : (float, float), optional
     template : Inertia
-        Effector, payload, rotors, friction and gravity; its rods are kept when
-        ``mass_per_length`` is None.
+        Effector, payload, rotors, friction and gravity, and the rods of ``robot``.
     mass_per_length : (float, float), optional
-        kg/m of the proximal and distal rods.
+        kg/m of the proximal and distal rods (uniform rods); None: each rod of the template
+        keeps its linear density and its shape on another length (see :func:`inertia_of`).
     grid : int
         Time-optimal grid of each move.
     tolerances : Tolerances
@@ -66,6 +66,8 @@ class Task:
         That law's keys (SI).
     samples : int
         Samples along a run task's path.
+    robot : FiveBar, optional
+        The task's own robot (m), whose rods the template holds.
     """
 
     moves: tuple[Move, ...]
@@ -83,6 +85,7 @@ class Task:
     law_type: str | None = None
     law_values: Mapping[str, Any] | None = None
     samples: int = 201
+    robot: FiveBar | None = None
 
     @property
     def kind(self) -> str:
@@ -97,13 +100,28 @@ def footprint_mm(lengths: Sequence[float]) -> float:
 
 
 def inertia_of(task: Task, robot: FiveBar) -> Inertia:
-    """The task's inertia on ``robot`` (m): uniform rods of ``mass_per_length`` when given."""
-    if task.mass_per_length is None:
+    """The task's inertia on ``robot`` (m): uniform rods of ``mass_per_length`` when given;
+    otherwise each rod of the task's robot scaled to its new length ``L' = k L`` keeping its
+    linear density and shape: mass ``k m``, centre of mass at the same fraction of the rod
+    (``k c``), inertia about the centre ``k^3 I`` (it scales as ``m L^2``). The effector, the
+    payload and the rotors stay as given."""
+    if task.mass_per_length is not None:
+        mp, md = task.mass_per_length
+        return task.template.with_(
+            proximal=(Rod.uniform(mp * robot.l1, robot.l1),
+                      Rod.uniform(mp * robot.l2, robot.l2)),
+            distal=(Rod.uniform(md * robot.L1, robot.L1), Rod.uniform(md * robot.L2, robot.L2)))
+    if task.robot is None:
         return task.template
-    mp, md = task.mass_per_length
+    old = task.robot
+
+    def scaled(rod: Rod, k: float) -> Rod:
+        return Rod(rod.mass * k, rod.com * k, rod.inertia * k**3)
+
+    p, d = task.template.proximal, task.template.distal
     return task.template.with_(
-        proximal=(Rod.uniform(mp * robot.l1, robot.l1), Rod.uniform(mp * robot.l2, robot.l2)),
-        distal=(Rod.uniform(md * robot.L1, robot.L1), Rod.uniform(md * robot.L2, robot.L2)))
+        proximal=(scaled(p[0], robot.l1 / old.l1), scaled(p[1], robot.l2 / old.l2)),
+        distal=(scaled(d[0], robot.L1 / old.L1), scaled(d[1], robot.L2 / old.L2)))
 
 
 def usable_area_mm2(robot_mm: FiveBar, mode: str, start_mm: Sequence[float],
