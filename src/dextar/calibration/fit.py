@@ -59,6 +59,7 @@ from .model import (
     jacobian_of,
     predict_of,
     rotation,
+    to_file_units,
     wrap,
 )
 from .observability import (
@@ -109,9 +110,9 @@ class Parameter:
 
     def in_file_units(self) -> tuple[str, float, float, float | None]:
         """``(unit, nominal, value, std)`` in mm or deg."""
-        f = 1e3 if self.name in LENGTHS else 180.0 / math.pi
-        return ("mm" if self.name in LENGTHS else "deg", self.nominal * f, self.value * f,
-                None if self.std is None else self.std * f)
+        return ("mm" if self.name in LENGTHS else "deg", to_file_units(self.name, self.nominal),
+                to_file_units(self.name, self.value),
+                None if self.std is None else to_file_units(self.name, self.std))
 
 
 @dataclass(frozen=True)

@@ -54,8 +54,10 @@ def file_unit(name: str) -> str:
 
 
 def to_file_units(name: str, value: float) -> float:
-    """A value of parameter ``name`` from SI (m, rad) to file units (mm, deg)."""
-    return 1e3 * value if name in LENGTHS else math.degrees(value)
+    """A value of parameter ``name`` from SI (m, rad) to file units (mm, deg), to 15
+    significant digits (so that 72 mm comes back as 72, not 72.00000000000001)."""
+    v = 1e3 * value if name in LENGTHS else math.degrees(value)
+    return float(f"{v:.15g}")
 
 
 @dataclass(frozen=True)

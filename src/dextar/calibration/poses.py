@@ -170,35 +170,37 @@ def _d_optimal(Jc: Array, modes: Array, P: Array, count: int, spacing: float,
     M = ridge.copy()
     spaced = True
 
-    def allowed(others: Sequence[int]) -> Array:
-        ok = np.ones(c, bool)
-        ok[list(others)] = False
-        for j in others:
-            near = (modes == modes[j]) & (np.hypot(*(P - P[j]).T) < spacing)
-            ok &= ~near
-        return ok
+    def near(j: int) -> Array:
+        """Candidates within ``spacing`` of candidate ``j`` in its mode (``j`` included)."""
+        return np.asarray((modes == modes[j]) & (np.hypot(*(P - P[j]).T) < spacing), dtype=int)
 
+    blocked = np.zeros(c, int)  # chosen poses within spacing of each candidate
+    taken = np.zeros(c, bool)
     for _ in range(count):
         g = _gains(Jc, np.linalg.inv(M))
-        ok = allowed(chosen)
+        ok = (blocked == 0) & ~taken
         if not ok.any():
             spaced = False
-            ok = np.ones(c, bool)
-            ok[chosen] = False
+            ok = ~taken
         j = int(np.argmax(np.where(ok, g, -np.inf)))
         chosen.append(j)
+        taken[j] = True
+        blocked += near(j)
         M += F[j]
     for _ in range(passes):
         improved = False
         for s in range(count):
-            Mm = M - F[chosen[s]]
+            old = chosen[s]
+            Mm = M - F[old]
             g = _gains(Jc, np.linalg.inv(Mm))
-            others = chosen[:s] + chosen[s + 1:]
-            ok = allowed(others)
-            ok[chosen[s]] = True
+            nb = near(old)
+            ok = ((blocked - nb) == 0) & ~taken
+            ok[old] = True
             j = int(np.argmax(np.where(ok, g, -np.inf)))
-            if g[j] > g[chosen[s]] * (1.0 + 1e-9) and j != chosen[s]:
+            if j != old and g[j] > g[old] * (1.0 + 1e-9):
                 chosen[s] = j
+                taken[old], taken[j] = False, True
+                blocked += near(j) - nb
                 M = Mm + F[j]
                 improved = True
         if not improved:
@@ -225,17 +227,34 @@ def _gray_order(modes: Sequence[str], start: str) -> list[str]:
 
 
 def _tour(q: Array, start: Array) -> list[int]:
-    """A nearest-neighbour tour of joint positions (n, 2) from ``start`` (2,), distance the
-    larger motor move."""
-    left = list(range(len(q)))
-    out = []
-    cur = start
+    """A tour of joint positions (n, 2) from ``start`` (2,), the distance the larger motor
+    move: nearest neighbours, then 2-opt passes (reverse a stretch while that shortens it)."""
+    pts = np.concatenate([start[None], q])
+    diff = np.abs(np.angle(np.exp(1j * (pts[:, None, :] - pts[None, :, :]))))
+    D = diff.max(axis=-1)
+    left = list(range(1, len(pts)))
+    order = [0]
     while left:
-        d = np.abs(np.angle(np.exp(1j * (q[left] - cur)))).max(axis=1)
-        i = left.pop(int(np.argmin(d)))
-        out.append(i)
-        cur = q[i]
-    return out
+        i = left.pop(int(np.argmin(D[order[-1], left])))
+        order.append(i)
+    n = len(order)
+    for _ in range(50):  # open path from the fixed start: reverse order[i:j + 1]
+        better = False
+        for i in range(1, n - 1):
+            o = np.array(order)
+            j = np.arange(i + 1, n)
+            nxt = np.where(j + 1 < n, o[np.minimum(j + 1, n - 1)], -1)
+            tail_old = np.where(nxt >= 0, D[o[j], np.maximum(nxt, 0)], 0.0)
+            tail_new = np.where(nxt >= 0, D[o[i], np.maximum(nxt, 0)], 0.0)
+            gain = D[o[i - 1], o[i]] + tail_old - D[o[i - 1], o[j]] - tail_new
+            k = int(np.argmax(gain))
+            if gain[k] > 1e-12:
+                jj = int(j[k])
+                order[i:jj + 1] = order[i:jj + 1][::-1]
+                better = True
+        if not better:
+            break
+    return [i - 1 for i in order[1:]]
 
 
 def select_poses(nominal: KinematicModel, count: int, *,
