@@ -79,16 +79,28 @@ def _major(S: Array) -> Array:
 
 def position_covariance(model: KinematicModel, points: Array, mode: str, assembly: int,
                         names: Sequence[str], covariance: Array,
-                        reading_std: float | None = None) -> tuple[Array, Array]:
-    """Covariance (n, 2, 2) of the position reached when commanding ``points`` (n, 2) of the
-    robot frame (m), and its parameters' part; see the module doc.
+                        reading_std: float | None = None, *, frame: str = "robot"
+                        ) -> tuple[Array, Array]:
+    """Covariance (n, 2, 2) of the position reached when commanding ``points`` (n, 2, m),
+    and its parameters' part; see the module doc.
+
+    ``frame = "robot"``: points and covariance in the robot frame (the instrument frame's
+    parameters, if among ``names``, are ignored); ``"instrument"``: points in the
+    instrument's frame, commanded through the estimated frame, whose uncertainty counts.
 
     Raises
     ------
     ReachError
         A point the model's robot does not reach.
     """
-    base = model.with_frame(0.0, 0.0, 0.0)
+    if frame == "instrument":
+        base = model
+        points = model.to_robot(points)
+    else:
+        base = model.with_frame(0.0, 0.0, 0.0)
+        keep = [i for i, n in enumerate(names) if n in ROBOT]
+        names = [names[i] for i in keep]
+        covariance = np.asarray(covariance)[np.ix_(keep, keep)]
     q = inverse_kinematics(base.robot, points, mode)
     k = closure(base, q - base.offsets, assembly)
     J = jacobian(base, k)

@@ -541,7 +541,8 @@ def calibrate(data: PoseData, nominal: KinematicModel, *, frame: str = "instrume
         near, _ = _nearer(p, data.readings[waiting], data.points[waiting])
         assembly[waiting] = np.where(data.assembly[waiting] != 0, data.assembly[waiting], near)
     status, message, nfev = sol.status, sol.message, sol.nfev
-    p[9] = float(wrap(np.asarray(p[9])))
+    if not -math.pi < p[9] <= math.pi:
+        p[9] = float(wrap(np.asarray(p[9])))
     ident_names, not_ident, combos = (ident.identifiable, ident.not_identifiable,
                                       ident.combinations)
     use = kept & (assembly != 0)
@@ -552,8 +553,8 @@ def calibrate(data: PoseData, nominal: KinematicModel, *, frame: str = "instrume
     k = closure_of(p, kd.readings, kd.assembly)
     k.raise_if_open(kd.rows)
     _check_modes(k, kd)
-    _check_reach(p_nom, p, kd)
     e_after = kd.points - predict_of(p, k)
+    _check_reach(p_nom, p, kd, outlier_factor * _robust_scale(np.hypot(*e_after.T)))
     J = jacobian_of(p, k)
     fidx = [INDEX[x] for x in ident_names]
     Jw = _apply_jac(W_all, J[:, :, fidx]).reshape(-1, len(fidx))
@@ -706,9 +707,10 @@ def _check_modes(k: Closure, d: PoseData) -> None:
             f"mode {sgn}, not {d.modes[i]} as the row says")
 
 
-def _check_reach(p_nom: Array, p: Array, d: PoseData) -> None:
+def _check_reach(p_nom: Array, p: Array, d: PoseData, slack: float) -> None:
     """Raise :class:`ReachError` for the first measured point (in the robot frame of the
-    fit) that neither the nominal nor the fitted robot reaches."""
+    fit) that neither the nominal nor the fitted robot reaches by more than ``slack`` (m;
+    a point measured at a stretched leg may fall out of reach by its noise)."""
     Pr = (d.points - p[7:9]) @ rotation(float(p[9]))
     fails = []
     for q in (p_nom, p):
@@ -719,7 +721,7 @@ def _check_reach(p_nom: Array, p: Array, d: PoseData) -> None:
             rho = np.hypot(Pr[:, 0] - cx, Pr[:, 1])
             over = np.maximum(np.maximum(abs(l - L) - rho, rho - (l + L)), 0.0)
             worst[:, leg] = over
-            out |= over > 1e-12 * (l + L)
+            out |= over > slack + 1e-12 * (l + L)
         fails.append((out, worst))
     bad = fails[0][0] & fails[1][0]
     if bad.any():
@@ -728,8 +730,8 @@ def _check_reach(p_nom: Array, p: Array, d: PoseData) -> None:
         raise ReachError(
             f"{d.source}: row {int(d.rows[i])}: the measured point ({1e3 * Pr[i, 0]:.6g}, "
             f"{1e3 * Pr[i, 1]:.6g}) mm (robot frame) is out of reach of leg {leg} of the "
-            f"nominal robot and of the fitted one (by {1e3 * fails[1][1][i, leg - 1]:.4g} mm) "
-            f"in working mode {d.modes[i]}")
+            f"nominal robot and of the fitted one (by {1e3 * fails[1][1][i, leg - 1]:.4g} mm, "
+            f"more than {1e3 * slack:.3g} mm, the outlier bound) in working mode {d.modes[i]}")
 
 
 def validation_errors(data: PoseData, before: KinematicModel,

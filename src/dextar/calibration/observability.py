@@ -32,7 +32,7 @@ from .model import NAMES
 #: A unit-norm column closer than this to the span of the columns before it is not
 #: identifiable (its standard deviation would be over a million times that of a column
 #: independent of the others).
-RANK_TOL = 1e-6
+RANK_TOL = 1e-4
 
 
 @dataclass(frozen=True)
