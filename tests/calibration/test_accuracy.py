@@ -15,11 +15,11 @@ from .conftest import COUNT, NOMINAL
 
 
 def test_linearised_covariance_matches_monte_carlo():
-    """4000 parameter sets drawn from a covariance (0.01 mm, 0.005 deg, correlated), each
+    """1500 parameter sets drawn from a covariance (0.01 mm, 0.005 deg, correlated), each
     commanded to the same targets by the readings of the mean model: the sample covariance
-    of the positions against the prediction. A standard deviation estimated from 4000
-    samples is within 1.1 % (1 sigma) of the truth; bound 5 %. Then the encoders alone:
-    readings off uniformly by up to half a count."""
+    of the positions against the prediction. A standard deviation estimated from 1500
+    samples is within 1.8 % (1 sigma) of the truth; bound 8 % (4.4 sigma). Then the
+    encoders alone: readings off uniformly by up to half a count."""
     rng = np.random.default_rng(0)
     A = rng.normal(size=(7, 7))
     scale = np.array([1e-5] * 5 + [math.radians(0.005)] * 2)
@@ -28,8 +28,8 @@ def test_linearised_covariance_matches_monte_carlo():
     r = NOMINAL.readings(targets, "+-")
     S, Sp = position_covariance(NOMINAL, targets, "+-", 1, ROBOT, cov, None)
     np.testing.assert_allclose(S, Sp)
-    draws = rng.multivariate_normal(np.zeros(7), cov, size=4000)
-    P = np.empty((4000, 3, 2))
+    draws = rng.multivariate_normal(np.zeros(7), cov, size=1500)
+    P = np.empty((1500, 3, 2))
     for k, dp in enumerate(draws):
         p = NOMINAL.vector()
         p[:7] += dp
@@ -37,17 +37,17 @@ def test_linearised_covariance_matches_monte_carlo():
     for j in range(3):
         emp = np.cov((P[:, j] - targets[j]).T)
         lam_e, lam_p = np.linalg.eigvalsh(emp), np.linalg.eigvalsh(S[j])
-        np.testing.assert_allclose(np.sqrt(lam_e), np.sqrt(lam_p), rtol=0.05)
+        np.testing.assert_allclose(np.sqrt(lam_e), np.sqrt(lam_p), rtol=0.08)
     # encoder resolution: uniform rounding errors of std count / sqrt(12)
     s_r = COUNT / math.sqrt(12)
     S2, Sp2 = position_covariance(NOMINAL, targets, "+-", 1, ROBOT, 0 * cov, s_r)
     assert np.abs(Sp2).max() == 0.0
-    dq = rng.uniform(-0.5 * COUNT, 0.5 * COUNT, size=(4000, 1, 2))
-    Pq = NOMINAL.predict((r[None] + dq).reshape(-1, 2), 1).reshape(4000, 3, 2)
+    dq = rng.uniform(-0.5 * COUNT, 0.5 * COUNT, size=(1500, 1, 2))
+    Pq = NOMINAL.predict((r[None] + dq).reshape(-1, 2), 1).reshape(1500, 3, 2)
     for j in range(3):
         emp = np.cov((Pq[:, j] - targets[j]).T)
         np.testing.assert_allclose(np.sqrt(np.linalg.eigvalsh(emp)),
-                                   np.sqrt(np.linalg.eigvalsh(S2[j])), rtol=0.05)
+                                   np.sqrt(np.linalg.eigvalsh(S2[j])), rtol=0.08)
 
 
 def test_the_map_of_a_calibration(four_modes):

@@ -54,19 +54,21 @@ def runs(four_modes, one_mode, held_out):
             # end to end: the calibrated robot's readings for targets given in the
             # instrument's frame, rounded to the encoder's counts, on the true robot
             pick = np.random.default_rng(100 + seed).choice(len(cand.q), 30, replace=False)
-            reached, reached_robot = [], []
-            for P, m in zip(cand.P[pick], cand.modes[pick], strict=True):
+            reached, reached_robot = np.empty((30, 2)), np.empty((30, 2))
+            for m in set(cand.modes[pick].tolist()):
+                sel = cand.modes[pick] == m
+                P = cand.P[pick][sel]
                 target = true.to_instrument(P)
                 r = res.calibrated.readings_for_measured(target, MODES[m])
                 r = np.round(r / COUNT) * COUNT
-                reached.append(true.predict(r[None], 1)[0] - target)
-                # the same target given in the robot's own frame (origin between the
-                # pivots), as a program gives it
+                reached[sel] = true.predict(r, 1) - target
+                # the same targets given in the robot's own frame (origin between the
+                # pivots), as a program gives them
                 r = np.round(res.calibrated.readings(P, MODES[m]) / COUNT) * COUNT
-                reached_robot.append(true.to_robot(true.predict(r[None], 1))[0] - P)
+                reached_robot[sel] = true.to_robot(true.predict(r, 1)) - P
             out.append({"sigma": sigma, "true": true, "res": res, "res1": res1,
-                        "frozen": frozen, "floor": floor, "reached": np.array(reached),
-                        "reached_robot": np.array(reached_robot)})
+                        "frozen": frozen, "floor": floor, "reached": reached,
+                        "reached_robot": reached_robot})
     return out
 
 
@@ -326,18 +328,20 @@ def test_the_predicted_accuracy_matches_the_misses_on_the_true_robot(runs):
                                                                        replace=False)
         res = r["res"]
         names, cov = res.robot_covariance()
-        for P, m, e, er in zip(cand.P[pick], cand.modes[pick], r["reached"],
-                               r["reached_robot"], strict=True):
-            target = r["true"].to_instrument(P)
-            S = cal.position_covariance(res.calibrated, target[None], MODES[m], 1,
-                                        res.identifiable, res.covariance, s_r,
-                                        frame="instrument")[0][0]
-            q_inst.append(float(e @ np.linalg.solve(S, e)))
-            S = cal.position_covariance(res.calibrated, P[None], MODES[m], 1, names, cov,
-                                        s_r)[0][0]
-            q_robot.append(float(er @ np.linalg.solve(S, er)))
-            Sw = res.calibrated.rotation() @ S @ res.calibrated.rotation().T
-            q_wrong.append(float(e @ np.linalg.solve(Sw, e)))
+        Rm = res.calibrated.rotation()
+        for m in set(cand.modes[pick].tolist()):
+            sel = cand.modes[pick] == m
+            P = cand.P[pick][sel]
+            e, er = r["reached"][sel], r["reached_robot"][sel]
+            S = cal.position_covariance(res.calibrated, r["true"].to_instrument(P), MODES[m],
+                                        1, res.identifiable, res.covariance, s_r,
+                                        frame="instrument")[0]
+            q_inst.extend(np.einsum("ni,ni->n", e, np.linalg.solve(S, e[..., None])[..., 0]))
+            S = cal.position_covariance(res.calibrated, P, MODES[m], 1, names, cov, s_r)[0]
+            q_robot.extend(np.einsum("ni,ni->n", er,
+                                     np.linalg.solve(S, er[..., None])[..., 0]))
+            Sw = Rm @ S @ Rm.T
+            q_wrong.extend(np.einsum("ni,ni->n", e, np.linalg.solve(Sw, e[..., None])[..., 0]))
     assert 1.0 < np.mean(q_inst) < 3.5
     assert 1.0 < np.mean(q_robot) < 3.5
     assert np.mean(q_wrong) > 3.5
