@@ -248,7 +248,9 @@ def test_a_row_in_another_working_mode_than_it_says(case):
     modes[3] = "--" if modes[3] != "--" else "++"
     wrong = cal.PoseData(data.readings, data.points, tuple(modes), data.assembly)
     with pytest.raises(dx.ParameterError, match="row 5: readings .* put the calibrated "
-                                                f"robot in working mode {re.escape(data.modes[3])}"):
+                                                f"robot in working mode {re.escape(data.modes[3])}, "
+                                                f"not {re.escape(modes[3])}, the working mode "
+                                                "given for it"):
         cal.calibrate(wrong, NOMINAL)
 
 
@@ -345,3 +347,41 @@ def test_the_predicted_accuracy_matches_the_misses_on_the_true_robot(runs):
     assert 1.0 < np.mean(q_inst) < 3.5
     assert 1.0 < np.mean(q_robot) < 3.5
     assert np.mean(q_wrong) > 3.5
+
+
+def test_a_row_the_nominal_robot_cannot_assemble_joins_after_the_fit(four_modes):
+    """Distal rods 0.5 mm longer than nominal: readings that stretch them beyond the nominal
+    rods' reach (but not the real ones') are predicted once the lengths are fitted."""
+    r = dx.FiveBar(0.072, 0.072, 0.0875, 0.0875, 0.060)
+    true = cal.KinematicModel(r, 0.001, -0.001, 0.2, 0.3, 1.0)
+    data = cal.measure(true, four_modes.readings, 1, np.random.default_rng(0),
+                       point_std=0.02e-3, count=COUNT)
+    # readings that put |B - C| halfway between the nominal and the true rods' reach
+    phi = np.radians(-20.0)
+    B = np.array([r.d / 2 + r.l1 * math.cos(phi + true.phi_offset),
+                  r.l1 * math.sin(phi + true.phi_offset)])
+    want = 0.5 * (r.L1 + r.L2 + NOMINAL.robot.L1 + NOMINAL.robot.L2)
+    D = np.array([-r.d / 2, 0.0])
+    # C on the circle about D at distance `want` from B, below the line D B
+    u = B - D
+    dist = np.hypot(*u)
+    a = (dist**2 + r.l2**2 - want**2) / (2 * dist)
+    h = math.sqrt(r.l2**2 - a**2)
+    C = D + a * u / dist - h * np.array([-u[1], u[0]]) / dist
+    psi = math.atan2(C[1], C[0] - D[0]) - true.psi_offset
+    extra = np.array([[phi, psi]])
+    assert cal.model.closure(NOMINAL, extra, 1).open.all()
+    assert not cal.model.closure(true, extra, 1).open.any()
+    more = cal.measure(true, extra, 1, np.random.default_rng(0), point_std=0.02e-3,
+                       frame="instrument")
+    both = cal.PoseData(np.concatenate([data.readings, more.readings]),
+                        np.concatenate([data.points, more.points]), data.modes + more.modes,
+                        0)
+    res = cal.calibrate(both, NOMINAL)
+    assert res.kept.all() and res.data.assembly[-1] == 1 and len(res.errors.rows) == 61
+    garbage = cal.PoseData(np.concatenate([data.readings, [[0.0, np.pi]]]),
+                           np.concatenate([data.points, more.points]), data.modes + more.modes,
+                           0)
+    with pytest.raises(dx.AssemblyError, match="row 62: the distal rods cannot meet at "
+                                               "readings .* nor with those fitted"):
+        cal.calibrate(garbage, NOMINAL)

@@ -109,3 +109,20 @@ def test_poses_csv_and_summary(four_modes):
     json.dumps(s, allow_nan=False)
     assert s["index"] == "O1" and s["o1"] == four_modes.observability.o1
     assert sum(s["modes"].values()) == 60
+
+
+def test_every_file_of_the_command(result, tmp_path):
+    res, held = result
+    files = out.calibration_files(res, data="measured.csv", working_mode="+-",
+                                  assembly_mode="up", encoder_counts=2**17, validation=held,
+                                  resolution=41)
+    assert set(files) == {"calibrated.toml", "parameters.csv", "summary.json",
+                          "residuals.png", "accuracy.png", "report.html"}
+    s = json.loads(files["summary.json"])
+    assert set(s["accuracy"]["modes"]) == set(res.data.modes)
+    assert tomllib.loads(files["calibrated.toml"])["robot"]["encoder_counts"] == 2**17
+    assert files["accuracy.png"].startswith(b"\x89PNG")
+    for name, content in files.items():
+        (tmp_path / name).write_bytes(content if isinstance(content, bytes)
+                                      else content.encode())
+    assert "nan" not in files["summary.json"].lower()

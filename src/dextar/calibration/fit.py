@@ -537,7 +537,15 @@ def calibrate(data: PoseData, nominal: KinematicModel, *, frame: str = "instrume
         if not waiting.any():
             break
         # rows the nominal robot could not assemble: their assembly with the fitted robot
-        closure_of(p, data.readings[waiting], 1).raise_if_open(data.rows[waiting])
+        kw = closure_of(p, data.readings[waiting], 1)
+        if kw.open.any():
+            i = int(np.flatnonzero(kw.open)[0])
+            raise AssemblyError(
+                f"{data.source}: row {int(data.rows[waiting][i])}: the distal rods cannot "
+                f"meet at readings ({math.degrees(data.readings[waiting][i, 0]):.6g}, "
+                f"{math.degrees(data.readings[waiting][i, 1]):.6g}) deg, with the nominal "
+                f"parameters nor with those fitted to the other rows (|B - C| "
+                f"{1e3 * kw.gap[i]:.4g} mm outside the rods' range)")
         near, _ = _nearer(p, data.readings[waiting], data.points[waiting])
         assembly[waiting] = np.where(data.assembly[waiting] != 0, data.assembly[waiting], near)
     status, message, nfev = sol.status, sol.message, sol.nfev
@@ -554,13 +562,16 @@ def calibrate(data: PoseData, nominal: KinematicModel, *, frame: str = "instrume
     k.raise_if_open(kd.rows)
     _check_modes(k, kd)
     e_after = kd.points - predict_of(p, k)
-    _check_reach(p_nom, p, kd, outlier_factor * _robust_scale(np.hypot(*e_after.T)))
+    if status == 0:
+        _check_reach(p_nom, p, kd, outlier_factor * _robust_scale(np.hypot(*e_after.T)))
+    else:
+        warnings.append("reach and outlier checks skipped: the fit did not converge")
     J = jacobian_of(p, k)
     fidx = [INDEX[x] for x in ident_names]
     Jw = _apply_jac(W_all, J[:, :, fidx]).reshape(-1, len(fidx))
     rw = _apply(W_all, -e_after)
     dw = np.hypot(*rw.T)
-    if robust is None:
+    if robust is None and status == 0:
         scale = _robust_scale(dw)
         out = dw > outlier_factor * scale
         if out.any():
@@ -704,7 +715,7 @@ def _check_modes(k: Closure, d: PoseData) -> None:
         raise ParameterError(
             f"{d.source}: row {int(d.rows[i])}: readings ({math.degrees(d.readings[i, 0]):.6g}, "
             f"{math.degrees(d.readings[i, 1]):.6g}) deg put the calibrated robot in working "
-            f"mode {sgn}, not {d.modes[i]} as the row says")
+            f"mode {sgn}, not {d.modes[i]}, the working mode given for it")
 
 
 def _check_reach(p_nom: Array, p: Array, d: PoseData, slack: float) -> None:

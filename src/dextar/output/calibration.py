@@ -381,3 +381,53 @@ def calibrated_toml(model: KinematicModel, *, working_mode: str, assembly_mode: 
                     lines += ["", f"[{name}.{k}]",
                               *(f"{kk} = {_toml_value(vv)}" for kk, vv in v.items())]
     return "\n".join(lines) + "\n"
+
+
+def calibration_files(res: CalibrationResult, *, data: str, config: str = "",
+                      working_mode: str, assembly_mode: str,
+                      encoder_counts: float | None = None,
+                      extra: Mapping[str, Any] | None = None,
+                      validation: PoseData | None = None, figures: bool = True,
+                      resolution: int = 121) -> dict[str, str | bytes]:
+    """Every file of ``dextar calibrate`` by name: ``calibrated.toml``, ``parameters.csv``,
+    ``summary.json`` and, with ``figures``, ``residuals.png``, ``accuracy.png`` and
+    ``report.html`` (the accuracy maps of the working modes of the kept poses, in
+    ``assembly_mode``, with the encoders' rounding of ``encoder_counts`` per turn).
+
+    ``extra`` holds the user's other config tables (raw TOML values) to carry into
+    ``calibrated.toml``; ``validation`` the held-out poses of ``res.validation`` (drawn in
+    ``residuals.png``).
+    """
+    import json
+
+    from ..calibration.accuracy import accuracy_map
+    from ..calibration.fit import encoder_std
+    from .figures import png_bytes
+
+    kept = res.data.subset(res.kept)
+    reading_std = None if encoder_counts is None else encoder_std(encoder_counts)
+    modes = [m for m in WORKING_MODES if m in kept.modes]
+    maps = [accuracy_map(res.calibrated, res.identifiable, res.covariance, m,
+                         assembly=assembly_mode, reading_std=reading_std,
+                         resolution=resolution) for m in modes] if figures else []
+    summary = calibration_summary(res, data=data, config=config, accuracy=maps,
+                                  encoder_counts=encoder_counts)
+    comment = (f"calibrated by dextar from {data} ({summary['status']}: "
+               f"{summary['rms_error_before_mm']:.4g} -> {summary['rms_error_after_mm']:.4g} "
+               f"mm RMS over {summary['n_poses']} poses)")
+    files: dict[str, str | bytes] = {
+        "calibrated.toml": calibrated_toml(
+            res.calibrated, working_mode=working_mode, assembly_mode=assembly_mode,
+            frame_identified=res.frame == "instrument", encoder_counts=encoder_counts,
+            extra=extra, comment=comment),
+        "parameters.csv": parameters_csv(res),
+        "summary.json": json.dumps(summary, indent=2, allow_nan=False) + "\n"}
+    if figures:
+        pts = {m: res.calibrated.to_robot(kept.points[[x == m for x in kept.modes]])
+               for m in modes}
+        pngs = {"residuals": png_bytes(residuals_figure(res, validation)),
+                "accuracy": png_bytes(accuracy_figure(maps, pts))}
+        files["residuals.png"] = pngs["residuals"]
+        files["accuracy.png"] = pngs["accuracy"]
+        files["report.html"] = calibration_report(summary, pngs)
+    return files
