@@ -14,7 +14,6 @@ from matplotlib.figure import Figure
 import dextar.calibration as cal
 from dextar import FiveBar
 from dextar.output import calibration as out
-from dextar.output.figures import png_bytes
 
 from .conftest import COUNT, NOMINAL
 
@@ -89,16 +88,12 @@ def test_calibrated_config_parses_and_round_trips(result):
 
 
 def test_figures_are_drawn(result, four_modes):
-    res, held = result
-    figs = [out.residuals_figure(res), out.residuals_figure(res, held),
-            out.poses_figure(four_modes, NOMINAL.robot)]
-    maps = [cal.accuracy_map(res.calibrated, res.identifiable, res.covariance, m,
-                             resolution=41, reading_std=cal.encoder_std(2**17))
-            for m in ("++", "+-", "-+")]
-    figs.append(out.accuracy_figure(maps, {"+-": four_modes.points[:5]}))
+    """The figures calibration_files does not draw (it draws the residuals with held-out
+    poses and the accuracy maps with the poses)."""
+    res, _ = result
+    figs = [out.residuals_figure(res), out.poses_figure(four_modes, NOMINAL.robot)]
     assert all(isinstance(f, Figure) for f in figs)
-    assert len(figs[0].axes) == 2 and len(figs[1].axes) == 4
-    assert png_bytes(figs[3]).startswith(b"\x89PNG")
+    assert len(figs[0].axes) == 2 and len(figs[1].axes) == 1
 
 
 def test_poses_csv_and_summary(four_modes):
@@ -115,13 +110,14 @@ def test_every_file_of_the_command(result, tmp_path):
     res, held = result
     files = out.calibration_files(res, data="measured.csv", working_mode="+-",
                                   assembly_mode="up", encoder_counts=2**17, validation=held,
-                                  resolution=41)
+                                  resolution=41, dpi=30)
     assert set(files) == {"calibrated.toml", "parameters.csv", "summary.json",
                           "residuals.png", "accuracy.png", "report.html"}
     s = json.loads(files["summary.json"])
     assert set(s["accuracy"]["modes"]) == set(res.data.modes)
     assert tomllib.loads(files["calibrated.toml"])["robot"]["encoder_counts"] == 2**17
     assert files["accuracy.png"].startswith(b"\x89PNG")
+    assert files["residuals.png"].startswith(b"\x89PNG")
     for name, content in files.items():
         (tmp_path / name).write_bytes(content if isinstance(content, bytes)
                                       else content.encode())

@@ -388,7 +388,7 @@ def calibration_files(res: CalibrationResult, *, data: str, config: str = "",
                       encoder_counts: float | None = None,
                       extra: Mapping[str, Any] | None = None,
                       validation: PoseData | None = None, figures: bool = True,
-                      resolution: int = 121) -> dict[str, str | bytes]:
+                      resolution: int = 121, dpi: int = 110) -> dict[str, str | bytes]:
     """Every file of ``dextar calibrate`` by name: ``calibrated.toml``, ``parameters.csv``,
     ``summary.json`` and, with ``figures``, ``residuals.png``, ``accuracy.png`` and
     ``report.html`` (the accuracy maps of the working modes of the kept poses, in
@@ -396,7 +396,7 @@ def calibration_files(res: CalibrationResult, *, data: str, config: str = "",
 
     ``extra`` holds the user's other config tables (raw TOML values) to carry into
     ``calibrated.toml``; ``validation`` the held-out poses of ``res.validation`` (drawn in
-    ``residuals.png``).
+    ``residuals.png``); ``resolution`` the accuracy maps' grid, ``dpi`` the figures'.
     """
     import json
 
@@ -425,8 +425,8 @@ def calibration_files(res: CalibrationResult, *, data: str, config: str = "",
     if figures:
         pts = {m: res.calibrated.to_robot(kept.points[[x == m for x in kept.modes]])
                for m in modes}
-        pngs = {"residuals": png_bytes(residuals_figure(res, validation)),
-                "accuracy": png_bytes(accuracy_figure(maps, pts))}
+        pngs = {"residuals": png_bytes(residuals_figure(res, validation), dpi=dpi),
+                "accuracy": png_bytes(accuracy_figure(maps, pts), dpi=dpi)}
         files["residuals.png"] = pngs["residuals"]
         files["accuracy.png"] = pngs["accuracy"]
         files["report.html"] = calibration_report(summary, pngs)
