@@ -376,14 +376,8 @@ def _resolve_frame(p: Array, data: PoseData, frame: str, usable: Array) -> tuple
 def _variable_scales(p: Array) -> Array:
     """Scales of the fit's variables (10,): 1 mm for a length, the angle that moves the
     end-effector 1 mm for an angle (SI)."""
-    l1, l2, L1, L2 = (float(v) for v in p[:4])
-    return 1e-3 / characteristic_scales_of(l1, l2, L1, L2)
-
-
-def characteristic_scales_of(l1: float, l2: float, L1: float, L2: float) -> Array:
-    """:func:`characteristic_scales` from the four rod lengths."""
-    reach = 0.5 * (l1 + L1 + l2 + L2)
-    return np.array([1.0 if n in LENGTHS else reach for n in NAMES])
+    reach = 0.5 * float(p[0] + p[2] + p[1] + p[3])
+    return np.array([1e-3 if n in LENGTHS else 1e-3 / reach for n in NAMES])
 
 
 @dataclass(frozen=True)

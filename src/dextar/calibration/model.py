@@ -32,7 +32,7 @@ import numpy as np
 
 from .._arrays import Array, as_points
 from ..errors import ParameterError
-from ..geometry import FiveBar, parse_working_mode
+from ..geometry import FiveBar
 from ..kinematics import inverse_kinematics
 
 #: The ten parameters of the model, in the order of every vector and matrix.
@@ -46,11 +46,6 @@ FRAME: tuple[str, ...] = ("x0", "y0", "theta0")
 ROBOT: tuple[str, ...] = NAMES[:7]
 #: Index of each parameter in :data:`NAMES`.
 INDEX: dict[str, int] = {n: i for i, n in enumerate(NAMES)}
-
-
-def file_unit(name: str) -> str:
-    """The unit of parameter ``name`` in files and tables: ``"mm"`` or ``"deg"``."""
-    return "mm" if name in LENGTHS else "deg"
 
 
 def to_file_units(name: str, value: float) -> float:
@@ -371,8 +366,3 @@ def characteristic_scales(robot: FiveBar) -> Array:
     moves the end-effector about that far per radian)."""
     reach = 0.5 * (robot.l1 + robot.L1 + robot.l2 + robot.L2)
     return np.array([1.0 if n in LENGTHS else reach for n in NAMES])
-
-
-def mode_signs(modes: Sequence[str]) -> Array:
-    """Working-mode names (n,) as signs, shape (n, 2)."""
-    return np.array([parse_working_mode(m) for m in modes], dtype=int).reshape(-1, 2)
