@@ -311,8 +311,7 @@ def calibration_report(summary: Mapping[str, Any], pngs: dict[str, bytes]) -> st
                          f"{v['worst_um']:.3g} um</li>" for k, v in a["modes"].items())
                + "</ul>")
     return page(
-        f"dextar calibrate {summary['data']}",
-        f"<h1>Kinematic calibration from {esc(str(summary['data']) or 'measured poses')}</h1>"
+        f"Kinematic calibration from {summary['data'] or 'measured poses'}",
         f"<table>{fact_rows}</table><h2>Warnings</h2><ul>{warn}</ul>"
         "<h2>Errors [mm]</h2><p>Distances between measured and predicted points; before: the "
         "nominal robot in the registered instrument frame.</p><table><tr><th></th>"
