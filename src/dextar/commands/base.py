@@ -91,6 +91,12 @@ def json_flag(sp: argparse.ArgumentParser) -> None:
     sp.add_argument("--json", action="store_true", help="print one JSON object")
 
 
+def units_argument(sp: argparse.ArgumentParser) -> None:
+    """``--units si|paper``: the unit system of the outputs (default ``[output].units``)."""
+    sp.add_argument("--units", choices=["si", "paper"], default=None,
+                    help="unit system of the output (default: the config's [output].units)")
+
+
 def units_note(sc: Scenario) -> str:
     """The run's unit system in words."""
     u = sc.units

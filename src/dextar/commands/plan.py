@@ -14,6 +14,7 @@ from .base import (
     law_payload,
     law_warnings,
     out_file,
+    units_argument,
     units_note,
     write_or_hand_back,
 )
@@ -28,6 +29,7 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
     config_argument(sp)
     json_flag(sp)
     sp.add_argument("--out", required=True, help="CSV file (- for stdout)")
+    units_argument(sp)
 
 
 def run(args: argparse.Namespace) -> Result:
@@ -36,7 +38,7 @@ def run(args: argparse.Namespace) -> Result:
     from ..output.tables import csv_text, trajectory_columns
 
     path = out_file(args.out, ".csv")
-    sc = load_scenario(args.config)
+    sc = load_scenario(args.config).in_units(args.units)
     law = sc.law()
     tr = sc.trajectory(law)
     where, data = write_or_hand_back(path, csv_text(trajectory_columns(tr, sc.units)))

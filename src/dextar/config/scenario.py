@@ -8,7 +8,7 @@ happens here, once, as the objects are built.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 from pathlib import Path as FilePath
 from typing import TYPE_CHECKING, Any, TypeVar
@@ -151,6 +151,16 @@ class Scenario:
     def tolerances(self) -> Tolerances:
         """The geometry checker's tolerances (``[tolerances]``)."""
         return self._get(TolerancesTable).tolerances()
+
+    def in_units(self, system: str | None) -> Scenario:
+        """The scenario computed in another unit system (``"si"`` or ``"paper"``; None: as
+        configured), as ``--units`` asks."""
+        if system is None or system == self.output.units:
+            return self
+        if system not in ("si", "paper"):
+            raise ConfigError(f"--units {system!r} must be si or paper")
+        tables = {**self.tables, "output": replace(self.output, units=system)}
+        return Scenario(tables, self.source, self.moves, self.doc, self.text)
 
     def raw(self, *names: str) -> dict[str, Mapping[str, Any]]:
         """The tables ``names`` as the file writes them (those it has)."""

@@ -24,8 +24,20 @@ from ..trajectory import Trajectory
 from ..units import SI
 from .moves import Move
 
-#: ``traj(law) -> Trajectory``: the motion of a law sampled on fixed fractions of its duration.
-Sampling = Callable[[Law], Trajectory]
+#: ``traj(law, times) -> Trajectory``: the motion of a law at ``times`` (None: on fixed
+#: fractions of its duration).
+Sampling = Callable[[Law, Array | None], Trajectory]
+#: Samples of a law's check (besides both sides of its breakpoints).
+CHECK_SAMPLES = 401
+
+
+def check_times(law: Law) -> Array:
+    """Where a law is checked against the motors: :data:`CHECK_SAMPLES` equally spaced times
+    and both sides of every breakpoint (where the acceleration jumps: its peaks are there)."""
+    b = law.breakpoints()
+    eps = 1e-9 * law.duration
+    t = np.concatenate([law.times(CHECK_SAMPLES), b - eps, b + eps])
+    return np.sort(np.clip(t, 0.0, law.duration))
 
 
 def law_values(kind: LawType, mv: Move) -> dict[str, Any]:
@@ -68,13 +80,22 @@ def move_law(mv: Move, path: Path, dynamics: PathDynamics, motors: MotorLimits |
         raise ParameterError("duration = \"fit\" needs the motors' limits")
     if not has_duration:
         raise ParameterError(f"law {mv.law!r} has no duration to fit")
+    limits = motors
 
-    def sampled(T: float) -> float:
-        tr_ = traj(build(T))
-        tr, sp = motors.ratios(inverse_dynamics(model, tr_.q, tr_.dq, tr_.ddq), tr_.dq)
-        return max(tr, sp)
+    def shortest(family: Callable[[float], Law], t_min: float) -> float:
+        """The shortest ``T >= t_min`` with ``family(T)`` within the motors."""
+        def sampled(T: float) -> float:
+            law = family(T)
+            tr_ = traj(law, check_times(law) if law.breakpoints().size else None)
+            tr, sp = limits.ratios(inverse_dynamics(model, tr_.q, tr_.dq, tr_.ddq), tr_.dq)
+            return max(tr, sp)
 
-    return build(shortest_within(stretched_ratio(build, traj, model, motors) or sampled))
+        ratio = stretched_ratio(family, traj, model, limits) or sampled
+        return max(t_min, shortest_within(ratio))
+
+    if kind.fit is not None:
+        return kind.fit(LawRequest(path, values, mass, None, SI), shortest)
+    return build(shortest(build, 0.0))
 
 
 def shortest_within(ratio: Callable[[float], float]) -> float:
@@ -131,7 +152,7 @@ def stretched_ratio(build: Callable[[float], Law], traj: Sampling, model: Model,
     a, b = one.evaluate(f), two.evaluate(2.0 * f) * scale
     if not np.allclose(a, b, rtol=1e-9, atol=1e-12 * float(np.abs(a).max())):
         return None
-    tr = traj(one)
+    tr = traj(one, check_times(one) if one.breakpoints().size else None)
     q, dq, ddq = tr.q, tr.dq, tr.ddq
     ine = model.inertia
     inertial = inverse_dynamics(Model(model.robot, ine.frictionless(), model.assembly,
