@@ -95,7 +95,7 @@ def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
                 best_fig = best_workspace_figure(robot_mm, task.working_mode,
                                                  evaluate_path(task, [best[k]
                                                                       for k in LENGTHS]))
-        write_sweep_outputs(od, summary, choice, rows, space.varied_columns, best_toml,
+        write_sweep_outputs(od, summary, choice, rows, space.varied_axes, best_toml,
                             best_fig, with_figures=figures)
     text = (f"design sweep: {n} designs ({stats.evaluated} evaluated, {n - stats.evaluated} "
             f"resumed) on {stats.workers} workers in {stats.wall_s:.1f} s "

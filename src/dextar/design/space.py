@@ -116,9 +116,10 @@ class DesignSpace:
         return out
 
     @property
-    def varied_columns(self) -> list[int]:
-        """The columns of :data:`LENGTHS` the sweep varies."""
-        return sorted({c for *_, cs in self.dims for c in cs})
+    def varied_axes(self) -> list[tuple[int, str]]:
+        """One ``(column of LENGTHS, label)`` per varied dimension: lengths tied to one range
+        (``l``: both proximal rods) are one axis, ``"l1 = l2"``."""
+        return sorted((cs[0], " = ".join(LENGTHS[c] for c in cs)) for *_, cs in self.dims)
 
     def objective_values(self, rows: list[dict[str, float]]) -> Array:
         """The objectives of ``rows`` to minimise, shape (n, n_objectives)."""

@@ -9,6 +9,7 @@ import io
 import json
 import os
 from collections.abc import Mapping, Sequence
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -23,7 +24,7 @@ from ..geometry import FiveBar
 from ..kinematics import workspace_map
 from .figures import plot_workspace
 from .files import OutputDir, write_text
-from .html_page import figures, page
+from .html_page import figures, grid, page, table
 from .tables import number
 
 #: Columns of designs.csv and pareto.csv.
@@ -100,7 +101,8 @@ def pareto_figure(F: Array, pareto: Array, best: int, names: Sequence[str]) -> F
 
 
 def scatter_matrix(X: Array, feasible: Array, names: Sequence[str]) -> Figure:
-    """Every pair of varied lengths (mm), feasible designs in blue, the others in grey."""
+    """Every pair of varied lengths (mm; tied lengths are one axis), feasible designs in
+    blue, the others in grey."""
     k = X.shape[1]
     fig = Figure(figsize=(2.2 * k + 1, 2.2 * k + 1))
     axes = fig.subplots(k, k, squeeze=False)
@@ -127,25 +129,30 @@ def design_report(summary: Mapping[str, Any], pareto_rows: Sequence[Mapping[str,
                   pngs: dict[str, bytes]) -> str:
     """The sweep's report: counts, the chosen design, the Pareto designs, the figures."""
     esc = html.escape
-    facts = [(k, summary[k]) for k in ("designs", "feasible", "feasible_fraction", "pareto",
-                                       "objectives", "sampling", "seed", "workers",
-                                       "wall_time_s", "designs_per_second", "evaluated",
-                                       "resumed") if k in summary]
-    rows = "".join(f"<tr><td>{esc(k)}</td><td>{esc(str(v))}</td></tr>" for k, v in facts)
-    head = "".join(f"<th>{esc(c)}</th>" for c in COLUMNS if c not in ("feasible", "reason"))
-    body = "".join(
-        f"<tr><td>{r['design']}</td>" + "".join(f"<td>{float(r[k]):.4g}</td>"
-                                                for k in (*LENGTHS, *METRICS)) + "</tr>"
-        for r in pareto_rows)
+    labels = {"designs": "designs", "feasible": "feasible designs",
+              "feasible_fraction": "feasible fraction", "pareto": "Pareto designs",
+              "objectives": "objectives (minimised; - maximises)", "sampling": "sampling",
+              "seed": "seed", "workers": "workers", "wall_time_s": "wall time [s]",
+              "designs_per_second": "designs per second", "evaluated": "evaluated",
+              "resumed": "resumed from an earlier run"}
+    facts = table([(label, _rounded(summary[k])) for k, label in labels.items()
+                   if k in summary])
+    pareto = grid([c for c in COLUMNS if c not in ("feasible", "reason")],
+                  [(r["design"], *(_rounded(r[k]) for k in (*LENGTHS, *METRICS)))
+                   for r in pareto_rows])
     best = summary.get("best")
     chosen = (f"<p>Chosen (the Pareto design closest to the ideal point): design "
               f"{best['design']}, l1 = {best['l1']:.4g}, l2 = {best['l2']:.4g}, L1 = "
               f"{best['L1']:.4g}, L2 = {best['L2']:.4g}, d = {best['d']:.4g} mm; written to "
               "best.toml.</p>") if best else "<p>No feasible design.</p>"
-    return page("dextar design sweep",
-                f"<h1>Design sweep of {esc(str(summary['task']))}</h1><table>{rows}</table>"
-                f"{chosen}<h2>Pareto designs</h2><table><tr>{head}</tr>{body}</table>"
-                f"<h2>Figures</h2>{figures(pngs)}")
+    return page(f"Design sweep of {Path(str(summary['task'])).name}",
+                f"<p>Task file {esc(str(summary['task']))}.</p>{facts}{chosen}"
+                f"<h2>Pareto designs</h2>{pareto}<h2>Figures</h2>{figures(pngs)}")
+
+
+def _rounded(v: Any) -> Any:
+    """A number to 4 significant digits for a table (other values as they are)."""
+    return float(f"{v:.4g}") if isinstance(v, float) else v
 
 
 class DesignsFile:
@@ -266,13 +273,13 @@ def best_workspace_figure(robot_mm: FiveBar, mode: str, P: Array) -> Figure:
     ws = workspace_map(robot_mm, mode, resolution=241)
     fig: Figure = plot_workspace(ws, path=P, unit="mm")
     fig.axes[0].set_title(f"chosen design: l1 = {robot_mm.l1:.4g}, l2 = {robot_mm.l2:.4g}, "
-                          f"L1 = {robot_mm.L1:.4g}, L2 = {robot_mm.L2:.4g}, d = "
-                          f"{robot_mm.d:.4g} mm", fontsize=9)
+                          f"L1 = {robot_mm.L1:.4g},\nL2 = {robot_mm.L2:.4g}, d = "
+                          f"{robot_mm.d:.4g} mm (working mode {mode})", fontsize=9)
     return fig
 
 
 def write_sweep_outputs(od: OutputDir, summary: Mapping[str, Any], choice: Choice,
-                        rows: Sequence[Mapping[str, Any]], varied: Sequence[int],
+                        rows: Sequence[Mapping[str, Any]], varied: Sequence[tuple[int, str]],
                         best_toml: str | None, best_figure: Figure | None, *,
                         with_figures: bool = True) -> None:
     """Write ``best.toml`` (with a feasible design), ``pareto.csv``, the figures (PNG and
@@ -287,9 +294,9 @@ def write_sweep_outputs(od: OutputDir, summary: Mapping[str, Any], choice: Choic
         names = list(summary["objectives"])
         for name, fig in (
                 ("pareto", pareto_figure(choice.F, choice.pareto, choice.best, names)),
-                ("designs", scatter_matrix(X[:, list(varied)],
+                ("designs", scatter_matrix(X[:, [c for c, _ in varied]],
                                            np.array([r["feasible"] for r in rows]),
-                                           [f"{LENGTHS[c]} [mm]" for c in varied])),
+                                           [f"{label} [mm]" for _, label in varied])),
                 ("best_workspace", best_figure)):
             pngs[name] = png_bytes(fig)
             od.write_bytes(f"{name}.png", pngs[name])

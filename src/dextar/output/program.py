@@ -114,11 +114,24 @@ def moves_figure(res: ProgramResult, robot_mm: FiveBar, mode: str) -> Figure:
     ws = workspace_map(robot_mm, mode, resolution=241)
     fig: Figure = plot_workspace(ws, path=res.P * 1e3, unit="mm")
     ax = fig.axes[0]
+    pts = res.P * 1e3
+    span = float(np.ptp(pts, axis=0).max()) or 1.0
+    lo, hi = pts.min(axis=0) - 0.35 * span, pts.max(axis=0) + 0.35 * span  # the moves' region
+    ax.set_xlim(lo[0], hi[0])
+    ax.set_ylim(lo[1], hi[1])
+    placed: list[Array] = []
     for index in np.unique(res.move_index):
         P = res.P[res.move_index == index] * 1e3
-        x, y = P[len(P) // 2]
-        ax.annotate(str(int(index)), (x, y), fontsize=8, color="white",
-                    bbox={"boxstyle": "circle,pad=0.2", "fc": "black", "alpha": 0.7})
+        at = P[len(P) // 2]
+        # a label that would sit on another's (a move back over the same segment, a dwell
+        # at a move's end) is moved aside, with a leader line to its move
+        near = sum(bool(np.hypot(*(at - p)) < 0.06 * span) for p in placed)
+        placed.append(at)
+        ax.annotate(str(int(index)), at, xytext=(14 * near, 12 * near),
+                    textcoords="offset points", fontsize=8, color="white",
+                    bbox={"boxstyle": "circle,pad=0.2", "fc": "black", "alpha": 0.7},
+                    arrowprops={"arrowstyle": "-", "color": "black", "lw": 0.6} if near
+                    else None)
     ax.set_title(f"Program: {len(res.move_types) or len(res.moves)} moves, cycle "
                  f"{res.cycle_time_s:.3f} s "
                  f"(working mode at the start: {mode})", fontsize=10)
