@@ -69,11 +69,13 @@ def build_parser() -> argparse.ArgumentParser:
                 "angles in degrees on the command line.")
     p.add_argument("--version", action="version", version=f"dextar {__version__}")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    p.set_defaults(parsers={})
     for name in COMMANDS:
         mod = _command(name)
         sp = sub.add_parser(mod.NAME, help=mod.HELP, description=mod.HELP)
         sp.registries = getattr(mod, "REGISTRIES_HELP", False)
         mod.add_arguments(sp)
+        p.get_default("parsers")[mod.NAME] = sp
         sp.set_defaults(run=mod.run)
     return p
 
@@ -98,7 +100,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     # negative numbers are values, not options: "dextar ik -10 120"
     argv = list(sys.argv[1:] if argv is None else argv)
     try:
-        args = parser.parse_args(_protect_negatives(argv))
+        args, extra = parser.parse_known_args(_protect_negatives(argv))
+        if extra:  # the command's own parser says it, pointing to the command's help
+            args.parsers[args.command].error(f"unrecognized arguments: {' '.join(extra)}")
     except SystemExit as exc:  # --help, --version, or a usage error (already printed)
         return int(exc.code or 0) if not isinstance(exc.code, str) else 2
     _terminate_as_interrupt()

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 
-from .base import Result, config_argument, json_flag, shown
+from .base import Result, config_argument, into_directory, shown
 
 NAME = "simulate"
 HELP = "computed-torque tracking against a perturbed plant"
@@ -13,11 +13,9 @@ REGISTRIES_HELP = True
 
 
 def add_arguments(sp: argparse.ArgumentParser) -> None:
-    """``[config]``, ``--out``, ``--force``, ``--json``."""
+    """``[config]``, ``--out``, ``--force``, ``--quiet``, ``--json``."""
     config_argument(sp)
-    json_flag(sp)
-    sp.add_argument("--out", default="dextar-sim", help="output directory")
-    sp.add_argument("--force", action="store_true", help="write into an existing directory")
+    into_directory(sp, default="dextar-sim")
 
 
 def run(args: argparse.Namespace) -> Result:
