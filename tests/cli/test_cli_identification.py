@@ -19,13 +19,6 @@ COLUMNS = ["t_s", "phi_rad", "psi_rad", "dphi_rad_s", "dpsi_rad_s", "ddphi_rad_s
            "ddpsi_rad_s2", "tau1_Nm", "tau2_Nm"]
 
 
-@pytest.fixture(scope="module")
-def excite_csv(tmp_path_factory):
-    path = tmp_path_factory.mktemp("ex") / "excite.csv"
-    assert main(["excite", CONFIG, "--out", str(path), "--duration", "10", "--quiet"]) == 0
-    return path
-
-
 def test_excite_writes_a_rest_to_rest_periodic_motion(excite_csv, capsys):
     head, data = read(excite_csv)
     assert head == COLUMNS

@@ -24,7 +24,9 @@ def test_a_users_run_draws_what_applies_and_names_what_42_leaves_out(tmp_path, c
     """line_si.toml (gravity, friction, payload): no Fig. 3 (the paper's uniform law) or Fig.
     7 (the paper's masses); the paper model's error is measured against the exact torques
     without gravity and friction, and says so."""
-    cfg = EXAMPLES / "line_si.toml"
+    cfg = tmp_path / "line.toml"  # line_si.toml, fewer samples and animation frames
+    cfg.write_text((EXAMPLES / "line_si.toml").read_text().replace(
+        "samples = 501", "samples = 101\nanimation_frames = 2"))
     out = tmp_path / "run"
     assert main(["run", str(cfg), "--out", str(out), "--quiet"]) == 0
     names = {p.name for p in out.iterdir()}
@@ -36,10 +38,8 @@ def test_a_users_run_draws_what_applies_and_names_what_42_leaves_out(tmp_path, c
     assert "without gravity and friction, which (42) leaves out" in capsys.readouterr().out
 
 
-def test_identify_without_config_says_what_it_assumed(tmp_path, capsys):
-    assert main(["excite", str(EXAMPLES / "pick_place.toml"), "--out", str(tmp_path / "e.csv"),
-                 "--duration", "5", "--quiet"]) == 0
-    main(["identify", str(tmp_path / "e.csv"), "--out", str(tmp_path / "id"), "--quiet"])
+def test_identify_without_config_says_what_it_assumed(tmp_path, capsys, excite_csv):
+    main(["identify", str(excite_csv), "--out", str(tmp_path / "id"), "--quiet"])
     err = capsys.readouterr().err
     assert "no --config: the robot is assumed to be the DexTAR" in err and "gravity" in err
 
@@ -125,17 +125,22 @@ def test_control_settings_out_of_range_are_refused_by_key(tmp_path, capsys, key,
 
 
 # ---------------------------------------------------------------- files and messages
-def test_every_output_follows_the_umask(tmp_path):
+def test_every_output_follows_the_umask(tmp_path, excite_csv):
+    small = tmp_path / "small.toml"
+    small.write_text('[output]\nfigures = ["fig4", "animation"]\nanimation_frames = 2\n'
+                     'samples = 101\n')
     old = os.umask(0o022)
     try:
-        main(["excite", str(EXAMPLES / "pick_place.toml"), "--out", str(tmp_path / "e.csv"),
-              "--duration", "5", "--quiet"])
         main(["program", str(EXAMPLES / "mode_change.toml"), "--out", str(tmp_path / "p"),
               "--quiet"])
-        main(["run", "--out", str(tmp_path / "r"), "--quiet"])
+        main(["run", str(small), "--out", str(tmp_path / "r"), "--quiet"])
+        main(["identify", str(excite_csv), "--config", str(EXAMPLES / "pick_place.toml"),
+              "--out", str(tmp_path / "i"), "--quiet"])
     finally:
         os.umask(old)
-    files = [tmp_path / "e.csv", *(tmp_path / "p").iterdir(), *(tmp_path / "r").iterdir()]
+    files = [*(tmp_path / "p").iterdir(), *(tmp_path / "r").iterdir(),
+             *(tmp_path / "i").iterdir()]
+    assert len(files) > 10
     assert {stat.S_IMODE(p.stat().st_mode) for p in files} == {0o644}
 
 

@@ -298,8 +298,9 @@ def test_fit_by_time_scaling_equals_resampling():
     motors = sc.si_motors
     path = Line((-0.04, 0.09), (0.04, 0.12))
 
-    def traj(law):
-        return sample_trajectory(m.robot, path, law, mode=sc.mode, samples=401, units=SI)
+    def traj(law, times=None):
+        return sample_trajectory(m.robot, path, law, mode=sc.mode, samples=401, times=times,
+                                 units=SI)
 
     for name, extra in (("min-jerk", {}), ("optimal", {"eta": 0.1})):
         def build(T, name=name, extra=extra):
