@@ -21,10 +21,9 @@ import tempfile
 import time
 from pathlib import Path
 
-from dextar.config import load_toml
+from dextar.config import load_scenario, load_toml
 from dextar.design.evaluate import evaluate_chunk
 from dextar.design.sweep import Cluster, run_sweep
-from dextar.jobs import design_task
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 REPEATS = 3
@@ -44,7 +43,7 @@ def task_file(folder: Path, example: str, samples: int, extra: dict) -> Path:
 
 
 def measure(name: str, path: Path, chunk: int) -> None:
-    task, space = design_task(str(path))
+    task, space = load_scenario(path).design_task()
     designs = space.designs()
     evaluate_chunk(task, designs[:2], 0)  # warm caches
     times = []

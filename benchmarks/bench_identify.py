@@ -23,15 +23,13 @@ from dextar.identification.base import base_parameters
 from dextar.identification.data import MotionData, read_motion_csv
 from dextar.identification.excite import design_excitation
 from dextar.identification.fit import identify
-from dextar.jobs import si_model
-from dextar.units import SI
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "pick_place.toml"
 
 
 def main() -> None:
     sc = load_scenario(EXAMPLE)
-    model, motors = si_model(sc), sc.table("motors").limits(SI)
+    model, motors = sc.si_model, sc.si_motors
     times = []
     for seed in range(3):
         t0 = time.perf_counter()

@@ -6,13 +6,14 @@ Run: python benchmarks/bench_program.py
 
 from __future__ import annotations
 
+import argparse
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
-from dextar import jobs
+from dextar.commands import program
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "pick_place.toml"
 
@@ -22,7 +23,9 @@ def timed(figures: bool) -> tuple[float, object]:
     for _ in range(3):
         with tempfile.TemporaryDirectory() as tmp:
             t0 = time.perf_counter()
-            res = jobs.program(str(EXAMPLE), str(Path(tmp) / "out"), figures=figures)
+            args = argparse.Namespace(config=str(EXAMPLE), out=str(Path(tmp) / "out"),
+                                      force=False, quiet=True, json=False)
+            res = program.run(args, figures=figures)
             best = min(best, time.perf_counter() - t0)
     return best, res
 

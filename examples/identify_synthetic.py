@@ -18,11 +18,9 @@ from dextar.identification.base import base_parameters
 from dextar.identification.data import MotionData
 from dextar.identification.excite import design_excitation
 from dextar.identification.fit import identify
-from dextar.jobs import si_model
-from dextar.units import SI
 
 sc = load_scenario(Path(__file__).with_name("pick_place.toml"))
-prior = si_model(sc)  # the config's robot: DexTAR, light rods, a gripper and its part
+prior = sc.si_model  # the config's robot: DexTAR, light rods, a gripper and its part
 true = Model(prior.robot, prior.inertia.scaled_masses(1.3).with_(viscous=(0.012, 0.008)))
 
 # 1. the tau = Y theta model and its base parameters (combinations the torques determine)
@@ -35,7 +33,7 @@ Y = regressor(true, q, dq, ddq)  # (2, 2, 15)
 assert np.allclose(Y @ standard_parameters(true.inertia), inverse_dynamics(true, q, dq, ddq))
 
 # 2. an exciting trajectory: 2 periods of 5 s, within the servo's torque and speed
-ex = design_excitation(prior, sc.mode, duration=10.0, motors=sc.table("motors").limits(SI))
+ex = design_excitation(prior, sc.mode, duration=10.0, motors=sc.si_motors)
 print(f"exciting trajectory: condition number {ex.condition_number:.3g}")
 
 # 3. "measure" it: the true robot's torques + 5 mN m noise, angles quantised to 2^17 counts

@@ -11,20 +11,12 @@ from dextar.cli import main
 from dextar.config import load_scenario
 from dextar.dynamics.regressor import standard_parameters
 from dextar.identification.base import base_parameters
-from dextar.jobs import si_model
 
 from ..program.test_program import EXAMPLES, read
 
 CONFIG = str(EXAMPLES / "pick_place.toml")
 COLUMNS = ["t_s", "phi_rad", "psi_rad", "dphi_rad_s", "dpsi_rad_s", "ddphi_rad_s2",
            "ddpsi_rad_s2", "tau1_Nm", "tau2_Nm"]
-
-
-@pytest.fixture(scope="module")
-def excite_csv(tmp_path_factory):
-    path = tmp_path_factory.mktemp("ex") / "excite.csv"
-    assert main(["excite", CONFIG, "--out", str(path), "--duration", "10", "--quiet"]) == 0
-    return path
 
 
 def test_excite_writes_a_rest_to_rest_periodic_motion(excite_csv, capsys):
@@ -64,7 +56,7 @@ def test_identify_writes_a_config_that_reproduces_the_base_parameters(excite_csv
     head, *_ = (out / "parameters.csv").read_text().splitlines()
     assert head == "name,meaning,value,std,rel_std_percent,unit"
     # the identified config loads and its model has exactly the identified base parameters
-    model = si_model(load_scenario(out / "identified.toml"))
+    model = load_scenario(out / "identified.toml").si_model
     base = base_parameters(model)
     beta = np.array([p["value"] for p in s["base_parameters"]])
     assert np.allclose(base.of(standard_parameters(model.inertia)), beta, rtol=1e-9)

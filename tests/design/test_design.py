@@ -17,9 +17,7 @@ from dextar.cli import main
 from dextar.config import load_scenario
 from dextar.design.evaluate import Task, evaluate_design
 from dextar.design.pareto import closest_to_ideal, pareto_mask
-from dextar.jobs import si_model
 from dextar.output.design import parse_line
-from dextar.units import SI
 
 pytest.importorskip("distributed")
 
@@ -70,11 +68,13 @@ def rows_of(out: Path) -> list[dict]:
 
 
 @pytest.fixture(scope="module")
-def sweep2(tmp_path_factory):
+def sweep2(tmp_path_factory, scheduler):
+    """The task swept on the session's two workers."""
     folder = tmp_path_factory.mktemp("sweep")
     task = write_task(folder)
     out = folder / "two"
-    assert main(["design", str(task), "--out", str(out), "--workers", "2", "--quiet"]) == 0
+    assert main(["design", str(task), "--out", str(out), "--scheduler", scheduler,
+                 "--quiet"]) == 0
     return task, out
 
 
@@ -83,10 +83,9 @@ def test_rows_are_the_single_design_function(sweep2):
     rows = rows_of(out)
     assert [r["design"] for r in rows] == list(range(64))
     sc = load_scenario(task_path)
-    prog = sc.table("program")
-    mt = sc.table("motors")
-    task = Task(tuple(sc.moves), prog.start, sc.mode, sc.assembly, mt.limits(SI),
-                mt.rms_torque, si_model(sc).inertia, (0.4, 0.3), 30, sc.tolerances)
+    task = Task(tuple(sc.moves), sc.program_start, sc.mode, sc.assembly, sc.si_motors,
+                sc.motors_table.rms_torque, sc.si_model.inertia, (0.4, 0.3), 30,
+                sc.tolerances)
     for i in (0, 7, 21, 42, 63):
         direct = evaluate_design(task, [rows[i][k] for k in ("l1", "l2", "L1", "L2", "d")])
         for k, v in direct.items():
@@ -131,11 +130,12 @@ def test_one_worker_gives_the_same_file(sweep2, tmp_path):
     assert (out1 / "pareto.csv").read_bytes() == (out2 / "pareto.csv").read_bytes()
 
 
-def test_a_killed_sweep_resumes_to_the_same_file(sweep2, tmp_path):
+def test_a_killed_sweep_resumes_to_the_same_file(sweep2, tmp_path, scheduler):
     task, out2 = sweep2
     out = tmp_path / "killed"
     proc = subprocess.Popen([sys.executable, "-m", "dextar", "design", str(task), "--out",
-                             str(out), "--workers", "1", "--quiet"], start_new_session=True)
+                             str(out), "--scheduler", scheduler, "--quiet"],
+                            start_new_session=True)
     csv_path = out / "designs.csv"
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline:
@@ -151,7 +151,8 @@ def test_a_killed_sweep_resumes_to_the_same_file(sweep2, tmp_path):
     assert 0 < done < 64, done  # killed half-way
     # a line cut short by the kill is dropped on resume
     csv_path.write_text(partial + "64,1.0,2.")
-    assert main(["design", str(task), "--out", str(out), "--resume", "--quiet"]) == 0
+    assert main(["design", str(task), "--out", str(out), "--resume", "--scheduler", scheduler,
+                 "--quiet"]) == 0
     assert csv_path.read_bytes() == (out2 / "designs.csv").read_bytes()
     s = json.loads((out / "summary.json").read_text())
     assert s["resumed"] == done and s["evaluated"] == 64 - done
@@ -172,11 +173,11 @@ def test_bad_design_tables_exit_2(tmp_path, capsys, design, message):
     assert not (tmp_path / "o").exists()
 
 
-def test_geometries_that_cannot_assemble_are_rows(tmp_path):
+def test_geometries_that_cannot_assemble_are_rows(tmp_path, scheduler):
     """Rods too short for the base: every design is a row with its reason, no crash."""
     task = write_task(tmp_path, design='[design]\nl = [5.0, 10.0]\nL = [5.0, 10.0]\n'
                                        'd = [60.0, 100.0]\nsamples = 8\ngrid = 30\n')
-    assert main(["design", str(task), "--out", str(tmp_path / "o"), "--workers", "1",
+    assert main(["design", str(task), "--out", str(tmp_path / "o"), "--scheduler", scheduler,
                  "--quiet"]) == 0
     rows = rows_of(tmp_path / "o")
     assert len(rows) == 8 and not any(r["feasible"] for r in rows)
@@ -185,7 +186,10 @@ def test_geometries_that_cannot_assemble_are_rows(tmp_path):
     assert s["feasible"] == 0 and s["best"] is None
 
 
-def test_unreachable_scheduler_is_named_within_10_s(tmp_path, capsys):
+def test_unreachable_scheduler_is_named_within_10_s(tmp_path, capsys, monkeypatch):
+    from dextar.design import sweep
+
+    monkeypatch.setattr(sweep, "CONNECT_TIMEOUT_S", 2)  # the default 8 s, shortened
     task = write_task(tmp_path)
     t0 = time.monotonic()
     assert main(["design", str(task), "--out", str(tmp_path / "o"), "--scheduler",
@@ -216,11 +220,10 @@ def test_resume_refuses_another_sweep(sweep2, tmp_path, capsys):
     assert "--resume" in capsys.readouterr().err
 
 
-def test_a_run_task_sweeps_its_path_and_law(tmp_path):
+def test_a_run_task_sweeps_its_path_and_law(tmp_path, scheduler):
     """A dextar run config (one path, one law) is a task too: geometry and torque metrics
     along its path; its rows are the single-design function's."""
     from dextar.config import load_toml
-    from dextar.jobs import design_task
 
     from ..program.test_program import EXAMPLES
     from ..robustness.harness import toml_text
@@ -232,9 +235,10 @@ def test_a_run_task_sweeps_its_path_and_law(tmp_path):
     path = tmp_path / "run.toml"
     path.write_text(toml_text(doc))
     out = tmp_path / "o"
-    assert main(["design", str(path), "--out", str(out), "--workers", "1", "--quiet"]) == 0
+    assert main(["design", str(path), "--out", str(out), "--scheduler", scheduler,
+                 "--quiet"]) == 0
     rows = rows_of(out)
-    task, space = design_task(str(path))
+    task, space = load_scenario(path).design_task()
     assert task.kind == "run"
     for i in (0, 9, 31):
         direct = evaluate_design(task, space.designs()[i])
@@ -277,7 +281,6 @@ def test_random_design_tables_are_read_or_refused_by_name(tmp_path_factory):
 
     from dextar.design.evaluate import evaluate_chunk
     from dextar.errors import ConfigError
-    from dextar.jobs import design_task
     from dextar.output.design import row_line
 
     from ..robustness.harness import toml_text
@@ -292,7 +295,7 @@ def test_random_design_tables_are_read_or_refused_by_name(tmp_path_factory):
         path = folder / "t.toml"
         path.write_text(toml_text({**base, "design": table}))
         try:
-            task, space = design_task(str(path))
+            task, space = load_scenario(path).design_task()
         except ConfigError as exc:
             assert "design" in str(exc) or "samples" in str(exc) or "seed" in str(exc), exc
             return
@@ -346,10 +349,9 @@ def test_a_worker_that_dies_is_replaced_and_the_rows_are_complete(sweep2):
     """One of two workers is killed after the first chunk: Dask reruns its chunks elsewhere
     and the sweep ends with every row, equal to the uninterrupted sweep's."""
     from dextar.design.sweep import Cluster, run_sweep
-    from dextar.jobs import design_task
 
     task_path, out2 = sweep2
-    task, space = design_task(str(task_path))
+    task, space = load_scenario(task_path).design_task()
     designs = space.designs()
     got: dict[int, dict] = {}
     killed = []
@@ -370,16 +372,15 @@ def test_a_worker_that_dies_is_replaced_and_the_rows_are_complete(sweep2):
         assert got[i] == expected[i]
 
 
-def test_sweeps_one_after_another_on_one_cluster(tmp_path):
+def test_sweeps_one_after_another_on_one_cluster(tmp_path, scheduler):
     """Two sweeps in a row on the same two workers (as a script or the benchmark does): the
     second one's task is not lost while the first one's copy is being released."""
     from dextar.design.sweep import Cluster, run_sweep
-    from dextar.jobs import design_task
 
-    task, space = design_task(str(write_task(tmp_path)))
+    task, space = load_scenario(write_task(tmp_path)).design_task()
     designs = space.designs()[:8]
     results = []
-    with Cluster(workers=2) as cluster:
+    with Cluster(scheduler=scheduler) as cluster:
         for _ in range(3):
             rows: list[dict] = []
             stats = run_sweep(cluster, task, designs, range(len(designs)), chunk=1,

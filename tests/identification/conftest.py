@@ -6,8 +6,6 @@ from dextar.dynamics import inverse_dynamics
 from dextar.identification.base import base_parameters
 from dextar.identification.data import MotionData
 from dextar.identification.excite import design_excitation
-from dextar.jobs import si_model
-from dextar.units import SI
 
 from ..program.test_program import EXAMPLES
 
@@ -19,7 +17,7 @@ COUNT = 2 * np.pi / 2**17
 def prior():
     """The pick-and-place robot (SI), its working mode and motors."""
     sc = load_scenario(EXAMPLES / "pick_place.toml")
-    return si_model(sc), sc.mode, sc.table("motors").limits(SI)
+    return sc.si_model, sc.mode, sc.si_motors
 
 
 @pytest.fixture(scope="session")

@@ -149,7 +149,7 @@ def configs(draw: st.DrawFn) -> dict[str, Any]:
     return doc
 
 
-COMMANDS = st.sampled_from(["plan", "torques", "plan", "torques", "export"])
+COMMANDS = st.sampled_from(["plan", "torques", "plan", "torques", "export", "simulate"])
 
 
 @st.composite

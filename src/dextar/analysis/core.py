@@ -95,13 +95,16 @@ _FD8 = np.array([1 / 280, -4 / 105, 1 / 5, -4 / 5, 0.0, 4 / 5, -1 / 5, 4 / 105, 
 class PaperComparison:
     """The paper's simplified model beside the exact one, on the same trajectory.
 
-    ``error`` compares the paper's torques with the exact inertial torques (gravity and
-    friction, which the paper's model leaves out, are excluded from both)."""
+    ``error`` compares the paper's torques with ``reference``, the exact torques without
+    what the paper's model leaves out (``leaves_out``: gravity, friction), so that it
+    measures the model's simplifications and not what it never claimed to include."""
 
     model: PaperModel
     beta: Array
     tau: Array
     error: dict[str, float]
+    reference: Array
+    leaves_out: tuple[str, ...]
     T_exact: Array
     T_fd: Array
     T_approx: Array
@@ -185,7 +188,9 @@ def _paper(sc: RunInputs, law: Law, tr: Trajectory, tau: Array) -> PaperComparis
     pm = paper_model(sc.robot, sc.inertia, beta0)
     tau_p = pm.torques(tr.q, tr.dq, tr.ddq)
     ine = sc.inertia
-    if any(ine.gravity) or ine.has_friction:
+    leaves_out = tuple(name for name, present in (("gravity", any(ine.gravity)),
+                                                  ("friction", ine.has_friction)) if present)
+    if leaves_out:
         # the paper's model is inertial only: compare with the exact inertial torques
         inertial = Model(sc.robot, ine.frictionless(), tr.assembly)
         tau = inverse_dynamics(inertial, tr.q, tr.dq, tr.ddq, t=tr.t)
@@ -198,7 +203,7 @@ def _paper(sc: RunInputs, law: Law, tr: Trajectory, tau: Array) -> PaperComparis
     JL = mL * sc.robot.L1**2 / 2
     T_S, T_r = triangle_energies(sc.robot, mL, JL, lam, tr.q, tr.dq, tr.dP)
     return PaperComparison(pm, base_angle(sc.robot, tr.q), tau_p, torque_error(tau, tau_p),
-                           T_exact, T_fd, T_approx, T_S, T_r,
+                           tau, leaves_out, T_exact, T_fd, T_approx, T_S, T_r,
                            {"distal_mass": mL, "JL": JL, "lambda": lam})
 
 

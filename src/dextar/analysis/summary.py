@@ -12,7 +12,7 @@ from .. import __version__
 from .._arrays import Array
 from ..dynamics.paper import paper_model_limits
 from ..geometry import DEXTAR_MM
-from ..laws import Law, OptimalLaw, TrapezoidalLaw
+from ..laws import LAW_TYPES, Law, law_type
 from ..trajectory import Trajectory
 from .core import (
     Analysis,
@@ -44,28 +44,33 @@ def is_paper_example(sc: RunInputs) -> bool:
 
 def law_summary(sc: RunInputs, law: Law, an: Analysis | None = None) -> dict[str, Any]:
     """The law actually used: its type, its one duration (run time unit and seconds), the
-    solver's status and message, and its own parameters."""
-    spec = sc.law_values
+    solver's status and message, its own quantities (:meth:`~dextar.laws.Law.report`) and
+    its config keys as given (each named with its config unit, ``eta_s2_per_kg``)."""
     out: dict[str, Any] = {"type": law.name, "duration": law.duration,
                            "duration_s": law.duration * sc.units.time_s,
                            "status": int(law.status), "success": bool(law.success),
-                           "message": law.message}
-    if isinstance(law, OptimalLaw):
-        out.update(eta=law.eta, eta_s2_per_kg=spec.get("eta"), ode_residual=law.residual,
-                   nodes=law.nodes)
-    if isinstance(law, TrapezoidalLaw):
-        out.update(vmax=law.vmax, amax=law.amax, cruise_speed=law.cruise)
-    if law.name == "time-optimal":
-        limit = getattr(law, "torque_limit", None)
-        out.update(torque_limit_Nm=list(spec["torque_limit"]) if spec.get("torque_limit")
-                   is not None else ([sc.units.torque_in_nm(v) for v in limit] if limit
-                                     else None), grid=spec["grid"],
-                   max_torque_ratio_check_samples=getattr(law, "max_torque_ratio", None))
-        if spec.get("speed_limit_deg_s") is not None:
-            out["speed_limit_deg_s"] = list(spec["speed_limit_deg_s"])
-        if an is not None:
-            out["max_torque_ratio"] = torque_limit_ratio(an)
+                           "message": law.message, **law.report(sc.units)}
+    params = law_type(law.name).params if law.name in LAW_TYPES else {}
+    for key, value in sc.law_values.items():
+        p = params.get(key)
+        if p is None or key == "duration" or value is None:
+            continue
+        out[_with_unit(key, p.unit)] = list(value) if isinstance(value, tuple) else value
+    if an is not None and law.torque_limit is not None:
+        out["max_torque_ratio"] = torque_limit_ratio(an)
     return out
+
+
+#: Config units as they end a JSON key.
+_UNIT_SUFFIX = {"s^2/kg": "s2_per_kg", "N m": "Nm", "mm/s": "mm_s", "mm/s^2": "mm_s2",
+                "mm": "mm", "deg": "deg", "deg/s": "deg_s", "s": "s", "kg": "kg", "rpm": "rpm"}
+
+
+def _with_unit(key: str, unit: str) -> str:
+    """``eta`` in s^2/kg -> ``eta_s2_per_kg``; a key that already says its unit, or has
+    none, as it is."""
+    suffix = _UNIT_SUFFIX.get(unit, "")
+    return key if not suffix or key.endswith("_" + suffix) else f"{key}_{suffix}"
 
 
 def _stats(tau: Array) -> dict[str, list[float]]:
@@ -111,9 +116,9 @@ def run_summary(an: Analysis, checks: dict[str, Any], uniform: Trajectory) -> di
             "rest",
         ],
     }
-    if isinstance(law, OptimalLaw):  # the paper's functional belongs to the paper's law
-        s["cost"] = {"total": law.cost, "kinetic": law.kinetic, "inertial": law.inertial,
-                     "unit": f"{sc.units.names['energy']} x {sc.units.names['time']}",
+    cost = law.cost_report()
+    if cost is not None:  # the paper's functional belongs to the paper's law
+        s["cost"] = {**cost, "unit": f"{sc.units.names['energy']} x {sc.units.names['time']}",
                      "definition": "Phi = (m/2) Int |rdot|^2 dt + (eta m^2/2) Int |rddot|^2 dt"}
     if an.paper is None:
         s["paper_model"] = {"not_applicable": paper_model_limits(sc.robot, sc.inertia)}
@@ -123,7 +128,11 @@ def run_summary(an: Analysis, checks: dict[str, Any], uniform: Trajectory) -> di
         s["torques"]["paper"] = _stats(p.tau)
         s["paper_model"] = {
             "beta0_deg": math.degrees(pm.beta0), "lambda": pm.lam, "C1": pm.C1, "C2": pm.C2,
-            "C3": pm.C3, "C4": pm.C4, "error_vs_exact": p.error}
+            "C3": pm.C3, "C4": pm.C4, "error_vs_exact": p.error,
+            "leaves_out": list(p.leaves_out),
+            "error_note": ("against the exact torques without "
+                           f"{' and '.join(p.leaves_out)}, which (42) leaves out"
+                           if p.leaves_out else "against the exact torques")}
         s["beta_range_deg"] = [float(np.degrees(p.beta.min())), float(np.degrees(p.beta.max()))]
         peakT = float(p.T_exact.max())
         s["energies"] = {

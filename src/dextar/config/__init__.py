@@ -4,7 +4,13 @@
 and one :func:`register_table` line.
 """
 
-from .scenario import Scenario, default_scenario, load_scenario, scenario_from_dict
+from .scenario import (
+    Scenario,
+    default_scenario,
+    load_robot_table,
+    load_scenario,
+    scenario_from_dict,
+)
 from .tables import (
     FIGURES,
     TABLES,
@@ -27,4 +33,5 @@ from .toml import check_tables, load_toml
 __all__ = ["FIGURES", "TABLES", "ControlTable", "FrictionTable", "GravityTable",
            "InertiaTable", "LawTable", "MotorsTable", "OutputTable", "PaperTable", "PathTable", "RobotTable",
            "Scenario", "Table", "TolerancesTable", "check_tables", "default_scenario",
+           "load_robot_table",
            "load_scenario", "load_toml", "register_table", "scenario_from_dict"]

@@ -8,24 +8,29 @@ happens here, once, as the objects are built.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 from pathlib import Path as FilePath
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from ..analysis import RunInputs
 from ..dynamics import Inertia, Model, RobotAlongPath
 from ..errors import ConfigError, DextarError
 from ..geometry import FiveBar
 from ..kinematics.checker import Tolerances
-from ..laws import Law, LawRequest, MotorLimits, law_type
+from ..laws import Law, LawRequest, law_type
+from ..motors import MotorLimits
 from ..params import read_params
 from ..paths import Path
-from ..program import Move
+from ..program import Move, ProgramRequest
 from ..trajectory import Trajectory, check_path, sample_trajectory
-from ..units import Units
+from ..units import SI, Units
 from .design import DesignTable
 from .program import ProgramTable, read_moves
+
+if TYPE_CHECKING:
+    from ..design.evaluate import Task
+    from ..design.space import DesignSpace
 from .tables import (
     TABLES,
     ControlTable,
@@ -41,21 +46,38 @@ from .tables import (
     Table,
     TolerancesTable,
 )
-from .toml import check_tables, load_toml
+from .toml import check_tables, read_config
 
 T = TypeVar("T", bound=Table)
 
 
 @dataclass(frozen=True)
 class Scenario:
-    """Every config table of a run (defaults where a table is absent) and its source."""
+    """Every config table of a run (defaults where a table is absent) and its source.
+
+    Attributes
+    ----------
+    tables : mapping of str to Table
+        Every registered table, parsed.
+    source : str
+        Where the config came from (its path, or the defaults).
+    moves : tuple of Move
+        The ``[[move]]`` tables (SI).
+    doc : mapping
+        The file as parsed (each table as written), read once.
+    text : bytes
+        The file's bytes (a sweep's signature), empty without a file.
+    """
 
     tables: Mapping[str, Table]
     source: str = "defaults (the paper's example)"
     moves: tuple[Move, ...] = ()
+    doc: Mapping[str, Any] = field(default_factory=dict)
+    text: bytes = b""
 
-    def table(self, name: str) -> Any:
-        """The parsed table ``[name]``."""
+    def table(self, name: str) -> Table:
+        """The parsed table ``[name]`` (a registered table; the typed properties below name
+        the built-in ones)."""
         return self.tables[name]
 
     def _get(self, cls: type[T]) -> T:
@@ -81,6 +103,36 @@ class Scenario:
         return self._get(LawTable)
 
     @property
+    def inertia_table(self) -> InertiaTable:
+        """``[inertia]``."""
+        return self._get(InertiaTable)
+
+    @property
+    def friction_table(self) -> FrictionTable:
+        """``[friction]``."""
+        return self._get(FrictionTable)
+
+    @property
+    def gravity_table(self) -> GravityTable:
+        """``[gravity]``."""
+        return self._get(GravityTable)
+
+    @property
+    def control_table(self) -> ControlTable:
+        """``[control]``."""
+        return self._get(ControlTable)
+
+    @property
+    def motors_table(self) -> MotorsTable:
+        """``[motors]``."""
+        return self._get(MotorsTable)
+
+    @property
+    def program_table(self) -> ProgramTable:
+        """``[program]``."""
+        return self._get(ProgramTable)
+
+    @property
     def output(self) -> OutputTable:
         """``[output]``."""
         return self._get(OutputTable)
@@ -98,8 +150,21 @@ class Scenario:
     @property
     def tolerances(self) -> Tolerances:
         """The geometry checker's tolerances (``[tolerances]``)."""
-        t = self._get(TolerancesTable)
-        return t.tolerances()
+        return self._get(TolerancesTable).tolerances()
+
+    def in_units(self, system: str | None) -> Scenario:
+        """The scenario computed in another unit system (``"si"`` or ``"paper"``; None: as
+        configured), as ``--units`` asks."""
+        if system is None or system == self.output.units:
+            return self
+        if system not in ("si", "paper"):
+            raise ConfigError(f"--units {system!r} must be si or paper")
+        tables = {**self.tables, "output": replace(self.output, units=system)}
+        return Scenario(tables, self.source, self.moves, self.doc, self.text)
+
+    def raw(self, *names: str) -> dict[str, Mapping[str, Any]]:
+        """The tables ``names`` as the file writes them (those it has)."""
+        return {k: self.doc[k] for k in names if k in self.doc}
 
     # ------------------------------------------------------------------ the run's objects
     @cached_property
@@ -107,8 +172,8 @@ class Scenario:
         """The run's unit system (``[output].units``)."""
         if self.output.units == "si":
             return Units("si", 1000.0, 1.0, 1.0)
-        inertia = self._get(InertiaTable)
-        return Units("paper", self.robot_mm.L1, inertia.effector_mass, self.law_table.duration_s)
+        return Units("paper", self.robot_mm.L1, self.inertia_table.effector_mass,
+                     self.law_table.duration_s)
 
     @property
     def robot_mm(self) -> FiveBar:
@@ -140,13 +205,14 @@ class Scenario:
         """The path as configured (mm, degrees)."""
         return self.path_table.summary()
 
+    def _inertia(self, units: Units) -> Inertia:
+        return self.inertia_table.build(units, self.robot_mm, self.friction_table,
+                                        self.gravity_table)
+
     @cached_property
     def inertia(self) -> Inertia:
         """Masses, inertias, friction and gravity in run units."""
-        t = self._get(InertiaTable)
-        f = self._get(FrictionTable)
-        g = self._get(GravityTable)
-        return t.build(self.units, self.robot_mm, f, g)
+        return self._inertia(self.units)
 
     @property
     def effector_mass(self) -> float:
@@ -156,19 +222,75 @@ class Scenario:
     @property
     def control(self) -> dict[str, Any]:
         """The control simulation's settings in run units."""
-        t = self._get(ControlTable)
-        inertia = self._get(InertiaTable)
-        return t.run_values(self.units, inertia.effector_mass)
+        return self.control_table.run_values(self.units, self.inertia_table.effector_mass)
 
     @property
     def motors(self) -> MotorLimits | None:
         """The motors' limits in run units (``[motors]``), or None."""
-        return self._get(MotorsTable).limits(self.units)
+        return self.motors_table.limits(self.units)
 
     def model(self, assembly: str | None = None) -> Model:
         """Robot and inertia assembled in ``assembly`` (default: the configured one)."""
         return Model(self.robot, self.inertia, assembly or self.assembly,
                      tol=self.tolerances.type2)
+
+    # ------------------------------------------------------------------ SI (programs, ...)
+    @cached_property
+    def si_model(self) -> Model:
+        """The robot and inertia in SI (m, kg, s), whatever ``[output].units``: the unit
+        system of programs, identification and design sweeps."""
+        return Model(self.robot_mm.scaled(1e-3), self._inertia(SI), self.assembly,
+                     tol=self.tolerances.type2)
+
+    @property
+    def si_motors(self) -> MotorLimits | None:
+        """The motors' limits in SI, or None."""
+        return self.motors_table.limits(SI)
+
+    @property
+    def program_mode(self) -> str:
+        """A program's working mode at its start (``[program].working_mode`` or the
+        robot's)."""
+        return self.program_table.working_mode or self.mode
+
+    @property
+    def program_start(self) -> tuple[float, float]:
+        """``[program].start`` in m."""
+        start = self.program_table.start
+        if start is None:
+            raise ConfigError("config key [program].start is required (the start point, at "
+                              "rest)")
+        return (SI.length(start[0]), SI.length(start[1]))
+
+    def program_request(self) -> ProgramRequest:
+        """The program of a task file (``[program]``, ``[[move]]``, ``[motors]``) in SI."""
+        if not self.moves:
+            raise ConfigError("the task has no move: add [[move]] tables")
+        m = self.si_model
+        return ProgramRequest(m.robot, m.inertia, self.moves, self.program_start,
+                              self.program_mode, self.assembly, self.si_motors,
+                              self.motors_table.rms_torque, self.output.servo_rate_hz,
+                              self.program_table.grid, self.tolerances)
+
+    def design_task(self, *, samples: int | None = None, seed: int | None = None
+                    ) -> tuple[Task, DesignSpace]:
+        """A sweep's :class:`~dextar.design.evaluate.Task` and design space: a program task
+        (``[program]`` and ``[[move]]``) or a run task (``[path]`` and ``[law]``; a law that
+        does not depend on the robot is computed once here), in SI."""
+        from .design_task import design_task
+
+        return design_task(self, samples=samples, seed=seed)
+
+    def model_file(self, robot_mm: FiveBar, mode: str, inertia: Inertia, comment: str) -> str:
+        """A config file of ``inertia`` (SI) on ``robot_mm`` with this scenario's friction
+        speed and gravity and its ``[motors]`` and ``[tolerances]`` as the file gives them
+        (``identified.toml``, ``best.toml``)."""
+        from ..output.config_file import model_toml
+
+        return model_toml(robot_mm, mode, self.assembly, inertia,
+                          coulomb_speed_deg_s=self.friction_table.coulomb_speed_deg_s,
+                          gravity_mm_s2=self.gravity_table.vector,
+                          extra=self.raw("motors", "tolerances"), comment=comment)
 
     def law(self, kind: str | None = None) -> Law:
         """The configured law, or the registered law ``kind`` with its defaults and the
@@ -202,14 +324,19 @@ class Scenario:
                                  tolerances=self.tolerances, units=self.units)
 
 
-def scenario_from_dict(doc: Mapping[str, Any]) -> Scenario:
+def scenario_from_dict(doc: Mapping[str, Any], *, source: str | None = None,
+                       text: bytes = b"") -> Scenario:
     """A :class:`Scenario` from a parsed config (tables as in ``examples/paper.toml``); every
     table is validated at this boundary, errors naming ``[table].key``."""
     check_tables({k: v for k, v in doc.items() if k != "move"}, set(TABLES) | {"move"})
     tables = {name: cls.from_toml(doc.get(name, {})) for name, cls in TABLES.items()}
     program = tables["program"]
-    assert isinstance(program, ProgramTable)
-    sc = Scenario(tables, moves=tuple(read_moves(doc.get("move"), program)))
+    if not isinstance(program, ProgramTable):
+        raise TypeError("table [program] is not a ProgramTable")
+    sc = Scenario(tables, moves=tuple(read_moves(doc.get("move"), program)), doc=dict(doc),
+                  text=text)
+    if source is not None:
+        sc = Scenario(sc.tables, source, sc.moves, sc.doc, text)
     try:  # build the run's objects now: a bad value fails here, named by its table
         _ = (sc.units, sc.robot, sc.path, sc.inertia)
     except ConfigError:
@@ -220,10 +347,22 @@ def scenario_from_dict(doc: Mapping[str, Any]) -> Scenario:
 
 
 def load_scenario(path: str | FilePath | None = None) -> Scenario:
-    """Read a config file (or none: the paper's example) into a :class:`Scenario`."""
-    doc = {} if path is None else load_toml(path)
-    sc = scenario_from_dict(doc)
-    return sc if path is None else replace(sc, source=str(path))
+    """Read a config file (or none: the paper's example) into a :class:`Scenario`; the file
+    is read once."""
+    if path is None:
+        return scenario_from_dict({})
+    doc, text = read_config(path)
+    return scenario_from_dict(doc, source=str(path), text=text)
+
+
+def load_robot_table(path: str | FilePath | None) -> RobotTable:
+    """``[robot]`` of a config file (every table's name checked; the DexTAR without a
+    file)."""
+    if path is None:
+        return RobotTable()
+    doc, _ = read_config(path)
+    check_tables({k: v for k, v in doc.items() if k != "move"}, set(TABLES) | {"move"})
+    return RobotTable.from_toml(doc.get("robot", {}))
 
 
 def default_scenario() -> Scenario:

@@ -21,15 +21,15 @@ from ..dynamics.friction import DEFAULT_COULOMB_SPEED_DEG_S
 from ..errors import ConfigError, DextarError
 from ..geometry import DEXTAR_MM, FiveBar, canonical_working_mode, parse_assembly_mode, preset
 from ..kinematics.checker import Tolerances
-from ..laws import LawType, MotorLimits, law_type
+from ..laws import LawType, law_type
+from ..motors import MotorLimits
+from ..output.run import FIGURES as FIGURES
 from ..params import Param, read_params, to_run_units
 from ..paths import Path, PathType, path_type
 from ..units import Units
 
 T = TypeVar("T", bound="Table")
 
-#: Figures a run can draw (``[output].figures``).
-FIGURES = ("fig3", "fig4", "fig5", "fig6", "fig7", "fig8", "fig9", "workspace", "animation")
 #: Most samples a run writes (a 200 s motion at 1 kHz).
 MAX_SAMPLES = 200_000
 
@@ -279,15 +279,16 @@ class ControlTable(Table):
     NAME: ClassVar[str] = "control"
     PARAMS: ClassVar[dict[str, Param]] = {
         "natural_frequency_hz": Param("number", "", 10.0, "closed-loop natural frequency, Hz",
-                                      positive=True),
-        "damping": Param("number", "", 1.0, "damping ratio", positive=True),
+                                      positive=True, maximum=1000.0),
+        "damping": Param("number", "", 1.0, "damping ratio", positive=True, maximum=100.0),
         "mass_error": Param("number", "", 0.2, "the plant's masses are (1 + this) times the "
-                            "model's", minimum=-0.99),
+                            "model's", minimum=-0.99, maximum=100.0),
         "payload": Param("number", "kg", None, "payload unknown to the controller (default "
-                         "0.1 of the end-effector mass)", minimum=0.0),
+                         "0.1 of the end-effector mass)", minimum=0.0, maximum=1e4),
         "torque_limit": Param("number", "N m", None, "saturation of each motor",
-                              positive=True),
-        "initial_error_deg": Param("point", "", (0.0, 0.0), "initial joint error [deg, deg]"),
+                              positive=True, maximum=1e6),
+        "initial_error_deg": Param("point", "", (0.0, 0.0), "initial joint error [deg, deg], "
+                                   "each within +-90"),
     }
 
     natural_frequency_hz: float = 10.0
@@ -296,6 +297,15 @@ class ControlTable(Table):
     payload: float | None = None
     torque_limit: float | None = None
     initial_error_deg: tuple[float, float] = (0.0, 0.0)
+
+    @classmethod
+    def from_toml(cls, raw: Mapping[str, object]) -> ControlTable:
+        """Read ``[control]``; the initial error is at most 90 deg per joint."""
+        t = cls(**read_params(cls.NAME, raw, cls.PARAMS))
+        if any(abs(v) > 90.0 for v in t.initial_error_deg):
+            raise ConfigError(f"config key [control].initial_error_deg "
+                              f"{list(t.initial_error_deg)} must be within +-90 deg per joint")
+        return t
 
     def run_values(self, units: Units, effector_kg: float) -> dict[str, Any]:
         """The controller's settings in run units (and their config values)."""
@@ -338,7 +348,9 @@ class OutputTable(Table):
         "units": Param("choice", "", "paper", "paper or si", choices=("paper", "si")),
         "samples": Param("integer", "", 1001, "samples written", minimum=2,
                          maximum=MAX_SAMPLES),
-        "figures": Param("text", "", None, "figures to draw"),  # a list: read below
+        "figures": Param("text", "", None, "figures to draw (default: all that apply: the "
+                         "paper's example all; another task without fig3 and fig7, which "
+                         "are about the paper's own example)"),  # a list: read below
         "animation_frames": Param("integer", "", 41, "frames of the animation", minimum=2,
                                   maximum=1000),
         "servo_rate_hz": Param("number", "", 1000.0, "setpoint rate of a program, Hz",
@@ -347,7 +359,7 @@ class OutputTable(Table):
 
     units: str = "paper"
     samples: int = 1001
-    figures: tuple[str, ...] = FIGURES
+    figures: tuple[str, ...] | None = None
     animation_frames: int = 41
     servo_rate_hz: float = 1000.0
 
@@ -356,7 +368,9 @@ class OutputTable(Table):
         """Read ``[output]``; ``figures`` is a list of figure names."""
         rest = {k: v for k, v in raw.items() if k != "figures"}
         t = read_params(cls.NAME, rest, cls.PARAMS)
-        figures = raw.get("figures", list(FIGURES))
+        figures = raw.get("figures")
+        if figures is None:
+            return cls(**t)
         if not isinstance(figures, list):
             raise ConfigError(f"config key [output].figures must be a list, got "
                               f"{type(figures).__name__} {figures!r}")

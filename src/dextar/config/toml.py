@@ -11,18 +11,27 @@ from typing import Any
 from ..errors import ConfigError
 
 
-def load_toml(path: str | Path) -> dict[str, Any]:
-    """Read a TOML file; a missing file or a syntax error becomes a :class:`ConfigError`."""
+def read_config(path: str | Path) -> tuple[dict[str, Any], bytes]:
+    """A TOML config file parsed, and its bytes; a missing file, an unreadable one or a
+    syntax error becomes a :class:`ConfigError` naming the file."""
     p = Path(path)
     try:
-        with p.open("rb") as fh:
-            return tomllib.load(fh)
+        text = p.read_bytes()
     except FileNotFoundError:
         raise ConfigError(f"config file {str(p)!r} does not exist") from None
+    except OSError as exc:
+        raise ConfigError(f"config file {str(p)!r} cannot be read: {exc}") from None
+    try:
+        return tomllib.loads(text.decode("utf-8")), text
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"config file {str(p)!r} is not valid TOML: {exc}") from None
-    except (OSError, UnicodeDecodeError) as exc:
+    except UnicodeDecodeError as exc:
         raise ConfigError(f"config file {str(p)!r} cannot be read: {exc}") from None
+
+
+def load_toml(path: str | Path) -> dict[str, Any]:
+    """Read a TOML file; a missing file or a syntax error becomes a :class:`ConfigError`."""
+    return read_config(path)[0]
 
 
 def check_tables(doc: Mapping[str, Any], known: Set[str]) -> None:

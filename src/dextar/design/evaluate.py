@@ -22,9 +22,10 @@ from ..geometry import FiveBar
 from ..kinematics import jacobian, workspace_map
 from ..kinematics.checker import Tolerances, pose_distances
 from ..kinematics.workspace import inverse_condition
-from ..laws import Law, LawRequest, MotorLimits, law_type
+from ..laws import Law, LawRequest, law_type
+from ..motors import MotorLimits
 from ..paths import Path
-from ..program import Move, ProgramResult, plan_program, sizing
+from ..program import Move, ProgramRequest, ProgramResult, sizing
 from ..trajectory import check_path, sample_trajectory
 from ..units import SI
 from .space import LENGTHS, METRICS
@@ -42,15 +43,16 @@ class Task:
     Attributes
     ----------
     moves : tuple of Move
-    start_mm : (float, float)
+    start : (float, float)
+        The start point (m).
     working_mode, assembly : str
     motors : MotorLimits, optional
     rms_limit : (float, float), optional
     template : Inertia
-        Effector, payload, rotors, friction and gravity; its rods are kept when
-        ``mass_per_length`` is None.
+        Effector, payload, rotors, friction and gravity, and the rods of ``robot``.
     mass_per_length : (float, float), optional
-        kg/m of the proximal and distal rods.
+        kg/m of the proximal and distal rods (uniform rods); None: each rod of the template
+        keeps its linear density and its shape on another length (see :func:`inertia_of`).
     grid : int
         Time-optimal grid of each move.
     tolerances : Tolerances
@@ -64,10 +66,12 @@ class Task:
         That law's keys (SI).
     samples : int
         Samples along a run task's path.
+    robot : FiveBar, optional
+        The task's own robot (m), whose rods the template holds.
     """
 
     moves: tuple[Move, ...]
-    start_mm: tuple[float, float]
+    start: tuple[float, float]
     working_mode: str
     assembly: str
     motors: MotorLimits | None
@@ -81,6 +85,7 @@ class Task:
     law_type: str | None = None
     law_values: Mapping[str, Any] | None = None
     samples: int = 201
+    robot: FiveBar | None = None
 
     @property
     def kind(self) -> str:
@@ -95,13 +100,28 @@ def footprint_mm(lengths: Sequence[float]) -> float:
 
 
 def inertia_of(task: Task, robot: FiveBar) -> Inertia:
-    """The task's inertia on ``robot`` (m): uniform rods of ``mass_per_length`` when given."""
-    if task.mass_per_length is None:
+    """The task's inertia on ``robot`` (m): uniform rods of ``mass_per_length`` when given;
+    otherwise each rod of the task's robot scaled to its new length ``L' = k L`` keeping its
+    linear density and shape: mass ``k m``, centre of mass at the same fraction of the rod
+    (``k c``), inertia about the centre ``k^3 I`` (it scales as ``m L^2``). The effector, the
+    payload and the rotors stay as given."""
+    if task.mass_per_length is not None:
+        mp, md = task.mass_per_length
+        return task.template.with_(
+            proximal=(Rod.uniform(mp * robot.l1, robot.l1),
+                      Rod.uniform(mp * robot.l2, robot.l2)),
+            distal=(Rod.uniform(md * robot.L1, robot.L1), Rod.uniform(md * robot.L2, robot.L2)))
+    if task.robot is None:
         return task.template
-    mp, md = task.mass_per_length
+    old = task.robot
+
+    def scaled(rod: Rod, k: float) -> Rod:
+        return Rod(rod.mass * k, rod.com * k, rod.inertia * k**3)
+
+    p, d = task.template.proximal, task.template.distal
     return task.template.with_(
-        proximal=(Rod.uniform(mp * robot.l1, robot.l1), Rod.uniform(mp * robot.l2, robot.l2)),
-        distal=(Rod.uniform(md * robot.L1, robot.L1), Rod.uniform(md * robot.L2, robot.L2)))
+        proximal=(scaled(p[0], robot.l1 / old.l1), scaled(p[1], robot.l2 / old.l2)),
+        distal=(scaled(d[0], robot.L1 / old.L1), scaled(d[1], robot.L2 / old.L2)))
 
 
 def usable_area_mm2(robot_mm: FiveBar, mode: str, start_mm: Sequence[float],
@@ -150,7 +170,8 @@ def evaluate_design(task: Task, lengths: Sequence[float]) -> dict[str, Any]:
     except DextarError as exc:
         row["reason"] = str(exc)
         return row
-    motors, violations = sizing(res)
+    size = sizing(res)
+    mA, mD = size.motors
     d = pose_distances(robot, res.q, res.P)
     J = jacobian(robot, res.q, res.P, tol=0.0)
     dex = inverse_condition(J[:, 0, 0], J[:, 0, 1], J[:, 1, 0], J[:, 1, 1])
@@ -158,17 +179,16 @@ def evaluate_design(task: Task, lengths: Sequence[float]) -> dict[str, Any]:
         "cycle_time_s": res.cycle_time_s,
         "min_type1_distance": float(d.type1.min()), "min_type2_distance": float(d.type2.min()),
         "gci": float(np.mean(dex)),
-        "peak_torque_A_Nm": motors[0]["peak_torque_Nm"],
-        "peak_torque_D_Nm": motors[1]["peak_torque_Nm"],
-        "rms_torque_A_Nm": motors[0]["rms_torque_Nm"],
-        "rms_torque_D_Nm": motors[1]["rms_torque_Nm"],
-        "workspace_area_mm2": usable_area_mm2(robot_mm, task.working_mode, task.start_mm,
+        "peak_torque_A_Nm": mA.peak_torque_Nm, "peak_torque_D_Nm": mD.peak_torque_Nm,
+        "rms_torque_A_Nm": mA.rms_torque_Nm, "rms_torque_D_Nm": mD.rms_torque_Nm,
+        "workspace_area_mm2": usable_area_mm2(robot_mm, task.working_mode,
+                                              [1e3 * v for v in task.start],
                                               task.tolerances.type2)})
-    if violations:
-        v = violations[0]
-        where = f" at t = {v['t_s']:.4g} s in move {v['move']}" if v["t_s"] is not None else ""
-        row["reason"] = (f"motors exceeded: motor {v['motor']} {v['quantity']} "
-                         f"{v['value']:.4g} above {v['limit']:.4g}{where}")
+    if size.violations:
+        v = size.violations[0]
+        where = f" at t = {v.t_s:.4g} s in move {v.move}" if v.t_s is not None else ""
+        row["reason"] = (f"motors exceeded: motor {v.motor} {v.quantity} "
+                         f"{v.value:.4g} above {v.limit:.4g}{where}")
         return row
     for k in METRICS:
         if not math.isfinite(float(row[k])):
@@ -183,11 +203,9 @@ def _plan(task: Task, robot: FiveBar) -> ProgramResult:
     one-move result with the same fields)."""
     inertia = inertia_of(task, robot)
     if task.path is None:
-        return plan_program(robot, inertia, task.moves, start=task.start_mm,
-                            working_mode=task.working_mode, assembly=task.assembly,
-                            motors=task.motors, rms_limit=task.rms_limit,
-                            servo_rate_hz=SWEEP_RATE_HZ, grid=task.grid,
-                            tolerances=task.tolerances)
+        return ProgramRequest(robot, inertia, task.moves, task.start, task.working_mode,
+                              task.assembly, task.motors, task.rms_limit, SWEEP_RATE_HZ,
+                              task.grid, task.tolerances).plan()
     model = Model(robot, inertia, task.assembly, tol=task.tolerances.type2)
     law = task.law
     if law is None:  # a law planned on the robot (time-optimal)

@@ -115,6 +115,12 @@ class DesignSpace:
                 out[:, c] = lo + (hi - lo) * u[:, j]
         return out
 
+    @property
+    def varied_axes(self) -> list[tuple[int, str]]:
+        """One ``(column of LENGTHS, label)`` per varied dimension: lengths tied to one range
+        (``l``: both proximal rods) are one axis, ``"l1 = l2"``."""
+        return sorted((cs[0], " = ".join(LENGTHS[c] for c in cs)) for *_, cs in self.dims)
+
     def objective_values(self, rows: list[dict[str, float]]) -> Array:
         """The objectives of ``rows`` to minimise, shape (n, n_objectives)."""
         F = np.empty((len(rows), len(self.objectives)))

@@ -1,6 +1,6 @@
 """The exact closed-chain dynamics along a path, for laws planned under motor limits.
 
-:class:`RobotAlongPath` implements :class:`dextar.laws.time_optimal.PathDynamics`: the
+:class:`RobotAlongPath` implements :class:`dextar.laws.constraints.PathDynamics`: the
 coefficients ``a = M q'``, ``b = M q'' + c(q, q')``, ``g`` of the path dynamics on a grid of
 arc lengths (from the joint path ``q(s)`` of the inverse kinematics), and the torque and speed
 ratios of a law through the exact model with gravity and friction.
@@ -8,19 +8,16 @@ ratios of a law through the exact model with gravity and friction.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from .._arrays import Array
 from ..kinematics import direct_kinematics
 from ..laws import Law, UniformLaw
-from ..laws.time_optimal import (
-    MotorLimits,
-    PathCoefficients,
-    TimeOptimalLaw,
-    solve_time_optimal_law,
-)
+from ..laws.constraints import JointSamples, PathCoefficients
+from ..laws.time_optimal import TimeOptimalLaw, solve_time_optimal_law
+from ..motors import MotorLimits
 from ..paths import Path
 from ..trajectory import JointLine, sample_trajectory
 from ..units import Units
@@ -54,18 +51,22 @@ class RobotAlongPath:
         jp = sample_trajectory(self.model.robot, self.path, UniformLaw(S, S), mode=self.mode,
                                times=np.asarray(s, float), units=self.units,
                                checked=self.checked)
-        robot, ine = self.model.robot, self.model.inertia
-        a, b, g = path_dynamics(Model(robot, ine, jp.assembly), jp.q, jp.dq, jp.ddq)
+        ine = self.model.inertia
+        a, b, g = path_dynamics(self._model(jp.assembly), jp.q, jp.dq, jp.ddq)
         return PathCoefficients(jp.t, jp.P, a, b, g, jp.dq, np.array(ine.coulomb, float),
                                 np.array(ine.viscous, float))
 
-    def ratios(self, law: Law, times: Array, motors: MotorLimits) -> tuple[float, float]:
-        """Largest torque and speed ratios of ``law`` at ``times`` (exact model)."""
+    def _model(self, assembly: str) -> Model:
+        """The model in the assembly mode the path's poses are in (its own tolerance)."""
+        return self.model if assembly == self.model.assembly else replace(self.model,
+                                                                          assembly=assembly)
+
+    def samples(self, law: Law, times: Array) -> JointSamples:
+        """``law`` at ``times`` through the exact model."""
         tr = sample_trajectory(self.model.robot, self.path, law, mode=self.mode, times=times,
                                checked=False)  # the path was checked by coefficients()
-        tau = inverse_dynamics(Model(self.model.robot, self.model.inertia, tr.assembly), tr.q,
-                               tr.dq, tr.ddq)
-        return motors.ratios(tau, tr.dq)
+        tau = inverse_dynamics(self._model(tr.assembly), tr.q, tr.dq, tr.ddq)
+        return JointSamples(tau, tr.dq)
 
 
 def time_optimal_law(model: Model, path: Path, *,
@@ -84,7 +85,7 @@ def time_optimal_law(model: Model, path: Path, *,
 @dataclass(frozen=True)
 class RobotAlongJointLine:
     """A robot model following a straight line in joint space (a joint move): ``q' = u``
-    constant, ``q'' = 0``; implements :class:`~dextar.laws.time_optimal.PathDynamics`."""
+    constant, ``q'' = 0``; implements :class:`~dextar.laws.constraints.PathDynamics`."""
 
     model: Model
     line: JointLine
@@ -101,16 +102,20 @@ class RobotAlongJointLine:
         q = self.line.at(s)
         u = np.broadcast_to(self.line.direction, q.shape).copy()
         robot, ine = self.model.robot, self.model.inertia
-        a, b, g = path_dynamics(Model(robot, ine, self.model.assembly, tol=0.0), q, u,
-                                np.zeros_like(u))
+        a, b, g = path_dynamics(self._free, q, u, np.zeros_like(u))
         P = direct_kinematics(robot, q, self.model.assembly)
         return PathCoefficients(s, P, a, b, g, u, np.array(ine.coulomb, float),
                                 np.array(ine.viscous, float))
 
-    def ratios(self, law: Law, times: Array, motors: MotorLimits) -> tuple[float, float]:
-        """Largest torque and speed ratios of ``law`` at ``times`` (exact model)."""
+    def samples(self, law: Law, times: Array) -> JointSamples:
+        """``law`` at ``times`` through the exact model."""
         s, ds, dds, _ = law.evaluate(times)
         u = self.line.direction
         q, dq, ddq = self.line.at(s), ds[:, None] * u, dds[:, None] * u
-        model = Model(self.model.robot, self.model.inertia, self.model.assembly, tol=0.0)
-        return motors.ratios(inverse_dynamics(model, q, dq, ddq), dq)
+        return JointSamples(inverse_dynamics(self._free, q, dq, ddq), dq)
+
+    @property
+    def _free(self) -> Model:
+        """The model without a singularity tolerance: a joint line may pass serial
+        singularities, and its parallel-singularity check is the trajectory's."""
+        return replace(self.model, tol=0.0)

@@ -10,12 +10,14 @@ from __future__ import annotations
 import math
 from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
 from .._arrays import Array
 from ..errors import ParameterError
 from ..paths import Path
+from ..units import Units
 
 
 def _positive(name: str, value: float) -> float:
@@ -48,6 +50,22 @@ class Law(ABC):
     def breakpoints(self) -> Array:
         """Times inside ``(0, duration)`` where the acceleration jumps (none by default)."""
         return np.empty(0)
+
+    @property
+    def torque_limit(self) -> tuple[float, float] | None:
+        """The motors' torque limits the law was planned within (run units; None for a law
+        that does not plan on the dynamics)."""
+        return None
+
+    def report(self, units: Units) -> dict[str, Any]:
+        """The law's own quantities for a run's summary (run units unless the key says
+        otherwise); none by default."""
+        return {}
+
+    def cost_report(self) -> dict[str, float] | None:
+        """The paper's functional when the law minimises it (``total``, ``kinetic``,
+        ``inertial``); None for the other laws."""
+        return None
 
     @abstractmethod
     def _evaluate(self, t: Array) -> Array:
@@ -120,7 +138,9 @@ class TrapezoidalLaw(Law):
 
     With ``duration=None`` the law is the fastest one within the limits (a triangle when
     ``vmax`` is not reached); with a duration the cruise speed is chosen to arrive at exactly
-    that time, which must be feasible with ``amax`` and ``vmax``. Read-only once built.
+    that time, which must be feasible with ``amax`` and ``vmax`` (``vmax`` may be ``inf``).
+    :meth:`shaped` gives the trapezoid of a duration that accelerates for a given fraction of
+    it. Read-only once built.
     """
 
     name = "trapezoid"
@@ -129,14 +149,18 @@ class TrapezoidalLaw(Law):
                  duration: float | None = None) -> None:
         """Plan the profile; raises :class:`ParameterError` when the duration is infeasible."""
         S = _positive("distance", distance)
-        vm = _positive("vmax", vmax)
+        vm = float(vmax) if vmax == math.inf else _positive("vmax", vmax)
         a = _positive("amax", amax)
         if duration is None:
+            if vm == math.inf:
+                raise ParameterError("trapezoid: the fastest law needs a finite vmax")
             v = min(vm, math.sqrt(S * a))
             T = S / v + v / a
         else:
             T = _positive("duration", duration)
             disc = a * a * T * T - 4 * a * S
+            if -1e-12 * a * a * T * T <= disc < 0:  # a triangle, up to rounding
+                disc = 0.0
             if disc < 0:
                 tmin = 2 * math.sqrt(S / a)
                 raise ParameterError(f"trapezoid: distance {S:.6g} cannot be covered in "
@@ -157,6 +181,23 @@ class TrapezoidalLaw(Law):
     def __repr__(self) -> str:
         return (f"TrapezoidalLaw(distance={self.distance!r}, vmax={self.vmax!r}, "
                 f"amax={self.amax!r}, duration={self.duration!r})")
+
+    @classmethod
+    def shaped(cls, distance: float, duration: float, accel_fraction: float) -> TrapezoidalLaw:
+        """The trapezoid of ``duration`` that accelerates during ``accel_fraction`` of it (in
+        (0, 1/2]; 1/3: a third accelerating, a third cruising, a third braking), so its shape
+        only stretches with the duration."""
+        S, T, rho = (_positive(n, v) for n, v in (("distance", distance),
+                                                   ("duration", duration),
+                                                   ("accel_fraction", accel_fraction)))
+        if rho > 0.5:
+            raise ParameterError(f"accel_fraction {rho!r} must be at most 1/2")
+        v = S / ((1.0 - rho) * T)
+        return cls(S, v * (1.0 + 1e-12), v / (rho * T), T)
+
+    def report(self, units: Units) -> dict[str, Any]:
+        """The limits and the cruise speed (run units)."""
+        return {"vmax": self.vmax, "amax": self.amax, "cruise_speed": self.cruise}
 
     def breakpoints(self) -> Array:
         """The ends of the acceleration and deceleration phases."""
@@ -202,8 +243,70 @@ def _curvature_at_s(path: Path, s: Array) -> Array:
     return np.asarray(path.curvature(path.parameter_at(s))[0])
 
 
+def _trapezoid(r: Any) -> TrapezoidalLaw:
+    """The registered trapezoid: the fastest within vmax and amax, or the one of a duration
+    (within vmax and amax when given, else a third of it accelerating); errors in the
+    config's units."""
+    S, p, u = r.path.length, r.params, r.units
+    vmax, amax, T = p.get("vmax"), p.get("amax"), p.get("duration")
+    speed, accel = u.length_mm / u.time_s, u.length_mm / u.time_s**2
+    if T is None and (vmax is None or amax is None):
+        raise ParameterError("the trapezoid law needs vmax and amax (the fastest law within "
+                             "them) or a duration (or, in a program, duration = \"fit\")")
+    if T is not None and amax is None:
+        amax = 4.5 * S / T**2  # a third of the time accelerating
+    try:
+        return TrapezoidalLaw(S, math.inf if vmax is None else vmax, amax, T)
+    except ParameterError:
+        T_ = float(T) * u.time_s
+        tmin = 2 * math.sqrt(S / amax) * u.time_s
+        raise ParameterError(
+            f"trapezoid: {u.mm(S):.6g} mm cannot be covered in {T_:.6g} s with amax "
+            f"{amax * accel:.6g} mm/s^2" + ("" if vmax is None else
+                                             f" and vmax {vmax * speed:.6g} mm/s")
+            + f" (it needs at least {tmin:.6g} s with that amax)") from None
+
+
+def _fit_trapezoid(r: Any, shortest: Any) -> TrapezoidalLaw:
+    """The shortest trapezoid within the motors and the given vmax and amax: for each
+    fraction ``rho`` of the time spent accelerating the shape only stretches with the
+    duration, so its shortest duration is a one-dimensional search, bounded below by vmax
+    (``T >= S / ((1 - rho) vmax)``) and amax (``T^2 >= S / (rho (1 - rho) amax)``); the
+    fraction is chosen by golden-section search (the duration is unimodal in it: the torque
+    limits favour a longer acceleration, the speed limits a shorter one)."""
+    S, p = r.path.length, r.params
+    vmax, amax = p.get("vmax"), p.get("amax")
+
+    def duration(rho: float) -> float:
+        t_min = 0.0
+        if vmax is not None:
+            t_min = max(t_min, S / ((1.0 - rho) * vmax))
+        if amax is not None:
+            t_min = max(t_min, math.sqrt(S / (rho * (1.0 - rho) * amax)))
+        return float(shortest(lambda T: TrapezoidalLaw.shaped(S, T, rho), t_min))
+
+    lo, hi = 0.02, 0.5
+    g = (math.sqrt(5.0) - 1.0) / 2.0
+    a, b = hi - g * (hi - lo), lo + g * (hi - lo)
+    fa, fb = duration(a), duration(b)
+    for _ in range(12):  # the fraction to ~1e-3: the duration is flat at its minimum
+        if fa <= fb:
+            hi, b, fb = b, a, fa
+            a = hi - g * (hi - lo)
+            fa = duration(a)
+        else:
+            lo, a, fa = a, b, fb
+            b = lo + g * (hi - lo)
+            fb = duration(b)
+    rho, T = (a, fa) if fa <= fb else (b, fb)
+    T_triangle = duration(0.5)  # the bracket's end (no cruise), which the search never meets
+    if T_triangle < T:
+        rho, T = 0.5, T_triangle
+    return TrapezoidalLaw.shaped(S, T, rho)
+
+
 def _register() -> None:
-    from ..params import REQUIRED, Param
+    from ..params import Param
     from .registry import LawType, register_law
 
     duration = Param("number", "s", 1.0, "motion time", positive=True)
@@ -215,13 +318,12 @@ def _register() -> None:
                          "rest-to-rest quintic, minimum jerk"))
     register_law(LawType(
         "trapezoid",
-        {"vmax": Param("number", "mm/s", REQUIRED, "cruise speed limit", positive=True),
-         "amax": Param("number", "mm/s^2", REQUIRED, "acceleration", positive=True),
-         "duration": Param("number", "s", None, "motion time (default: the fastest)",
-                           positive=True)},
-        lambda r: TrapezoidalLaw(r.path.length, r.params["vmax"], r.params["amax"],
-                                 r.params.get("duration")),
-        "trapezoidal speed: accelerate, cruise, decelerate"))
+        {"vmax": Param("number", "mm/s", None, "cruise speed limit", positive=True),
+         "amax": Param("number", "mm/s^2", None, "acceleration", positive=True),
+         "duration": Param("number", "s", None, "motion time (default: the fastest within "
+                           "vmax and amax)", positive=True)},
+        _trapezoid, "trapezoidal speed: accelerate, cruise, decelerate (vmax and amax, or a "
+        "duration: then a third accelerating unless amax is given)", fit=_fit_trapezoid))
 
 
 _register()

@@ -53,6 +53,7 @@ from scipy.interpolate import make_interp_spline
 from .._arrays import Array
 from ..errors import ConvergenceError, ParameterError
 from ..paths import Path
+from ..units import Units
 from .base import Law, _positive, law_cost
 
 
@@ -473,6 +474,14 @@ class OptimalLaw(Law):
     def cost(self) -> float:
         """The functional ``Phi``, kinetic plus inertial part."""
         return self.kinetic + self.inertial
+
+    def cost_report(self) -> dict[str, float]:
+        """The functional it minimises: total, kinetic and inertial parts."""
+        return {"total": self.cost, "kinetic": self.kinetic, "inertial": self.inertial}
+
+    def report(self, units: Units) -> dict[str, Any]:
+        """``eta`` (run units), the ODE residual and the collocation nodes."""
+        return {"eta": self.eta, "ode_residual": self.residual, "nodes": self.nodes}
 
     def cost_parts(self, path: Path, mass: float, eta: float) -> tuple[float, float]:
         """The functional's two parts (stored when ``mass`` and ``eta`` are the law's own)."""

@@ -53,6 +53,11 @@ class LawRequest:
     motors: Any = None
 
 
+#: ``shortest(family, t_min) -> T``: the shortest duration ``T >= t_min`` for which the law
+#: ``family(T)`` stays within the motors (given by the planner that fits a duration).
+Shortest = Callable[[Callable[[float], Law], float], float]
+
+
 @dataclass(frozen=True)
 class LawType:
     """A registered law.
@@ -69,6 +74,12 @@ class LawType:
         One line for the docs.
     needs_dynamics : bool
         The law is planned on the robot's dynamics (motor limits): the request carries them.
+    fit : callable, optional
+        How the law's shortest duration within the motors is found (``duration = "fit"`` in
+        a program), for a law with more shapes than one per duration:
+        ``fit(request, shortest) -> Law``, where ``shortest(family, t_min)`` is the shortest
+        duration ``T >= t_min`` for which ``family(T)`` stays within the motors. Without it,
+        the law's own duration is fitted.
     """
 
     name: str
@@ -76,6 +87,7 @@ class LawType:
     build: Callable[[LawRequest], Law]
     help: str = ""
     needs_dynamics: bool = False
+    fit: Callable[[LawRequest, Shortest], Law] | None = None
 
 
 LAW_TYPES: dict[str, LawType] = {}

@@ -1,26 +1,16 @@
-"""Time-optimal law of motion along a path under motor torque and speed limits.
+"""Time-optimal law of motion along a path within the limits of the robot's dynamics.
 
 The solver needs the robot's dynamics along the path only through the small
-:class:`PathDynamics` interface (implemented for the exact closed-chain model by
-:class:`dextar.dynamics.along_path.RobotAlongPath`), so this module, like every law, sits
-below the trajectory and dynamics stages. ``dextar.dynamics.time_optimal_law(model, path,
-...)`` is the one-call form.
+:class:`~dextar.laws.constraints.PathDynamics` interface (implemented for the exact
+closed-chain model by :class:`dextar.dynamics.along_path.RobotAlongPath`), so this module,
+like every law, sits below the trajectory and dynamics stages; the limits are constraint
+objects (:mod:`dextar.laws.constraints`: torque, speed, torque-speed envelope) that a caller
+composes. ``dextar.dynamics.time_optimal_law(model, path, ...)`` is the one-call form.
 
-Along the path (arc length ``s``) the joint motion is ``qdot = q' sdot`` and
-``qddot = q' sddot + q'' sdot^2``, so with ``x = sdot^2`` and ``u = sddot`` the exact inverse
-dynamics are affine in ``(x, u)`` up to friction:
-
-    tau(s) = a(s) u + b(s) x + g(s) + f(s, sdot),
-    a = M q',  b = M q'' + c(q, q'),  g = gravity,  f = friction (viscous + Coulomb).
-
-Friction is bounded, not linearised: the regularised Coulomb torque (see
-:mod:`dextar.dynamics.friction`) always lies between 0 and ``coulomb * sign(q')``, and the
-viscous torque ``viscous q' sqrt(x)`` between 0 and its tangent upper bound at the previous
-iterate's speed (the first tangent at the motors' speed limits), so the limits are enforced
-for every friction value in that interval (both ends of the interval are rows of the linear
-programme); a torque-speed envelope is bounded by the same tangents. Where a joint reverses
-along the path the interval is ``[-coulomb, coulomb]``; at the two rest points friction is
-zero. The iterates are solved until the tangent settles (:data:`TANGENT_RTOL`).
+With ``x = sdot^2`` and ``u = sddot`` every constraint is a set of linear rows in ``(u, x)``
+at each grid point (or a cap on ``x``); the speed-dependent bounds (viscous friction, the
+torque-speed envelope) are tangents at a tangent point, first at the motors' speed limits,
+then at the previous iterate's speeds, until the tangent settles (:data:`TANGENT_RTOL`).
 
 The solver is reachability analysis (TOPP-RA, Pham & Pham 2018) with the *interpolation*
 discretisation on a grid of arc lengths (equal segments, or finer where the dynamics change
@@ -33,27 +23,38 @@ elimination of ``u``, the static rows precomputed for all points at once), then 
 takes the largest admissible acceleration from rest.
 
 Output check and margin: the settled law is then sampled densely (both ends and seven
-interior points of every segment) through the exact model with friction; if a torque exceeds
-its limit by more than ``tol`` (default 1e-3) or a speed its limit, the limits are tightened
-by the excess and the problem solved again (a few iterations at most). The law reports ``status`` (0: the
-limits hold within ``tol`` on the check samples; 1: they do not after the iterations, with
-the excess in ``message``) and ``max_torque_ratio``. When no motion within the limits exists
-at all, :class:`~dextar.errors.InfeasibleError` names the point, the motor and the torque.
+interior points of every segment) through the exact model with friction; if a constraint of
+a kind (torque, speed) is exceeded by more than ``tol`` (default 1e-3), every constraint of
+that kind is tightened by the excess and the problem solved again (a few iterations at most).
+The law reports ``status`` (0: the limits hold within ``tol`` on the check samples; 1: they do
+not after the iterations, with the excess in ``message``) and ``max_torque_ratio``. When no
+motion within the limits exists at all, :class:`~dextar.errors.InfeasibleError` names the
+point, the motor and the torque.
 """
 
 from __future__ import annotations
 
-import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from functools import cached_property
-from typing import Any, Protocol
+from typing import Any
 
 import numpy as np
 
 from .._arrays import Array
 from ..errors import InfeasibleError, ParameterError
+from ..motors import MotorLimits
 from ..units import Units
 from .base import Law
+from .constraints import (
+    Constraint,
+    PathCoefficients,
+    PathDynamics,
+    Tangent,
+    motor_constraints,
+    point_rows,
+    ratios_by_kind,
+    speed_cap,
+)
 
 #: Greatest number of solves (friction tangent updates and limit margins).
 MAX_SOLVES = 8
@@ -107,6 +108,11 @@ class TimeOptimalLaw(Law):
         """The grid points, where the acceleration jumps."""
         return self.knots_t[1:-1]
 
+    def report(self, units: Units) -> dict[str, Any]:
+        """The torque limits (N m) and the largest torque ratio on the check samples."""
+        return {"torque_limit_Nm": [float(units.torque_in_nm(v)) for v in self.torque_limit],
+                "max_torque_ratio_check_samples": self.max_torque_ratio}
+
     def _evaluate(self, t: Array) -> Array:
         k = np.clip(np.searchsorted(self.knots_t, t, side="right") - 1, 0, self.accel.size - 1)
         tau = t - self.knots_t[k]
@@ -116,120 +122,13 @@ class TimeOptimalLaw(Law):
         return np.stack([s, v + u * tau, u, np.zeros_like(t)])
 
 
-@dataclass(frozen=True)
-class PathCoefficients:
-    """The path dynamics on a grid of arc lengths: ``tau = a u + b x + g + f``.
-
-    Attributes
-    ----------
-    s : ndarray, shape (N + 1,)
-        Arc lengths of the grid, increasing from 0 to the path's length.
-    P : ndarray, shape (N + 1, 2)
-        End-effector positions (for the words of an error).
-    a, b, g : ndarray, shape (N + 1, 2)
-        ``M q'``, ``M q'' + c(q, q')`` and the gravity torques.
-    dq_ds : ndarray, shape (N + 1, 2)
-        ``q'``, the joint rates per unit arc length.
-    coulomb, viscous : ndarray, shape (2,)
-        The motors' friction coefficients.
-    """
-
-    s: Array
-    P: Array
-    a: Array
-    b: Array
-    g: Array
-    dq_ds: Array
-    coulomb: Array
-    viscous: Array
-
-    @cached_property
-    def friction_sides(self) -> tuple[Array, Array]:
-        """Where each joint's friction may push up (forward motion, or a reversal near) and
-        down: two arrays (N + 1, 2) of 1.0 and 0.0, both 0 at the two rest points (where
-        friction is exactly zero)."""
-        sg = np.sign(self.dq_ds)
-        steady = (sg == np.roll(sg, 1, axis=0)) & (sg == np.roll(sg, -1, axis=0)) & (sg != 0)
-        steady[[0, -1]] = (sg[[0, -1]] == sg[[1, -2]]) & (sg[[0, -1]] != 0)
-        up = ((steady & (sg > 0)) | ~steady).astype(float)
-        down = ((steady & (sg < 0)) | ~steady).astype(float)
-        up[[0, -1]] = down[[0, -1]] = 0.0
-        return up, down
-
-
-@dataclass(frozen=True)
-class MotorLimits:
-    """The two motors' limits at the joints (run units): peak torque, maximum speed and,
-    optionally, a torque-speed envelope: full torque up to ``knee_speed``, then linearly
-    down to zero at ``max_speed``.
-
-    Attributes
-    ----------
-    peak_torque : (float, float)
-        Motor at A, motor at D.
-    max_speed : (float, float)
-        ``inf`` for none.
-    knee_speed : (float, float), optional
-        Below ``max_speed``; None for no envelope.
-    """
-
-    peak_torque: tuple[float, float]
-    max_speed: tuple[float, float] = (math.inf, math.inf)
-    knee_speed: tuple[float, float] | None = None
-
-    def __post_init__(self) -> None:
-        t, w = np.asarray(self.peak_torque, float), np.asarray(self.max_speed, float)
-        if t.shape != (2,) or not np.all(np.isfinite(t) & (t > 0)):
-            raise ParameterError(f"torque limits {self.peak_torque!r} must be two positive "
-                                 "numbers")
-        if w.shape != (2,) or not np.all(w > 0):
-            raise ParameterError(f"speed limits {self.max_speed!r} must be two positive numbers")
-        if self.knee_speed is not None:
-            k = np.asarray(self.knee_speed, float)
-            if k.shape != (2,) or not np.all((k > 0) & (k < w)):
-                raise ParameterError(f"knee speeds {self.knee_speed!r} must be positive and below "
-                                     f"the maximum speeds {self.max_speed!r}")
-
-    def available_torque(self, dq: Array) -> Array:
-        """The torque each motor can give at joint rates ``dq`` (..., 2), same shape."""
-        peak = np.asarray(self.peak_torque, float)
-        if self.knee_speed is None:
-            return np.broadcast_to(peak, np.shape(dq)).copy()
-        w, k = np.asarray(self.max_speed, float), np.asarray(self.knee_speed, float)
-        frac = np.clip((w - np.abs(dq)) / (w - k), 0.0, 1.0)
-        return np.asarray(peak * frac)
-
-    def ratios(self, tau: Array, dq: Array) -> tuple[float, float]:
-        """Largest ``|tau| / available torque`` and ``|qdot| / max speed`` over samples (n, 2)."""
-        avail = self.available_torque(dq)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            r = np.where(avail > 0, np.abs(tau) / avail, np.where(np.abs(tau) > 0, np.inf, 0.0))
-        return float(r.max()), float((np.abs(dq) / np.asarray(self.max_speed, float)).max())
-
-
-class PathDynamics(Protocol):
-    """The robot along a path, as the time-optimal law needs it."""
-
-    @property
-    def length(self) -> float:
-        """The path's length."""
-        ...
-
-    def coefficients(self, s: Array) -> PathCoefficients:
-        """The coefficients at the arc lengths ``s`` (N + 1,), from 0 to the length."""
-        ...
-
-    def ratios(self, law: Law, times: Array, motors: MotorLimits) -> tuple[float, float]:
-        """Largest torque and speed ratios of ``law`` at ``times`` against ``motors`` (exact
-        model with gravity and friction)."""
-        ...
-
-
 def solve_time_optimal_law(dynamics: PathDynamics, *,
                            torque_limit: tuple[float, float] | None = None,
                            speed_limit: tuple[float, float] | None = None,
-                           motors: MotorLimits | None = None, grid: int | Array = 400,
-                           tol: float = 1e-3, units: Units | None = None) -> TimeOptimalLaw:
+                           motors: MotorLimits | None = None,
+                           constraints: Sequence[Constraint] | None = None,
+                           grid: int | Array = 400, tol: float = 1e-3,
+                           units: Units | None = None) -> TimeOptimalLaw:
     """The fastest rest-to-rest law along a path within motor torque and speed limits.
 
     Parameters
@@ -242,6 +141,9 @@ def solve_time_optimal_law(dynamics: PathDynamics, *,
         ``|qdot|`` limits of the motors (rad per run time unit).
     motors : MotorLimits, optional
         The limits with a torque-speed envelope (instead of the two above).
+    constraints : sequence of Constraint, optional
+        The limits as constraint objects (instead of the above; see
+        :mod:`dextar.laws.constraints`); one of them must limit the torques.
     grid : int or ndarray, shape (N + 1,)
         Number of equal segments in arc length, or the grid's arc lengths (increasing from 0
         to the path's length; finer where the dynamics change fast, e.g. in a blend).
@@ -261,87 +163,112 @@ def solve_time_optimal_law(dynamics: PathDynamics, *,
         No motion within the limits exists: names the point (mm), the arc length, the motor
         and the torque needed against the limit.
     """
-    if motors is None:
-        if torque_limit is None:
-            raise ParameterError("a time-optimal law needs torque limits (or motors)")
-        t2 = np.broadcast_to(np.asarray(torque_limit, float), (2,))
-        w2 = np.broadcast_to(np.asarray(math.inf if speed_limit is None else speed_limit,
-                                        float), (2,))
-        motors = MotorLimits((float(t2[0]), float(t2[1])), (float(w2[0]), float(w2[1])))
-    tmax = np.asarray(motors.peak_torque, float)
-    wmax = np.asarray(motors.max_speed, float)
-    knee = None if motors.knee_speed is None else np.asarray(motors.knee_speed, float)
+    cons = _constraints(torque_limit, speed_limit, motors, constraints)
     if not (0 < tol < 1):
         raise ParameterError(f"tolerance {tol!r} must be in (0, 1)")
     length = float(dynamics.length)
     s_grid = _grid(grid, length)
-    n = len(s_grid) - 1
     co = dynamics.coefficients(s_grid)
+    tmax = np.asarray(_torque_limit(cons), float)
     _check_holding(co, tmax, units)
     ds = np.diff(co.s)
-    scale_t, scale_w = 1.0, 1.0
+    # the tightening of each kind of limit (the message names torque and speed always)
+    scales = dict.fromkeys(("torque", "speed", *(c.kind for c in cons)), 1.0)
     law: TimeOptimalLaw | None = None
-    has_viscous = bool(np.any(co.viscous > 0)) or knee is not None  # needs a tangent point
-    # the tangent points of the viscous and envelope bounds, first at the speed limits
-    x0 = _speed_limits(co, wmax) if has_viscous else None
+    ratio: dict[str, float] = {}
+    tangent = any(c.needs_tangent(co) for c in cons)  # speed-dependent bounds
+    # the tangent points of the speed-dependent bounds, first at the speed limits
+    x0 = _first_tangent(speed_cap(cons, co)) if tangent else None
+    limits = (_torque_limit(cons), _speed_limit(cons))
     for solve in range(1, MAX_SOLVES + 1):
-        x = _reachability(co, ds, tmax * scale_t, wmax * scale_w, x0, units,
-                          None if knee is None else knee * scale_w)
-        tangent_moved = has_viscous and (x0 is None or np.abs(np.sqrt(x) - np.sqrt(x0)).max()
-                                         > TANGENT_RTOL * np.sqrt(x).max())
-        bounded = x0 is not None or not has_viscous  # friction bound in place
-        if has_viscous:
+        x = _reachability(co, ds, [c.scaled(scales) for c in cons], x0, units)
+        tangent_moved = tangent and (x0 is None or np.abs(np.sqrt(x) - np.sqrt(x0)).max()
+                                     > TANGENT_RTOL * np.sqrt(x).max())
+        bounded = x0 is not None or not tangent  # friction bound in place
+        if tangent:
             x0 = x
         if tangent_moved and solve < MAX_SOLVES:
             continue  # the check waits for the friction tangent to settle
-        law = _law(length, co.s, x, tmax, wmax, solve)
+        law = _law(length, co.s, x, *limits, solve)
         dts = np.diff(law.knots_t)
         times = (law.knots_t[:-1, None] + dts[:, None] * CHECK_FRACTIONS[None, :]).reshape(-1)
-        tr_ratio, sp_ratio = dynamics.ratios(law, times, motors)
-        law = _with(law, tr_ratio, sp_ratio, 0, "")
-        if tr_ratio <= 1 + tol and sp_ratio <= 1 + tol:
+        ratio = ratios_by_kind(cons, dynamics.samples(law, times))
+        law = _with(law, ratio.get("torque", 0.0), ratio.get("speed", 0.0), 0, "")
+        if all(r <= 1 + tol for r in ratio.values()):
             break
         if bounded:  # discretisation excess: tighten by it
-            scale_t *= min(1.0, (1 + 0.25 * tol) / max(tr_ratio, 1e-300))
-            scale_w *= min(1.0, (1 + 0.25 * tol) / max(sp_ratio, 1e-300))
+            for kind, r in ratio.items():
+                scales[kind] *= min(1.0, (1 + 0.25 * tol) / max(r, 1e-300))
     assert law is not None
-    ok = law.max_torque_ratio <= 1 + tol and law.max_speed_ratio <= 1 + tol
+    return _verdict(law, ratio, scales, ds, tol)
+
+
+def _constraints(torque_limit: tuple[float, float] | None,
+                 speed_limit: tuple[float, float] | None, motors: MotorLimits | None,
+                 constraints: Sequence[Constraint] | None) -> tuple[Constraint, ...]:
+    """The constraints of a solve, from whichever form the caller gave."""
+    if constraints is not None:
+        cons = tuple(constraints)
+    elif motors is not None:
+        cons = motor_constraints(motors)
+    elif torque_limit is not None:
+        cons = motor_constraints(MotorLimits.of(torque_limit, speed_limit))
+    else:
+        raise ParameterError("a time-optimal law needs torque limits (or motors)")
+    if not any(c.torque_limit is not None for c in cons):
+        raise ParameterError("a time-optimal law needs a torque limit among its constraints")
+    return cons
+
+
+def _torque_limit(cons: Sequence[Constraint]) -> tuple[float, float]:
+    """The peak torques of the first torque constraint."""
+    return next(t for c in cons if (t := c.torque_limit) is not None)
+
+
+def _speed_limit(cons: Sequence[Constraint]) -> tuple[float, float]:
+    """The lowest speed limit of each motor (``inf`` without one)."""
+    w = np.full(2, np.inf)
+    for c in cons:
+        if c.speed_limit is not None:
+            w = np.minimum(w, np.asarray(c.speed_limit, float))
+    return float(w[0]), float(w[1])
+
+
+def _verdict(law: TimeOptimalLaw, ratio: dict[str, float], scales: dict[str, float],
+             ds: Array, tol: float) -> TimeOptimalLaw:
+    """The settled law with its status and the message in words."""
+    n, length = len(ds), law.distance
+    ok = all(r <= 1 + tol for r in ratio.values())
     where = (f"{n} segments of {ds[0]:.4g}" if np.ptp(ds) <= 1e-9 * length else
              f"{n} segments of {ds.min():.4g} to {ds.max():.4g}")
-    margin = "" if scale_t == 1.0 and scale_w == 1.0 else (
-        f"; limits tightened by {1 - scale_t:.2%} (torque) and {1 - scale_w:.2%} (speed) so "
-        "that they hold between the grid points")
+    margin = "" if all(v == 1.0 for v in scales.values()) else (
+        "; limits tightened by " + " and ".join(f"{1 - v:.2%} ({k})" for k, v in scales.items())
+        + " so that they hold between the grid points")
+    extra = "".join(f", {k} ratio {r:.5f}" for k, r in ratio.items()
+                    if k not in ("torque", "speed"))
+    ratios = (f"torque ratio {law.max_torque_ratio:.5f}, speed ratio "
+              f"{law.max_speed_ratio:.5f}{extra}")
     if ok:
-        msg = (f"time-optimal within the limits: torque ratio {law.max_torque_ratio:.5f}, speed "
-               f"ratio {law.max_speed_ratio:.5f} on the check samples ({where}, "
+        msg = (f"time-optimal within the limits: {ratios} on the check samples ({where}, "
                f"{law.solves} solve(s)){margin}")
         return _with(law, law.max_torque_ratio, law.max_speed_ratio, 0, msg)
-    msg = (f"limits exceeded on the check samples after {law.solves} solves: torque ratio "
-           f"{law.max_torque_ratio:.5f}, speed ratio {law.max_speed_ratio:.5f} (tolerance "
-           f"{1 + tol:g}); refine the grid")
+    msg = (f"limits exceeded on the check samples after {law.solves} solves: {ratios} "
+           f"(tolerance {1 + tol:g}); refine the grid")
     return _with(law, law.max_torque_ratio, law.max_speed_ratio, 1, msg)
 
 
-def _speed_limits(co: PathCoefficients, wmax: Array) -> Array | None:
-    """The squared path speeds (N + 1,) at which a motor reaches its speed limit: the first
-    tangent points of the speed-dependent bounds. Every tangent bounds ``sqrt(x)`` from
-    above, so the first law is within the limits; from these speeds, above the optimum's, the
-    iteration settles in about one solve fewer than from a first solve without those bounds
-    (2.8 instead of 3.7 per move over the pick-and-place sweep, cycle times as close to the
-    settled ones). None without a finite speed limit (the first solve then goes without)."""
-    x = _speed_cap(co, wmax)
+def _first_tangent(x: Array) -> Array | None:
+    """The first tangent points of the speed-dependent bounds: the squared path speeds
+    (N + 1,) at which a motor reaches its speed limit (``x``, the speed cap). Every tangent
+    bounds ``sqrt(x)`` from above, so the first law is within the limits; from these speeds,
+    above the optimum's, the iteration settles in about one solve fewer than from a first
+    solve without those bounds (2.8 instead of 3.7 per move over the pick-and-place sweep,
+    cycle times as close to the settled ones). None without a finite speed limit (the first
+    solve then goes without)."""
     finite = np.isfinite(x)
     if not finite.any():
         return None
     return np.asarray(np.where(finite, x, x[finite].max()))
-
-
-def _speed_cap(co: PathCoefficients, wmax: Array) -> Array:
-    """The largest squared path speed (N + 1,) within both motors' speed limits (``inf``
-    where neither joint moves)."""
-    with np.errstate(divide="ignore"):
-        return np.asarray(np.min(np.where(co.dq_ds != 0, (wmax / np.abs(co.dq_ds)) ** 2,
-                                          np.inf), axis=1))
 
 
 def _grid(grid: int | Array, length: float) -> Array:
@@ -393,49 +320,12 @@ def _check_holding(co: PathCoefficients, tmax: Array, units: Units | None) -> No
             f"{_describe(co, int(k), units)}, above its limit {_torque(units, tmax[i])}")
 
 
-def _friction_bounds(co: PathCoefficients, x0: Array | None
-                     ) -> tuple[Array, Array, Array, Array]:
-    """Friction ``f`` in ``[phi_lo + psi_lo x, phi_hi + psi_hi x]`` at each grid point,
-    arrays (N + 1, 2)."""
-    up, down = co.friction_sides
-    if x0 is None:
-        far_phi, far_psi = np.broadcast_to(co.coulomb, up.shape), np.zeros(up.shape)
-    else:  # viscous |f| <= w sqrt(x) <= w (x + x0) / (2 sqrt(x0)), tangent at x0
-        r = np.sqrt(np.maximum(x0, 1e-9 * max(float(x0.max()), 1e-300)))[:, None]
-        w = co.viscous * np.abs(co.dq_ds)
-        far_phi, far_psi = co.coulomb + 0.5 * w * r, 0.5 * w / r
-    return -down * far_phi, -down * far_psi, up * far_phi, up * far_psi
-
-
-def _rows(co: PathCoefficients, ds: Array, tmax: Array, wmax: Array,
-          x0: Array | None, knee: Array | None = None) -> tuple[Array, Array, Array]:
-    """Static rows ``Gu u + Gx x <= h`` of every stage, arrays (N, m).
-
-    With a torque-speed envelope (``knee``) and a tangent point ``x0``, each motor also has
-    ``|tau| + sigma |q'| sqrt(x) <= T + sigma knee`` (``sigma = T / (wmax - knee)``), with
-    ``sqrt(x)`` bounded above by its tangent at ``max(x0, x_knee)``: conservative, and exact at
-    the tangent point."""
-    phi_lo, psi_lo, phi_hi, psi_hi = _friction_bounds(co, x0)
-    xmax = _speed_cap(co, wmax)
-    # rows at each point over (u, X), X the squared speed at that point: the torque rows,
-    # then the speed-only ones (X <= xmax, X >= 0)
-    pu = [co.a, -co.a]
-    px = [co.b + psi_hi, -(co.b + psi_lo)]
-    ph = [tmax - co.g - phi_hi, tmax + co.g + phi_lo]
-    if knee is not None and x0 is not None:
-        sigma = tmax / (wmax - knee)
-        qabs = np.abs(co.dq_ds)
-        with np.errstate(divide="ignore"):
-            xk = np.where(qabs > 0, (knee / qabs) ** 2, np.inf)
-        r = np.sqrt(np.minimum(np.maximum(x0[:, None], xk), 1e300))
-        slope = np.where(qabs > 0, sigma * qabs / (2 * r), 0.0)
-        offset = np.where(qabs > 0, sigma * qabs * r / 2, 0.0)
-        cap = tmax + sigma * knee - offset
-        pu += [co.a, -co.a]
-        px += [co.b + psi_hi + slope, -(co.b + psi_lo) + slope]
-        ph += [cap - co.g - phi_hi, cap + co.g + phi_lo]
-    pu_, px_, ph_ = (np.concatenate(v, axis=1) for v in (pu, px, ph))
-    return _stage_rows(pu_, px_, ph_, xmax, ds)
+def _rows(co: PathCoefficients, ds: Array, constraints: Sequence[Constraint],
+          x0: Array | None) -> tuple[Array, Array, Array]:
+    """Static rows ``Gu u + Gx x <= h`` of every stage, arrays (N, m): the constraints' rows
+    at both points of each stage and the speed cap at its first."""
+    rows = point_rows(constraints, Tangent(co, x0))
+    return _stage_rows(rows.pu, rows.px, rows.ph, speed_cap(constraints, co), ds)
 
 
 def _stage_rows(pu: Array, px: Array, ph: Array, xmax: Array, ds: Array
@@ -453,10 +343,11 @@ def _stage_rows(pu: Array, px: Array, ph: Array, xmax: Array, ds: Array
     return Gu, Gx, h
 
 
-def _reachability(co: PathCoefficients, ds: Array, tmax: Array, wmax: Array,
-                  x0: Array | None, units: Units | None, knee: Array | None = None) -> Array:
+def _reachability(co: PathCoefficients, ds: Array, constraints: Sequence[Constraint],
+                  x0: Array | None, units: Units | None) -> Array:
     """Squared speeds ``x`` at the grid points of the fastest admissible motion."""
-    Gu, Gx, h = _rows(co, ds, tmax, wmax, x0, knee)
+    Gu, Gx, h = _rows(co, ds, constraints, x0)
+    tmax = np.asarray(_torque_limit(constraints), float)  # for the words of an error
     n = Gu.shape[0]
     tiny = 1e-12 * (np.abs(Gu) + 2 * ds[:, None] * np.abs(Gx))
     up, lo_, xonly = Gu > tiny, Gu < -tiny, np.abs(Gu) <= tiny
@@ -585,8 +476,8 @@ def _unreachable(co: PathCoefficients, k: int, tmax: Array, units: Units | None
         "before the end of the path")
 
 
-def _law(S: float, s: Array, x: Array, tmax: Array, wmax: Array,
-         solves: int) -> TimeOptimalLaw:
+def _law(S: float, s: Array, x: Array, tmax: tuple[float, float],
+         wmax: tuple[float, float], solves: int) -> TimeOptimalLaw:
     v = np.sqrt(np.maximum(x, 0.0))
     den = v[:-1] + v[1:]
     if np.any(den <= 0):
@@ -597,12 +488,8 @@ def _law(S: float, s: Array, x: Array, tmax: Array, wmax: Array,
     knots_t = np.concatenate([[0.0], np.cumsum(dts)])
     accel = (v[1:] - v[:-1]) / dts  # constant acceleration on each segment
     return TimeOptimalLaw(distance=S, duration=float(knots_t[-1]), knots_t=knots_t, knots_s=s,
-                          knots_v=v, accel=accel, torque_limit=(float(tmax[0]), float(tmax[1])),
-                          speed_limit=(float(wmax[0]), float(wmax[1])), solves=solves)
-
-
-
-
+                          knots_v=v, accel=accel, torque_limit=tmax, speed_limit=wmax,
+                          solves=solves)
 
 
 def _build(r: Any) -> TimeOptimalLaw:
@@ -612,8 +499,7 @@ def _build(r: Any) -> TimeOptimalLaw:
     p = r.params
     motors = r.motors
     if p.get("torque_limit") is not None:
-        motors = MotorLimits(tuple(p["torque_limit"]),
-                             tuple(p.get("speed_limit_deg_s") or (math.inf, math.inf)))
+        motors = MotorLimits.of(p["torque_limit"], p.get("speed_limit_deg_s"))
     elif motors is None:
         raise ConfigError("config key [law].torque_limit is required for a time-optimal law "
                           "(or a [motors] table with peak_torque)")

@@ -9,14 +9,15 @@ from typing import Any
 from ..dynamics import Inertia
 from ..errors import NumericalError
 from ..geometry import FiveBar
+from .tables import number
 
 
 def toml_number(v: float) -> str:
-    """A finite number as TOML (17 significant digits)."""
+    """A finite number as TOML (the shortest text of the same double)."""
     v = float(v)
     if not math.isfinite(v):
         raise NumericalError(f"value {v!r} to write in a config is not finite")
-    return repr(v)
+    return number(v)
 
 
 def _pair(a: float, b: float) -> str:

@@ -16,13 +16,25 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from .._arrays import Array
-from ..design.space import LENGTHS, METRICS
+from ..design.pareto import Choice
+from ..design.space import LENGTHS, METRICS, DesignSpace
+from ..design.sweep import SweepStats
 from ..errors import ConfigError
-from .files import write_text
-from .html_page import figures, page
+from ..geometry import FiveBar
+from ..kinematics import workspace_map
+from .figures import plot_workspace
+from .files import OutputDir, write_text
+from .html_page import figures, grid, page, table
+from .tables import number
 
 #: Columns of designs.csv and pareto.csv.
 COLUMNS = ("design", *(f"{k}_mm" for k in LENGTHS), "feasible", "reason", *METRICS)
+
+
+#: Every file a sweep may write.
+DESIGN_FILES = ("designs.csv", "sweep.json", "pareto.csv", "best.toml", "summary.json",
+                "report.html", *(f"{n}.{e}" for n in ("pareto", "designs", "best_workspace")
+                                 for e in ("png", "svg")))
 
 
 def header() -> str:
@@ -34,9 +46,9 @@ def row_line(row: Mapping[str, Any]) -> str:
     """One design's CSV line: numbers to 17 digits, an empty cell for a metric that does not
     exist (the plan failed first), ``true``/``false`` for ``feasible``."""
     cells: list[str] = [str(int(row["design"]))]
-    cells += [repr(float(row[k])) for k in LENGTHS]
+    cells += [number(row[k]) for k in LENGTHS]
     cells += ["true" if row["feasible"] else "false", str(row["reason"])]
-    cells += ["" if row[k] is None else repr(float(row[k])) for k in METRICS]
+    cells += ["" if row[k] is None else number(row[k]) for k in METRICS]
     buf = io.StringIO()
     csv.writer(buf, lineterminator="\n").writerow(cells)
     return buf.getvalue()
@@ -89,7 +101,8 @@ def pareto_figure(F: Array, pareto: Array, best: int, names: Sequence[str]) -> F
 
 
 def scatter_matrix(X: Array, feasible: Array, names: Sequence[str]) -> Figure:
-    """Every pair of varied lengths (mm), feasible designs in blue, the others in grey."""
+    """Every pair of varied lengths (mm; tied lengths are one axis), feasible designs in
+    blue, the others in grey."""
     k = X.shape[1]
     fig = Figure(figsize=(2.2 * k + 1, 2.2 * k + 1))
     axes = fig.subplots(k, k, squeeze=False)
@@ -116,73 +129,78 @@ def design_report(summary: Mapping[str, Any], pareto_rows: Sequence[Mapping[str,
                   pngs: dict[str, bytes]) -> str:
     """The sweep's report: counts, the chosen design, the Pareto designs, the figures."""
     esc = html.escape
-    facts = [(k, summary[k]) for k in ("designs", "feasible", "feasible_fraction", "pareto",
-                                       "objectives", "sampling", "seed", "workers",
-                                       "wall_time_s", "designs_per_second", "evaluated",
-                                       "resumed") if k in summary]
-    rows = "".join(f"<tr><td>{esc(k)}</td><td>{esc(str(v))}</td></tr>" for k, v in facts)
-    head = "".join(f"<th>{esc(c)}</th>" for c in COLUMNS if c not in ("feasible", "reason"))
-    body = "".join(
-        f"<tr><td>{r['design']}</td>" + "".join(f"<td>{float(r[k]):.4g}</td>"
-                                                for k in (*LENGTHS, *METRICS)) + "</tr>"
-        for r in pareto_rows)
+    labels = {"designs": "designs", "feasible": "feasible designs",
+              "feasible_fraction": "feasible fraction", "pareto": "Pareto designs",
+              "objectives": "objectives (minimised; - maximises)", "sampling": "sampling",
+              "seed": "seed", "workers": "workers", "wall_time_s": "wall time [s]",
+              "designs_per_second": "designs per second", "evaluated": "evaluated",
+              "resumed": "resumed from an earlier run"}
+    facts = table([(label, _rounded(summary[k])) for k, label in labels.items()
+                   if k in summary])
+    pareto = grid([c for c in COLUMNS if c not in ("feasible", "reason")],
+                  [(r["design"], *(_rounded(r[k]) for k in (*LENGTHS, *METRICS)))
+                   for r in pareto_rows])
     best = summary.get("best")
     chosen = (f"<p>Chosen (the Pareto design closest to the ideal point): design "
               f"{best['design']}, l1 = {best['l1']:.4g}, l2 = {best['l2']:.4g}, L1 = "
               f"{best['L1']:.4g}, L2 = {best['L2']:.4g}, d = {best['d']:.4g} mm; written to "
               "best.toml.</p>") if best else "<p>No feasible design.</p>"
-    return page("dextar design sweep",
-                f"<h1>Design sweep of {esc(str(summary['task']))}</h1><table>{rows}</table>"
-                f"{chosen}<h2>Pareto designs</h2><table><tr>{head}</tr>{body}</table>"
-                f"<h2>Figures</h2>{figures(pngs)}")
+    return page(f"Design sweep of {Path(str(summary['task'])).name}",
+                f"<p>Task file {esc(str(summary['task']))}.</p>{facts}{chosen}"
+                f"<h2>Pareto designs</h2>{pareto}<h2>Figures</h2>{figures(pngs)}")
+
+
+def _rounded(v: Any) -> Any:
+    """A number to 4 significant digits for a table (other values as they are)."""
+    return float(f"{v:.4g}") if isinstance(v, float) else v
 
 
 class DesignsFile:
-    """``designs.csv`` of a sweep in ``outdir``, with ``sweep.json`` (the sweep's signature).
+    """``designs.csv`` of a sweep in an output directory, with ``sweep.json`` (the sweep's
+    signature).
 
-    Opened fresh (refused over a non-empty folder without ``force``) or to ``resume`` (the
-    complete rows of the same sweep kept, a line cut short by a kill dropped). Rows are
-    appended as chunks finish (flushed to disk each time); :meth:`finish` rewrites the file
-    in design order, atomically."""
+    Opened fresh, or to ``resume`` (the complete rows of the same sweep kept, a line cut
+    short by a kill dropped); the directory's own checks (empty, ``--force``) are
+    :class:`~dextar.output.files.OutputDir`'s. Rows are appended as chunks finish (flushed to
+    disk each time); :meth:`finish` rewrites the file in design order, atomically."""
 
-    def __init__(self, outdir: Path, designs: Array, signature: str, *, resume: bool,
-                 force: bool, label: str) -> None:
-        """Check the folder (and read the rows to resume); nothing is written yet.
+    def __init__(self, od: OutputDir, designs: Array, signature: str, *, resume: bool,
+                 label: str) -> None:
+        """Read the rows to resume; nothing is written yet.
 
         Raises
         ------
         ConfigError
-            A non-empty folder without ``force`` or ``resume``; ``resume`` without a sweep
-            of the same signature, or with rows of other lengths.
+            ``resume`` without a sweep of the same signature, or with rows of other lengths.
         """
-        self.outdir, self.designs, self.signature = outdir, designs, signature
-        self.csv, self.meta = outdir / "designs.csv", outdir / "sweep.json"
+        self.od, self.designs, self.signature = od, designs, signature
+        self.csv, self.meta = od.path / "designs.csv", od.path / "sweep.json"
         self.rows: dict[int, dict[str, Any]] = {}
         self._fh: Any = None
-        n = len(designs)
         if resume:
-            if not (self.csv.is_file() and self.meta.is_file()):
-                raise ConfigError(f"--resume: {label} holds no sweep to resume (designs.csv "
-                                  "and sweep.json)")
-            try:
-                same = json.loads(self.meta.read_text()).get("signature") == signature
-            except (ValueError, OSError):
-                same = False
-            if not same:
-                raise ConfigError(f"--resume: the sweep in {label} was made with another task, "
-                                  "[design] or --samples/--seed; rerun without --resume (and "
-                                  "--force to overwrite it)")
-            for line in self.csv.read_text().splitlines(keepends=True)[1:]:
-                r = parse_line(line)
-                if r is None or not 0 <= r["design"] < n:
-                    continue
-                if not np.allclose([r[k] for k in LENGTHS], designs[r["design"]], rtol=1e-12):
-                    raise ConfigError(f"--resume: design {r['design']} in {self.csv} has other "
-                                      "lengths than this sweep's")
-                self.rows[r["design"]] = r
-        elif outdir.exists() and (not outdir.is_dir() or any(outdir.iterdir())) and not force:
-            raise ConfigError(f"output directory {label!r} exists and is not empty; use "
-                              "--force to overwrite it or --resume to complete its sweep")
+            self._resume(label)
+
+    def _resume(self, label: str) -> None:
+        designs, n = self.designs, len(self.designs)
+        if not (self.csv.is_file() and self.meta.is_file()):
+            raise ConfigError(f"--resume: {label} holds no sweep to resume (designs.csv and "
+                              "sweep.json)")
+        try:
+            same = json.loads(self.meta.read_text()).get("signature") == self.signature
+        except (ValueError, OSError):
+            same = False
+        if not same:
+            raise ConfigError(f"--resume: the sweep in {label} was made with another task, "
+                              "[design] or --samples/--seed; rerun without --resume (and "
+                              "--force to overwrite it)")
+        for line in self.csv.read_text().splitlines(keepends=True)[1:]:
+            r = parse_line(line)
+            if r is None or not 0 <= r["design"] < n:
+                continue
+            if not np.allclose([r[k] for k in LENGTHS], designs[r["design"]], rtol=1e-12):
+                raise ConfigError(f"--resume: design {r['design']} in {self.csv} has other "
+                                  "lengths than this sweep's")
+            self.rows[r["design"]] = r
 
     @property
     def missing(self) -> list[int]:
@@ -190,11 +208,12 @@ class DesignsFile:
         return [i for i in range(len(self.designs)) if i not in self.rows]
 
     def __enter__(self) -> DesignsFile:
-        self.outdir.mkdir(parents=True, exist_ok=True)
         write_text(self.meta, json.dumps({"signature": self.signature,
                                           "designs": len(self.designs)}) + "\n")
         write_text(self.csv, header() + "".join(row_line(self.rows[i]) for i in
                                                 sorted(self.rows)))
+        self.od.record("sweep.json")
+        self.od.record("designs.csv")
         self._fh = open(self.csv, "a", encoding="utf-8")  # noqa: SIM115 - closed in __exit__
         return self
 
@@ -214,3 +233,75 @@ class DesignsFile:
         ordered = [self.rows[i] for i in range(len(self.designs))]
         write_text(self.csv, header() + "".join(row_line(r) for r in ordered))
         return ordered
+
+
+def reason_counts(rows: Sequence[Mapping[str, Any]]) -> dict[str, int]:
+    """How many designs failed for each kind of reason."""
+    kinds = (("geometry", "geometry"), ("motors exceeded", "motors exceeded"),
+             ("singularity", "singularity"), ("out of reach", "unreachable"),
+             ("internal error", "internal error"))
+    out: dict[str, int] = {}
+    for r in rows:
+        if not r["feasible"]:
+            text = str(r["reason"])
+            kind = next((name for key, name in kinds if key in text), "other")
+            out[kind] = out.get(kind, 0) + 1
+    return out
+
+
+def sweep_summary(task_file: str, kind: str, space: DesignSpace, stats: SweepStats,
+                  choice: Choice, rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
+    """``summary.json`` of a sweep: counts, the sampling, the run's figures, the chosen
+    design and the reasons designs failed."""
+    n = len(rows)
+    return {
+        "task": task_file, "task_kind": kind, "designs": n,
+        "feasible": len(choice.feasible), "feasible_fraction": len(choice.feasible) / n,
+        "objectives": list(space.objectives), "sampling": space.sampling, "seed": space.seed,
+        "varied": [name for name, *_ in space.dims],
+        "mass_per_length_kg_m": (list(space.mass_per_length) if space.mass_per_length
+                                 else None),
+        "evaluated": stats.evaluated, "resumed": n - stats.evaluated,
+        "workers": stats.workers, "wall_time_s": stats.wall_s,
+        "designs_per_second": stats.evaluated / stats.wall_s if stats.wall_s > 0 else 0.0,
+        "pareto": len(choice.pareto_rows), "best": choice.best_row,
+        "reasons": reason_counts(rows)}
+
+
+def best_workspace_figure(robot_mm: FiveBar, mode: str, P: Array) -> Figure:
+    """The chosen design's workspace with the task's path."""
+    ws = workspace_map(robot_mm, mode, resolution=241)
+    fig: Figure = plot_workspace(ws, path=P, unit="mm")
+    fig.axes[0].set_title(f"chosen design: l1 = {robot_mm.l1:.4g}, l2 = {robot_mm.l2:.4g}, "
+                          f"L1 = {robot_mm.L1:.4g},\nL2 = {robot_mm.L2:.4g}, d = "
+                          f"{robot_mm.d:.4g} mm (working mode {mode})", fontsize=9)
+    return fig
+
+
+def write_sweep_outputs(od: OutputDir, summary: Mapping[str, Any], choice: Choice,
+                        rows: Sequence[Mapping[str, Any]], varied: Sequence[tuple[int, str]],
+                        best_toml: str | None, best_figure: Figure | None, *,
+                        with_figures: bool = True) -> None:
+    """Write ``best.toml`` (with a feasible design), ``pareto.csv``, the figures (PNG and
+    SVG), ``report.html`` and ``summary.json`` into the sweep's directory."""
+    pngs: dict[str, bytes] = {}
+    if best_toml is not None:
+        od.write_text("best.toml", best_toml)
+    if with_figures and choice.best >= 0 and best_figure is not None:
+        from .figures import png_bytes, svg_bytes
+
+        X = np.array([[r[k] for k in LENGTHS] for r in rows])
+        names = list(summary["objectives"])
+        for name, fig in (
+                ("pareto", pareto_figure(choice.F, choice.pareto, choice.best, names)),
+                ("designs", scatter_matrix(X[:, [c for c, _ in varied]],
+                                           np.array([r["feasible"] for r in rows]),
+                                           [f"{label} [mm]" for _, label in varied])),
+                ("best_workspace", best_figure)):
+            pngs[name] = png_bytes(fig)
+            od.write_bytes(f"{name}.png", pngs[name])
+            od.write_bytes(f"{name}.svg", svg_bytes(fig))
+    od.write_text("pareto.csv", header() + "".join(row_line(r) for r in choice.pareto_rows))
+    if with_figures:
+        od.write_text("report.html", design_report(summary, choice.pareto_rows, pngs))
+    od.write_text("summary.json", json.dumps(summary, indent=2, allow_nan=False) + "\n")

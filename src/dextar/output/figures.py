@@ -118,9 +118,15 @@ def fig9(an: Analysis) -> Any:
     """Fig. 9: motor torques, exact and (where it applies) the paper's (42)."""
     tr, ine = an.trajectory, an.inputs.inertia
     curves = [(tr.t, an.tau[:, 0], "b-", r"$M_1$ exact"), (tr.t, an.tau[:, 1], "g-", r"$M_2$ exact")]
-    if an.paper is not None:
-        curves += [(tr.t, an.paper.tau[:, 0], "b--", r"$M_1$ paper (42)"),
-                   (tr.t, an.paper.tau[:, 1], "g--", r"$M_2$ paper (42)")]
+    p = an.paper
+    if p is not None:
+        if p.leaves_out:  # what (42) models: the exact torques without gravity and friction
+            without = f"exact without {' and '.join(p.leaves_out)}"
+            curves += [(tr.t, p.reference[:, 0], "b:", rf"$M_1$ {without}"),
+                       (tr.t, p.reference[:, 1], "g:", rf"$M_2$ {without}")]
+        left = f" (no {', no '.join(p.leaves_out)})" if p.leaves_out else ""
+        curves += [(tr.t, p.tau[:, 0], "b--", rf"$M_1$ paper (42){left}"),
+                   (tr.t, p.tau[:, 1], "g--", rf"$M_2$ paper (42){left}")]
     title = (f"Fig. 9: motor torques ($m_L$ = {ine.distal[0].mass:.3g}, "
              f"$m_l$ = {ine.proximal[0].mass:.3g})")
     return _time_plot(an, title, _labels(an)["tau"], curves, title_size=10)

@@ -1,25 +1,45 @@
-"""Atomic file writing: every output goes to a temporary file in the target folder and is
-renamed into place, so an interrupted run never leaves a half-written file."""
+"""Writing files: each output appears only when complete and follows the user's umask.
+
+One mechanism for every command: a file is written to a temporary name in its target folder
+(or in a staging folder beside an output directory) and renamed into place, so an interrupted
+run never leaves a half-written file. :class:`OutputDir` is an output directory: refused when
+it holds files unless forced (or resumed), created only when its first file is written (a
+command that fails first leaves nothing), and after a forced run it holds that run's files
+only: the files of the command's own names (``produces``) that this run did not write are
+removed; files of other names are left alone.
+"""
 
 from __future__ import annotations
 
 import contextlib
 import os
+import shutil
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Collection, Iterator
 from pathlib import Path
 from typing import Any
+
+from ..errors import ConfigError
+
+
+def _file_mode() -> int:
+    """The mode of a new file under the current umask (read without changing it for long)."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return 0o666 & ~mask
 
 
 @contextlib.contextmanager
 def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
-    """Yield a temporary path beside ``path``; on success it is renamed onto ``path``."""
+    """Yield a temporary path beside ``path``; on success it gets the umask's mode and is
+    renamed onto ``path``."""
     target = Path(path)
     target.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".part", dir=target.parent)
     os.close(fd)
     try:
         yield Path(tmp)
+        os.chmod(tmp, _file_mode())
         os.replace(tmp, target)
     finally:
         if os.path.exists(tmp):
@@ -42,3 +62,86 @@ def save_figure(fig: Any, path: str | os.PathLike[str], **kwargs: Any) -> None:
     fmt = Path(path).suffix.lstrip(".").lower() or "png"
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format=fmt, **kwargs)
+
+
+def check_output_dir(path: Path, *, force: bool, hint: str = "use --force to overwrite its "
+                     "files") -> None:
+    """Refuse ``path`` when it is not a directory, or holds files and ``force`` is false."""
+    if path.exists():
+        if not path.is_dir():
+            raise ConfigError(f"output {str(path)!r} exists and is not a directory")
+        if not force and any(path.iterdir()):
+            raise ConfigError(f"output directory {str(path)!r} exists and is not empty; {hint}")
+
+
+class OutputDir:
+    """An output directory whose files appear only when complete (see the module doc).
+
+    ``produces``: the names the command may write (removed after a forced run when this run
+    did not write them); ``keep``: a resumed run, the files already there are its own (no
+    check, nothing removed)."""
+
+    def __init__(self, path: str | os.PathLike[str], *, force: bool = False,
+                 keep: bool = False, produces: Collection[str] = (),
+                 hint: str = "use --force to overwrite its files") -> None:
+        """Check ``path``: refused when it exists, holds files and neither ``force`` nor
+        ``keep`` is set. Nothing is created yet."""
+        self.path = Path(path)
+        if not keep:
+            check_output_dir(self.path, force=force, hint=hint)
+        self.keep = keep
+        self.produces = frozenset(produces)
+        self._staging: Path | None = None
+        self.written: list[str] = []
+
+    @property
+    def staging(self) -> Path:
+        """The staging folder beside the directory (both created on first use)."""
+        if self._staging is None:
+            self.path.mkdir(parents=True, exist_ok=True)
+            self._staging = Path(tempfile.mkdtemp(prefix=f".{self.path.name}.staging-",
+                                                  dir=self.path.parent))
+        return self._staging
+
+    def write_bytes(self, name: str, data: bytes) -> Path:
+        """Write ``name`` in the staging folder, then rename it into place."""
+        tmp = self.staging / name
+        tmp.write_bytes(data)
+        target = self.path / name
+        os.replace(tmp, target)
+        self.record(name)
+        return target
+
+    def write_text(self, name: str, text: str) -> Path:
+        """Write ``name`` as UTF-8 text (see :meth:`write_bytes`)."""
+        return self.write_bytes(name, text.encode("utf-8"))
+
+    def record(self, name: str) -> None:
+        """Count ``name`` as this run's (a file written into the folder some other way)."""
+        if name not in self.written:
+            self.written.append(name)
+
+    def finish(self) -> None:
+        """The run completed: remove the files of the command's names that this run did not
+        write (an earlier run's)."""
+        if self.keep or not self.path.is_dir():
+            return
+        for name in self.produces - set(self.written):
+            stale = self.path / name
+            if stale.is_file():
+                stale.unlink()
+
+    def close(self) -> None:
+        """Remove the staging folder."""
+        if self._staging is not None:
+            shutil.rmtree(self._staging, ignore_errors=True)
+
+    def __enter__(self) -> OutputDir:
+        return self
+
+    def __exit__(self, exc_type: object, *exc: object) -> None:
+        try:
+            if exc_type is None:
+                self.finish()
+        finally:
+            self.close()

@@ -1,19 +1,142 @@
-"""Writing an identification: the parameter table, the fit figure and the report (the
-identified config is :func:`dextar.output.config_file.model_toml`)."""
+"""Writing an identification and an exciting trajectory: the summary, the parameter table,
+the fit figure and the report (the identified config is
+:func:`dextar.output.config_file.model_toml`), the exciting trajectory's samples."""
 
 from __future__ import annotations
 
 import html
+import json
 import math
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
 from matplotlib.figure import Figure
 
 from .._arrays import Array
-from ..identification.fit import IdentificationResult
+from ..dynamics import Model, inverse_dynamics
+from ..dynamics.regressor import NAMES, standard_parameters
+from ..identification.data import MotionData
+from ..identification.excite import ExcitationResult
+from ..identification.fit import IdentificationResult, check_working_mode, condition
 from .config_file import toml_number as _num
+from .files import OutputDir
 from .html_page import figures, page
+
+
+def excitation_columns(model: Model, res: ExcitationResult, rate: float) -> dict[str, Array]:
+    """An exciting trajectory's samples at ``rate`` (Hz) with the model's torques (SI)."""
+    n = int(round(res.duration * rate)) + 1
+    t = np.arange(n) / rate
+    q, dq, ddq = res.trajectory.evaluate(t)
+    tau = inverse_dynamics(model, q, dq, ddq, t=t)
+    return {"t_s": t, "phi_rad": q[:, 0], "psi_rad": q[:, 1], "dphi_rad_s": dq[:, 0],
+            "dpsi_rad_s": dq[:, 1], "ddphi_rad_s2": ddq[:, 0], "ddpsi_rad_s2": ddq[:, 1],
+            "tau1_Nm": tau[:, 0], "tau2_Nm": tau[:, 1]}
+
+
+def excitation_payload(res: ExcitationResult, harmonics: int, base_hz: float, samples: int,
+                       rate: float, out: str) -> dict[str, Any]:
+    """What ``dextar excite`` reports (JSON)."""
+    return {"condition_number": res.condition_number, "duration_s": res.duration,
+            "periods": res.periods, "period_s": res.trajectory.period,
+            "harmonics": harmonics, "base_hz": base_hz, "samples": samples, "rate_hz": rate,
+            "rest_pose_deg": [float(v) for v in np.degrees(res.trajectory.q0)],
+            "min_type1_distance": res.min_type1_distance,
+            "min_type2_distance": res.min_type2_distance,
+            "peak_torque_Nm": [float(v) for v in res.peak_torque],
+            "peak_speed_rad_s": [float(v) for v in res.peak_speed],
+            "status": res.status, "message": res.message, "out": out}
+
+
+def _rms(x: Array) -> list[float]:
+    return [float(v) for v in np.sqrt((x ** 2).mean(axis=0))]
+
+
+@dataclass(frozen=True)
+class IdentificationReport:
+    """An identification as written: the summary (``summary.json``), the result and the
+    fit figure's panels ``(title, t, measured, predicted)``."""
+
+    summary: dict[str, Any]
+    result: IdentificationResult
+    panels: tuple[tuple[str, Array, Array, Array], ...]
+
+    @classmethod
+    def of(cls, res: IdentificationResult, data: MotionData, model: Model, mode: str,
+           data_path: str, config: str | None, vdata: MotionData | None = None,
+           validate: str | None = None) -> IdentificationReport:
+        """The summary of ``res`` (and of its prediction of ``vdata`` when given)."""
+        c = res.conditioned
+        if c is None:
+            raise ValueError("an identification result without its conditioned data")
+        summary: dict[str, Any] = {
+            "status": ("identified" if res.status == 0 else "poorly conditioned"
+                       if res.status == 1 else "not physically consistent"),
+            "message": res.message, "method": res.method, "data": data_path,
+            "config": config or "defaults", "n_samples": res.n_samples, "n_used": res.n_used,
+            "sample_rate_hz": data.rate_hz, "cutoff_hz": res.cutoff_hz,
+            "condition_number": res.condition_number,
+            "rms_residual_Nm": [float(v) for v in res.rms_residual],
+            "base_parameters": [{"name": n, "meaning": m, "unit": u, "value": float(v),
+                                 "std": float(s)}
+                                for n, m, u, v, s in zip(res.base.names, res.base.meanings,
+                                                         res.base.units, res.beta, res.std,
+                                                         strict=True)],
+            "unidentifiable": [NAMES[j] for j in res.base.unidentifiable],
+            "physically_consistent": res.consistent, "warnings": list(res.warnings),
+            "units": "SI: s, rad, N m; base parameters in the unit of their column"}
+        panels = [("identification data", c.t, c.tau, res.base.columns(c.Y) @ res.beta)]
+        if vdata is not None:
+            check_working_mode(vdata, model, mode)
+            vc = condition(vdata, model, cutoff_hz=res.cutoff_hz)
+            pred = vc.Y @ res.theta
+            prior = vc.Y @ standard_parameters(model.inertia)
+            summary["validation_data"] = validate
+            summary["validation_rms_error_Nm"] = _rms(pred - vc.tau)
+            summary["validation_rms_error_prior_Nm"] = _rms(prior - vc.tau)
+            summary["validation_rms_torque_Nm"] = _rms(vc.tau)
+            panels.append(("validation data", vc.t, vc.tau, pred))
+        return cls(summary, res, tuple(panels))
+
+    def lines(self) -> list[str]:
+        """The identification in words (without the files)."""
+        res, s = self.result, self.summary
+        lines = [f"identified {res.base.size} base parameters from {res.n_samples} samples "
+                 f"({res.n_used} used after filtering at {res.cutoff_hz:.3g} Hz): "
+                 f"{res.method}, condition number {res.condition_number:.4g}, RMS residual "
+                 f"{res.rms_residual[0]:.4g}, {res.rms_residual[1]:.4g} N m",
+                 *(f"  {n:<7} = {v: .6g} +- {sd:.2g} {u}  ({m})" for n, m, u, v, sd in
+                   zip(res.base.names, res.base.meanings, res.base.units, res.beta, res.std,
+                       strict=True))]
+        if "validation_rms_error_Nm" in s:
+            e, ep = s["validation_rms_error_Nm"], s["validation_rms_error_prior_Nm"]
+            lines.append(f"validation on {s['validation_data']}: RMS error {e[0]:.4g}, "
+                         f"{e[1]:.4g} N m (prior model {ep[0]:.4g}, {ep[1]:.4g} N m)")
+        return lines
+
+
+#: Every file an identification may write.
+IDENTIFICATION_FILES = ("identified.toml", "parameters.csv", "summary.json", "fit.png",
+                        "report.html")
+
+
+def write_identification(out: str, rep: IdentificationReport, model_toml: str, *,
+                         force: bool = False, with_figures: bool = True) -> None:
+    """Write ``identified.toml``, ``parameters.csv``, ``fit.png``, ``report.html`` and
+    ``summary.json`` into ``out``."""
+    with OutputDir(out, force=force, produces=IDENTIFICATION_FILES) as od:
+        od.write_text("identified.toml", model_toml)
+        od.write_text("parameters.csv", parameters_csv(rep.result))
+        if with_figures:
+            from .figures import png_bytes
+
+            png = png_bytes(fit_figure(rep.panels))
+            od.write_bytes("fit.png", png)
+            od.write_text("report.html", identification_report(rep.summary, {"fit": png}))
+        od.write_text("summary.json", json.dumps(rep.summary, indent=2, allow_nan=False)
+                      + "\n")
 
 
 def parameters_csv(res: IdentificationResult) -> str:
@@ -79,8 +202,7 @@ def identification_report(summary: Mapping[str, Any], pngs: dict[str, bytes]) ->
     fact_rows = "".join(f"<tr><td>{esc(k)}</td><td>{esc(str(v))}</td></tr>" for k, v in facts)
     warn = "".join(f"<li>{esc(w)}</li>" for w in summary["warnings"]) or "<li>none</li>"
     return page(
-        f"dextar identify {summary['data']}",
-        f"<h1>Identification from {esc(str(summary['data']))}</h1>"
+        f"Identification from {summary['data']}",
         f"<table>{fact_rows}</table><h2>Warnings</h2><ul>{warn}</ul>"
         "<h2>Base parameters</h2><p>Each a combination of standard parameters (SI); the "
         "standard deviations account for the correlation the low-pass leaves in the "

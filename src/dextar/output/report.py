@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-import base64
 import html
 from typing import Any
 
 from ..analysis import Analysis
+from .html_page import image, page, table
 
 CAPTIONS = {
     "fig3": "Leading angles for uniform motion along the path (the paper's Fig. 3). The paper "
@@ -25,23 +25,6 @@ CAPTIONS = {
 }
 
 
-def _fmt(v: Any) -> str:
-    if isinstance(v, float):
-        if v == 0 or (1e-3 <= abs(v) < 1e5):
-            return f"{v:.6g}"
-        return f"{v:.3e}"
-    if isinstance(v, list):
-        return ", ".join(_fmt(x) for x in v)
-    if isinstance(v, dict):
-        return "; ".join(f"{k} = {_fmt(x)}" for k, x in v.items())
-    return html.escape(str(v))
-
-
-def _table(rows: list[tuple[str, Any]], head: tuple[str, str] = ("quantity", "value")) -> str:
-    body = "".join(f"<tr><td>{html.escape(k)}</td><td>{_fmt(v)}</td></tr>" for k, v in rows)
-    return f"<table><tr><th>{head[0]}</th><th>{head[1]}</th></tr>{body}</table>"
-
-
 def _title(s: dict[str, Any]) -> str:
     if "claims" in s:
         return "DexTAR: the paper's example, optimal motion and motor torques"
@@ -54,54 +37,55 @@ def render_report(an: Analysis, s: dict[str, Any], pngs: dict[str, bytes],
                   gif: bytes | None = None) -> str:
     """The run's report as one self-contained HTML page (figures and animation inline)."""
     u = s["units"]
-    title = _title(s)
-    parts = [
-        "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
-        f"<title>{html.escape(title)}</title><style>",
-        "body{font-family:sans-serif;max-width:960px;margin:2em auto;color:#222}",
-        "table{border-collapse:collapse;margin:0.5em 0 1.5em}td,th{border:1px solid #ccc;",
-        "padding:3px 8px;text-align:left;font-size:14px}th{background:#eee}",
-        "figure{margin:1.5em 0}img{max-width:100%}.holds{color:#060}.fails{color:#b00}",
-        ".approximate{color:#a60}</style></head><body>",
-        f"<h1>{html.escape(title)}</h1>",
-        f"<p>Config: {html.escape(str(s['config']))}. dextar {s['dextar_version']}. Units: "
-        f"length {u['length_unit']}, mass {u['mass_unit']}, time {u['time_unit']}; energies "
-        f"and torques in {html.escape(u['torque_unit'])}; angles in radians in the CSV.",
-        f" One length unit is {u['length_unit_in_mm']:g} mm, one mass unit "
-        f"{u['mass_unit_in_kg']:g} kg, one time unit {u['time_unit_in_s']:g} s.</p>",
-        "<h2>Parameters</h2>",
-    ]
-    g = s["robot"]["geometry_mm"]
-    law = s["law"]
-    M, L, T = u["mass_unit"], u["length_unit"], u["time_unit"]
-    E, Q = u["energy_unit"], u["torque_unit"]
-    rows = [(f"{k} [mm]", v) for k, v in g.items()]
+    intro = (f"<p>Config: {html.escape(str(s['config']))}. dextar {s['dextar_version']}. "
+             f"Units: length {u['length_unit']}, mass {u['mass_unit']}, time "
+             f"{u['time_unit']}; energies and torques in {html.escape(u['torque_unit'])}; "
+             f"angles in radians in the CSV. One length unit is {u['length_unit_in_mm']:g} "
+             f"mm, one mass unit {u['mass_unit_in_kg']:g} kg, one time unit "
+             f"{u['time_unit_in_s']:g} s.</p>")
+    body = [intro, "<h2>Parameters</h2>", table(_parameters(s)), "<h2>Results</h2>",
+            table(_results(s)), _claims(s), "<h2>Validation</h2>", table(_validation(s)),
+            "<h2>Figures</h2>", _figures(s, pngs, gif), "<h2>Assumptions</h2><ul>",
+            *(f"<li>{html.escape(a)}</li>" for a in s["assumptions"]), "</ul>"]
+    return page(_title(s), "".join(body))
+
+
+def _parameters(s: dict[str, Any]) -> list[tuple[str, Any]]:
+    u, law, ine = s["units"], s["law"], s["inertia"]
+    M, L, T, Q = u["mass_unit"], u["length_unit"], u["time_unit"], u["torque_unit"]
+    rows: list[tuple[str, Any]] = [(f"{k} [mm]", v) for k, v in s["robot"]["geometry_mm"].items()]
     rows += [("working mode", s["robot"]["working_mode"]),
              ("assembly mode", s["robot"]["assembly_mode"]),
              ("path", {k: v for k, v in s["path"].items()}),
              ("law", law["type"])]
-    if "eta_s2_per_kg" in law:
-        rows.append(("eta, weight of the inertia forces [s^2/kg]", law["eta_s2_per_kg"]))
-    if "torque_limit_Nm" in law:
-        rows.append(("motor torque limits (A, D) [N m]", law["torque_limit_Nm"]))
-    if "speed_limit_deg_s" in law:
-        rows.append(("motor speed limits (A, D) [deg/s]", law["speed_limit_deg_s"]))
+    for key, label in (("eta_s2_per_kg", "eta, weight of the inertia forces [s^2/kg]"),
+                       ("torque_limit_Nm", "motor torque limits (A, D) [N m]"),
+                       ("speed_limit_deg_s", "motor speed limits (A, D) [deg/s]")):
+        if key in law:
+            rows.append((label, law[key]))
     rows += [("samples written", s["output"]["samples"]),
-             (f"end-effector mass [{M}]", s["inertia"]["effector_mass"]),
-             (f"payload [{M}]", s["inertia"]["payload"]),
+             (f"end-effector mass [{M}]", ine["effector_mass"]),
+             (f"payload [{M}]", ine["payload"]),
              (f"proximal rods AB, DC (mass [{M}], com [{L}], inertia [{M} {L}^2])",
-              [list(r.values()) for r in s["inertia"]["proximal"]]),
+              [list(r.values()) for r in ine["proximal"]]),
              (f"distal rods BP, CP (mass [{M}], com [{L}], inertia [{M} {L}^2])",
-              [list(r.values()) for r in s["inertia"]["distal"]]),
-             (f"rotor inertia (A, D) [{M} {L}^2]", s["inertia"]["rotor"]),
-             (f"viscous friction (A, D) [{Q} {T}/rad]", s["inertia"]["viscous"]),
-             (f"Coulomb friction (A, D) [{Q}]", s["inertia"]["coulomb"]),
-             (f"gravity [{L}/{T}^2]", s["inertia"]["gravity"])]
-    parts.append(_table(rows))
-    parts.append("<h2>Results</h2>")
-    rows = [(f"motion time [{T}]", law["duration"]), ("motion time [s]", law["duration_s"]),
-            ("law solver status (0 = success)", law["status"]),
-            ("law solver message", law["message"])]
+              [list(r.values()) for r in ine["distal"]]),
+             (f"rotor inertia (A, D) [{M} {L}^2]", ine["rotor"]),
+             (f"viscous friction (A, D) [{Q} {T}/rad]", ine["viscous"]),
+             (f"Coulomb friction (A, D) [{Q}]", ine["coulomb"]),
+             (f"gravity [{L}/{T}^2]", ine["gravity"])]
+    return rows
+
+
+def _results(s: dict[str, Any]) -> list[tuple[str, Any]]:
+    u, law = s["units"], s["law"]
+    M, L, T = u["mass_unit"], u["length_unit"], u["time_unit"]
+    E, Q = u["energy_unit"], u["torque_unit"]
+    rows: list[tuple[str, Any]] = [(f"motion time [{T}]", law["duration"])]
+    if T != "s":
+        rows.append(("motion time [s]", law["duration_s"]))
+    rows += [("law solver status (0 = success)", law["status"]),
+             ("law solver message", law["message"])]
     if "max_torque_ratio" in law:
         rows.append(("largest |torque| / limit over the written samples",
                      law["max_torque_ratio"]))
@@ -111,57 +95,58 @@ def render_report(an: Analysis, s: dict[str, Any], pngs: dict[str, bytes],
                  (f"kinetic part (m/2) Int |rdot|^2 dt [{E} {T}]", c["kinetic"]),
                  (f"inertial part (eta m^2/2) Int |rddot|^2 dt [{E} {T}]", c["inertial"]),
                  ("optimal-law ODE residual (relative, dimensionless)", law["ode_residual"])]
+    power, force = ("W", "N") if T == "s" else (f"{E}/{T}", f"{M} {L}/{T}^2")
     rows += [(f"peak |tau| exact (motor A, D) [{Q}]", s["torques"]["exact"]["peak"]),
              (f"RMS tau exact (motor A, D) [{Q}]", s["torques"]["exact"]["rms"]),
-             (f"peak |power| (motor A, D) [{E}/{T}]", s["peak_power"]),
-             (f"peak passive-joint forces [{M} {L}/{T}^2]", s["peak_joint_forces"])]
-    if "beta0_deg" in s.get("paper_model", {}):
-        pm = s["paper_model"]
+             (f"peak |power| (motor A, D) [{power}]", s["peak_power"]),
+             (f"peak passive-joint forces [{force}]", s["peak_joint_forces"])]
+    pm = s.get("paper_model", {})
+    if "beta0_deg" in pm:
         rows += [(f"peak |tau| paper (42) [{Q}]", s["torques"]["paper"]["peak"]),
                  ("beta range along the path [deg]", s["beta_range_deg"]),
                  ("beta0 [deg]", pm["beta0_deg"]),
                  (f"C1, C2, C3, C4 of (40) [{M} {L}^2]", [pm["C1"], pm["C2"], pm["C3"],
                                                          pm["C4"]]),
-                 ("paper torque error: max / RMS (fraction of the peak exact torque)",
+                 ("paper torque error: max / RMS (fraction of the peak exact torque; "
+                  f"{pm['error_note']})",
                   [pm["error_vs_exact"]["max_relative"], pm["error_vs_exact"]["rms_relative"]])]
-    if "not_applicable" in s.get("paper_model", {}):
-        rows.append(("paper's simplified model", "not applicable: "
-                     + s["paper_model"]["not_applicable"]))
-    parts.append(_table(rows))
-    if "claims" in s:
-        parts.append("<h2>The paper's claims against the exact model</h2><table><tr><th>claim"
-                     "</th><th>measure</th><th>value</th><th>verdict</th></tr>")
-        for cl in s["claims"]:
-            note = f"<br><small>{html.escape(cl['note'])}</small>" if "note" in cl else ""
-            parts.append(f"<tr><td>{html.escape(cl['claim'])}{note}</td><td>"
-                         f"{html.escape(cl['measure'])}<br><small>"
-                         f"{html.escape(cl['criterion'])}</small></td><td>{cl['value']:.3g}</td>"
-                         f"<td class='{cl['verdict']}'>{cl['verdict']}</td></tr>")
-        parts.append("</table>")
+    if "not_applicable" in pm:
+        rows.append(("paper's simplified model", "not applicable: " + pm["not_applicable"]))
+    return rows
+
+
+def _claims(s: dict[str, Any]) -> str:
+    if "claims" not in s:
+        return ""
+    parts = ["<h2>The paper's claims against the exact model</h2><table><tr><th>claim</th>"
+             "<th>measure</th><th>value</th><th>verdict</th></tr>"]
+    for cl in s["claims"]:
+        note = f"<br><small>{html.escape(cl['note'])}</small>" if "note" in cl else ""
+        parts.append(f"<tr><td>{html.escape(cl['claim'])}{note}</td><td>"
+                     f"{html.escape(cl['measure'])}<br><small>{html.escape(cl['criterion'])}"
+                     f"</small></td><td>{cl['value']:.3g}</td><td class='{cl['verdict']}'>"
+                     f"{cl['verdict']}</td></tr>")
+    return "".join(parts) + "</table>"
+
+
+def _validation(s: dict[str, Any]) -> list[tuple[str, Any]]:
     v = s["validation"]
     fw = v["forward_resimulation"]
-    parts.append("<h2>Validation</h2>")
-    parts.append(_table([
+    return [
         ("power balance: max |tau.qdot - dT/dt| / max |tau.qdot| (dimensionless; the torques "
          "against the rate of change of the exact kinetic energy, gravity and friction off)",
          v["power_balance_relative"]),
         ("forward re-simulation under the computed torques: final angle error / angle range "
          "(dimensionless)", fw["final_error_relative_to_range"]),
-        ("forward re-simulation: largest angle error [rad]", fw["max_error_rad"])]))
-    parts.append("<h2>Figures</h2>")
-    for name, data in pngs.items():
-        b64 = base64.b64encode(data).decode("ascii")
-        parts.append(f"<figure><img alt='{name}' src='data:image/png;base64,{b64}'>"
-                     f"<figcaption>{html.escape(_caption(name, law['type']))}</figcaption>"
-                     "</figure>")
+        ("forward re-simulation: largest angle error [rad]", fw["max_error_rad"])]
+
+
+def _figures(s: dict[str, Any], pngs: dict[str, bytes], gif: bytes | None) -> str:
+    law = s["law"]["type"]
+    parts = [image(data, name, _caption(name, law)) for name, data in pngs.items()]
     if gif is not None:
-        b64 = base64.b64encode(gif).decode("ascii")
-        parts.append(f"<figure><img alt='animation' src='data:image/gif;base64,{b64}'>"
-                     f"<figcaption>The robot following the path ({html.escape(law['type'])} "
-                     "law).</figcaption></figure>")
-    parts.append("<h2>Assumptions</h2><ul>")
-    parts += [f"<li>{html.escape(a)}</li>" for a in s["assumptions"]]
-    parts.append("</ul></body></html>\n")
+        parts.append(image(gif, "animation", f"The robot following the path ({law} law).",
+                           mime="image/gif"))
     return "".join(parts)
 
 

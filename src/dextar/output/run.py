@@ -13,8 +13,14 @@ from typing import Any
 from ..analysis import Analysis
 from ..errors import DextarError
 from ..trajectory import Trajectory
-from .outdir import OutputDir
+from .files import OutputDir
 from .tables import csv_text, run_columns
+
+#: Figures a run can draw (``[output].figures``).
+FIGURES = ("fig3", "fig4", "fig5", "fig6", "fig7", "fig8", "fig9", "workspace", "animation")
+#: Every file a run may write.
+RUN_FILES = ("trajectory.csv", "summary.json", "report.html", "animation.gif", "workspace.png",
+             *(f"fig{k}.{ext}" for k in range(3, 10) for ext in ("png", "svg")))
 
 
 class Progress:
@@ -59,11 +65,25 @@ def staged(progress: Progress) -> Stage:
     return stage
 
 
+def default_figures(an: Analysis) -> tuple[str, ...]:
+    """The figures that apply: every one for the paper's example; for another task none of
+    the paper's illustrations of its own example (Fig. 3, its uniform law; Fig. 7, its
+    masses)."""
+    from ..analysis.summary import is_paper_example
+
+    if is_paper_example(an.inputs):
+        return FIGURES
+    return tuple(f for f in FIGURES if f not in ("fig3", "fig7"))
+
+
 def write_run(od: OutputDir, an: Analysis, uniform: Trajectory, summary: dict[str, Any], *,
-              figures: tuple[str, ...], animation_frames: int, stage: Stage,
+              figures: tuple[str, ...] | None, animation_frames: int, stage: Stage,
               progress: Progress) -> None:
-    """Write a run's files into ``od``: ``trajectory.csv``, the figures (PNG and SVG), the
-    animation, ``report.html`` and, last, ``summary.json`` (with the files and timings)."""
+    """Write a run's files into ``od``: ``trajectory.csv``, the figures (PNG and SVG; None:
+    :func:`default_figures`), the animation, ``report.html`` and, last, ``summary.json``
+    (with the files and timings)."""
+    if figures is None:
+        figures = default_figures(an)
     stage("trajectory.csv", lambda: od.write_text("trajectory.csv", csv_text(run_columns(an))))
     figs = stage("figures", lambda: _figures(an, uniform, od, figures))
     gif = None

@@ -25,7 +25,6 @@ The path parameter ``p`` has the path's own unit (radians on an arc, none on a l
 
 from __future__ import annotations
 
-import io
 from typing import Any
 
 import numpy as np
@@ -67,8 +66,15 @@ def trajectory_columns(tr: Any, units: Units) -> dict[str, Array]:
     }
 
 
+def number(v: float) -> str:
+    """A float as written in every output: the shortest text that reads back to the same
+    double (``0.0005``, not ``0.00050000000000000001``), and ``0.0`` for a negative zero."""
+    return repr(float(v) + 0.0)
+
+
 def csv_text(columns: dict[str, Array]) -> str:
-    """CSV with a header row of the column names and one row per sample (17 digits).
+    """CSV with a header row of the column names and one row per sample, each number the
+    shortest text that reads back to the same double (:func:`number`).
 
     Raises :class:`~dextar.errors.NumericalError` naming the column and row of a value that
     is not finite: no NaN is ever written.
@@ -79,10 +85,8 @@ def csv_text(columns: dict[str, Array]) -> str:
         bad = np.argwhere(~np.isfinite(data))[0]
         raise NumericalError(f"column {names[bad[1]]} is not finite at row {bad[0]} (the "
                              "parameters overflow double precision)")
-    buf = io.StringIO()
-    buf.write(",".join(names) + "\n")
-    np.savetxt(buf, data, delimiter=",", fmt="%.17g")
-    return buf.getvalue()
+    rows = (data + 0.0).tolist()  # + 0.0: no negative zeros
+    return ",".join(names) + "\n" + "".join(",".join(map(repr, r)) + "\n" for r in rows)
 
 
 def torque_columns(an: Any) -> dict[str, Array]:

@@ -1,5 +1,19 @@
 """Robot programs: a sequence of moves under the motors, its setpoints and motor sizing."""
 
-from .plan import MOVE_TYPES, Move, PlannedMove, ProgramResult, plan_program, sizing
+from . import move_types as _builtin  # noqa: F401 - registers line, arc, dwell, joint
+from .moves import MOVE_TYPES, Move, MoveType, move_type, register_move
+from .plan import (
+    MovePlan,
+    MoveTiming,
+    PlanContext,
+    PlannedMove,
+    PlanState,
+    ProgramRequest,
+    ProgramResult,
+    plan_program,
+)
+from .sizing import MotorSizing, Sizing, Violation, sizing
 
-__all__ = ["MOVE_TYPES", "Move", "PlannedMove", "ProgramResult", "plan_program", "sizing"]
+__all__ = ["MOVE_TYPES", "MotorSizing", "Move", "MovePlan", "MoveTiming", "MoveType",
+           "PlanContext", "PlanState", "PlannedMove", "ProgramRequest", "ProgramResult", "Sizing", "Violation",
+           "move_type", "plan_program", "register_move", "sizing"]

@@ -8,10 +8,11 @@ integrates its own (true) dynamics, e.g. with masses off by 20 % and an unmodell
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.integrate import solve_ivp
+from scipy.integrate import RK45, OdeSolution
 from scipy.interpolate import CubicHermiteSpline
 
 from .._arrays import Array
@@ -25,7 +26,8 @@ from ..trajectory import Trajectory
 @dataclass(frozen=True, kw_only=True)
 class ControlResult(SimResult):
     """Tracking: a :class:`~dextar.dynamics.forward.SimResult` on the trajectory's time grid
-    (``q, dq`` the plant's, ``tau`` the applied, saturated torques) with
+    (``q, dq`` the plant's, ``tau`` the applied, saturated torques; ``status`` 1 when the
+    plant met a singularity and the samples end there, ``message`` saying which) with
 
     Attributes
     ----------
@@ -107,21 +109,52 @@ def simulate_computed_torque(trajectory: Trajectory, controller: Model, plant: M
         try:
             M, h = state_dynamics(plant, q, dq)
         except SingularityError as exc:
-            raise SingularityError(f"controlled robot at t = {t:.6g}: {exc}") from None
+            raise SingularityError(f"the controlled robot met a singularity at t = {t:.6g}: "
+                                   f"{exc}") from None
         return np.concatenate([dq, np.linalg.solve(M, tau - h)])
 
     y0 = np.concatenate([tr.q[0] + np.asarray(initial_error, float), tr.dq[0]])
     dt = float(np.min(np.diff(tr.t)))
-    sol = solve_ivp(rhs, (tr.t[0], tr.t[-1]), y0, t_eval=tr.t, method="RK45", rtol=rtol,
-                    atol=1e-10, max_step=4 * dt)
-    if not sol.success:
-        raise ConvergenceError(f"control simulation failed at t = {sol.t[-1]:.6g}: "
-                               f"{sol.message}")
-    q, dq = sol.y[:2].T, sol.y[2:].T
-    taus, sat = zip(*(control(ti, qi, dqi) for ti, qi, dqi in zip(sol.t, q, dq, strict=True)),
+    t_end, sol, stop = _integrate(rhs, tr.t, y0, rtol=rtol, max_step=4 * dt)
+    n = int(np.searchsorted(tr.t, t_end, side="right"))
+    t = tr.t[:n]
+    y = sol(t)
+    q, dq = y[:2].T, y[2:].T
+    taus, sat = zip(*(control(ti, qi, dqi) for ti, qi, dqi in zip(t, q, dq, strict=True)),
                     strict=True)
     P = direct_kinematics(plant.robot, q, plant.assembly)
-    return ControlResult(t=sol.t, q=q, dq=dq, tau=np.array(taus), status=int(sol.status),
-                         message=str(sol.message), P=P, joint_error=tr.q - q,
-                         task_error=np.linalg.norm(tr.P - P, axis=-1), saturated=np.array(sat),
+    saturated = np.array(sat)
+    if stop is None:
+        status, message = 0, "the controlled robot followed the whole motion"
+    else:
+        status, message = 1, stop
+    return ControlResult(t=t, q=q, dq=dq, tau=np.array(taus), status=status, message=message,
+                         P=P, joint_error=tr.q[:n] - q,
+                         task_error=np.linalg.norm(tr.P[:n] - P, axis=-1), saturated=saturated,
                          torque_limit=torque_limit)
+
+
+def _integrate(rhs: Callable[[float, Array], Array], t: Array, y0: Array, *, rtol: float,
+               max_step: float) -> tuple[float, Callable[[Array], Array], str | None]:
+    """Step the plant from ``t[0]`` towards ``t[-1]``; a singularity met on the way ends the
+    integration there (a result, not a failure). Returns the last time reached, the dense
+    solution up to it and why it stopped early (None: it did not)."""
+    solver = RK45(rhs, float(t[0]), y0, float(t[-1]), rtol=rtol, atol=1e-10,
+                  max_step=max_step)
+    times, pieces = [float(t[0])], []
+    stop: str | None = None
+    while solver.status == "running":
+        try:
+            solver.step()
+        except SingularityError as exc:
+            stop = str(exc)
+            break
+        if solver.status == "failed":
+            raise ConvergenceError(f"control simulation failed at t = {solver.t:.6g}: "
+                                   "the integrator's step became too small")
+        times.append(solver.t)
+        pieces.append(solver.dense_output())
+    if not pieces:
+        raise SingularityError(f"the controlled robot cannot start: {stop}")
+    sol = OdeSolution(times, pieces)
+    return times[-1], (lambda tt: np.asarray(sol(tt))), stop

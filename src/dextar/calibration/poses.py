@@ -1,0 +1,370 @@
+"""Measurement poses for a calibration: chosen from the reachable workspace of the working
+modes, away from both singularity types, to maximise the observability index O1
+(:mod:`dextar.calibration.observability`), in an order a robot can visit.
+
+1. **Candidates**: a grid over the legs' reach in each working mode (offset by the seed
+   within a cell), kept where both legs reach, the pose is in the robot's assembly mode,
+   its normalised distances to serial and parallel singularities are at least ``margin``
+   and the distal rods keep ``closure_slack`` from stretched or folded (so that the real
+   robot, off by its errors, still assembles at the commanded readings).
+2. **D-optimal design** (O1 is the information matrix's determinant to the power
+   ``1 / 2p``): a greedy pass adds the candidate that raises the determinant most (the
+   matrix determinant lemma, vectorised over candidates), then Fedorov exchange passes swap
+   a chosen pose for the best candidate while the determinant grows. Poses of a working
+   mode keep ``spacing`` apart, so the design spreads over the workspace instead of
+   repeating its extreme points. With a stated noise each candidate's information is
+   whitened by its covariance ``sigma^2 I + s_r^2 J_q J_q^T`` (a pose where the encoders'
+   resolution blurs the point counts for less).
+3. **Order**: working modes in a Gray-code order from the robot's (one leg changes its
+   sign at a time, the way a five-bar changes mode through a serial singularity), poses
+   of a mode by a nearest-neighbour tour in joint space (the larger of the two motor moves).
+
+Joubair, Slamani and Bonev measured their DexTAR in all four working modes: poses of one
+mode leave the parameters more correlated (see :mod:`dextar.calibration`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._arrays import Array
+from ..errors import ParameterError
+from ..geometry import (
+    WORKING_MODES,
+    canonical_working_mode,
+    parse_assembly_mode,
+    parse_working_mode,
+)
+from ..kinematics import assembly_mode, inverse_kinematics
+from ..kinematics.checker import pose_distances, reach_violation
+from .model import NAMES, ROBOT, KinematicModel, characteristic_scales, closure, jacobian
+from .observability import Observability, identifiability, observability
+
+#: Default distance (normalised, the sine of the angle at an elbow or at P) from both
+#: singularity types.
+DEFAULT_MARGIN = 0.2
+#: Default slack (m) of the distal rods from stretched and folded at a pose.
+DEFAULT_SLACK = 4e-3
+
+
+@dataclass(frozen=True)
+class PoseSelection:
+    """Measurement poses in visiting order (SI).
+
+    Attributes
+    ----------
+    modes : tuple of str
+        Working mode of each pose.
+    assembly : str
+        The assembly mode of every pose (``"up"`` or ``"down"``).
+    readings : ndarray, shape (n, 2)
+        Encoder readings to command (rad): the nominal inverse kinematics minus the
+        nominal offsets.
+    points : ndarray, shape (n, 2)
+        Nominal end-effector points (m), robot frame.
+    type1, type2 : ndarray, shape (n,)
+        Normalised distances to serial and parallel singularities.
+    parameters : tuple of str
+        The parameters the design is for.
+    observability : Observability
+        Of ``parameters`` over the poses (unweighted, scaled Jacobian).
+    index : str
+        The maximised index, ``"O1"``.
+    n_candidates : int
+    status : int
+        0; 1 when fewer candidates than poses asked for were far enough apart (the spacing
+        was relaxed).
+    message : str
+    """
+
+    modes: tuple[str, ...]
+    assembly: str
+    readings: Array
+    points: Array
+    type1: Array
+    type2: Array
+    parameters: tuple[str, ...]
+    observability: Observability
+    index: str
+    n_candidates: int
+    status: int
+    message: str
+
+    @property
+    def success(self) -> bool:
+        """True when ``status`` is 0."""
+        return self.status == 0
+
+    def __len__(self) -> int:
+        return len(self.readings)
+
+
+@dataclass(frozen=True)
+class _Candidates:
+    modes: Array       # (c,) index into the modes tuple
+    q: Array           # (c, 2) geometric angles
+    P: Array           # (c, 2)
+    type1: Array
+    type2: Array
+    J: Array           # (c, 2, 10) robot frame (theta0 = 0)
+
+
+def candidates(nominal: KinematicModel, modes: Sequence[str], assembly: int, *,
+               margin: float, closure_slack: float, resolution: int,
+               rng: np.random.Generator) -> tuple[tuple[str, ...], _Candidates]:
+    """Candidate poses of ``modes`` (step 1 of the module doc)."""
+    r = nominal.robot
+    reach = max(r.l1 + r.L1, r.l2 + r.L2)
+    h = 0.5 * r.d
+    lo, hi = np.array([-h - reach, -reach]), np.array([h + reach, reach])
+    step = float((hi - lo).max()) / (resolution - 1)
+    off = rng.uniform(0.0, step, 2)
+    xs = np.arange(lo[0] + off[0], hi[0], step)
+    ys = np.arange(lo[1] + off[1], hi[1], step)
+    X, Y = np.meshgrid(xs, ys)
+    grid = np.stack([X.ravel(), Y.ravel()], axis=-1)
+    out, _ = reach_violation(r, grid)
+    grid = grid[(out == 0).all(axis=1)]
+    m_all, q_all, P_all = [], [], []
+    names = tuple(canonical_working_mode(m) for m in modes)
+    base = nominal.with_frame(0.0, 0.0, 0.0)
+    for i, mode in enumerate(names):
+        q = inverse_kinematics(r, grid, mode)
+        d = pose_distances(r, q, grid)
+        ok = (d.type1 >= margin) & (d.type2 >= margin)
+        ok &= assembly_mode(r, q, grid) == assembly
+        k = closure(base, q - base.offsets, assembly)
+        bc = np.hypot(*(k.B - k.C).T)
+        ok &= (bc <= r.L1 + r.L2 - closure_slack) & (bc >= abs(r.L1 - r.L2) + closure_slack)
+        m_all.append(np.full(int(ok.sum()), i))
+        q_all.append(q[ok])
+        P_all.append(grid[ok])
+    q = np.concatenate(q_all)
+    P = np.concatenate(P_all)
+    d = pose_distances(r, q, P)
+    k = closure(base, q - base.offsets, assembly)
+    return names, _Candidates(np.concatenate(m_all), q, P, d.type1, d.type2,
+                              jacobian(base, k))
+
+
+def _gains(Jc: Array, Minv: Array) -> Array:
+    """``det(I + J_i M^-1 J_i^T)`` of each candidate (c,): the factor by which adding it
+    multiplies ``det M``."""
+    G = np.einsum("cik,kl,cjl->cij", Jc, Minv, Jc, optimize=True)
+    return np.asarray((1.0 + G[:, 0, 0]) * (1.0 + G[:, 1, 1]) - G[:, 0, 1] * G[:, 1, 0])
+
+
+def _d_optimal(Jc: Array, modes: Array, P: Array, count: int, spacing: float,
+               passes: int) -> tuple[Array, bool]:
+    """Indices of ``count`` candidates maximising ``det(sum J_i^T J_i)`` (greedy, then
+    Fedorov exchange), poses of one mode ``spacing`` apart when possible; and whether the
+    spacing held."""
+    c, _, p = Jc.shape
+    F = np.einsum("cki,ckj->cij", Jc, Jc)
+    ridge = 1e-9 * float(np.trace(F.mean(axis=0))) / p * np.eye(p)
+    chosen: list[int] = []
+    M = ridge.copy()
+    spaced = True
+
+    def near(j: int) -> Array:
+        """Candidates within ``spacing`` of candidate ``j`` in its mode (``j`` included)."""
+        return np.asarray((modes == modes[j]) & (np.hypot(*(P - P[j]).T) < spacing), dtype=int)
+
+    blocked = np.zeros(c, int)  # chosen poses within spacing of each candidate
+    taken = np.zeros(c, bool)
+    for _ in range(count):
+        g = _gains(Jc, np.linalg.inv(M))
+        ok = (blocked == 0) & ~taken
+        if not ok.any():
+            spaced = False
+            ok = ~taken
+        j = int(np.argmax(np.where(ok, g, -np.inf)))
+        chosen.append(j)
+        taken[j] = True
+        blocked += near(j)
+        M += F[j]
+    for _ in range(passes):
+        improved = False
+        for s in range(count):
+            old = chosen[s]
+            Mm = M - F[old]
+            g = _gains(Jc, np.linalg.inv(Mm))
+            nb = near(old)
+            ok = ((blocked - nb) == 0) & ~taken
+            ok[old] = True
+            j = int(np.argmax(np.where(ok, g, -np.inf)))
+            if j != old and g[j] > g[old] * (1.0 + 1e-9):
+                chosen[s] = j
+                taken[old], taken[j] = False, True
+                blocked += near(j) - nb
+                M = Mm + F[j]
+                improved = True
+        if not improved:
+            break
+    return np.array(chosen), spaced
+
+
+def _gray_order(modes: Sequence[str], start: str) -> list[str]:
+    """The modes in an order that changes one leg's sign at a time where it can, from
+    ``start`` (or the first mode when ``start`` is not among them)."""
+    todo = list(dict.fromkeys(modes))
+    cur = start if start in todo else todo[0]
+    order = [cur]
+    todo.remove(cur)
+    while todo:
+        a = parse_working_mode(cur)
+        nxt = min(todo, key=lambda m: (sum(x != y for x, y in zip(a, parse_working_mode(m),
+                                                                   strict=True)),
+                                       WORKING_MODES.index(m)))
+        order.append(nxt)
+        todo.remove(nxt)
+        cur = nxt
+    return order
+
+
+def _tour(q: Array, start: Array) -> list[int]:
+    """A tour of joint positions (n, 2) from ``start`` (2,), the distance the larger motor
+    move: nearest neighbours, then 2-opt passes (reverse a stretch while that shortens it)."""
+    pts = np.concatenate([start[None], q])
+    diff = np.abs(np.angle(np.exp(1j * (pts[:, None, :] - pts[None, :, :]))))
+    D = diff.max(axis=-1)
+    left = list(range(1, len(pts)))
+    order = [0]
+    while left:
+        i = left.pop(int(np.argmin(D[order[-1], left])))
+        order.append(i)
+    n = len(order)
+    for _ in range(50):  # open path from the fixed start: reverse order[i:j + 1]
+        better = False
+        for i in range(1, n - 1):
+            o = np.array(order)
+            j = np.arange(i + 1, n)
+            nxt = np.where(j + 1 < n, o[np.minimum(j + 1, n - 1)], -1)
+            tail_old = np.where(nxt >= 0, D[o[j], np.maximum(nxt, 0)], 0.0)
+            tail_new = np.where(nxt >= 0, D[o[i], np.maximum(nxt, 0)], 0.0)
+            gain = D[o[i - 1], o[i]] + tail_old - D[o[i - 1], o[j]] - tail_new
+            k = int(np.argmax(gain))
+            if gain[k] > 1e-12:
+                jj = int(j[k])
+                order[i:jj + 1] = order[i:jj + 1][::-1]
+                better = True
+        if not better:
+            break
+    return [i - 1 for i in order[1:]]
+
+
+def select_poses(nominal: KinematicModel, count: int, *,
+                 modes: Sequence[str] = WORKING_MODES, start_mode: str = "+-",
+                 assembly: str | int = "up", frame: str = "instrument",
+                 margin: float = DEFAULT_MARGIN, closure_slack: float = DEFAULT_SLACK,
+                 spacing: float | None = None, point_std: float | None = None,
+                 reading_std: float | None = None, resolution: int = 61, seed: int = 0,
+                 passes: int = 4) -> PoseSelection:
+    """Choose ``count`` measurement poses (see the module doc).
+
+    Parameters
+    ----------
+    nominal : KinematicModel
+        The nominal robot (SI) and encoder offsets.
+    count : int
+        Poses wanted (at least twice the parameters: 20, or 14 in the robot frame).
+    modes : sequence of str
+        Working modes to measure in (default all four).
+    start_mode : str
+        The robot's working mode (the tour starts there).
+    assembly : {"up", "down"}
+        The robot's assembly mode.
+    frame : {"instrument", "robot"}
+        Whether the instrument frame is unknown (ten parameters) or the data will be in
+        the robot frame (seven).
+    margin : float
+        Least normalised distance to both singularity types.
+    closure_slack : float
+        Least slack (m) of the distal rods from stretched or folded.
+    spacing : float, optional
+        Least distance (m) between poses of a mode (default 4 % of the legs' mean reach).
+    point_std, reading_std : float, optional
+        The instrument's noise per axis (m) and the encoders' (rad): with both, each
+        candidate's information is weighted by its covariance.
+    resolution : int
+        Grid points along the longer side of the workspace's box.
+    seed : int
+        Offsets the candidate grid within a cell.
+    passes : int
+        Most exchange passes.
+
+    Returns
+    -------
+    PoseSelection
+
+    Raises
+    ------
+    ParameterError
+        Too few poses asked for, or fewer candidates than poses.
+    """
+    if frame not in ("instrument", "robot"):
+        raise ParameterError(f"frame {frame!r} must be 'instrument' or 'robot'")
+    names = NAMES if frame == "instrument" else ROBOT
+    if not (isinstance(count, (int, np.integer)) and count >= 2 * len(names)):
+        raise ParameterError(f"{count!r} poses: a calibration of {len(names)} parameters "
+                             f"needs at least {2 * len(names)}")
+    if not (math.isfinite(margin) and 0.0 <= margin < 1.0):
+        raise ParameterError(f"singularity margin {margin!r} must be in [0, 1)")
+    if not 10 <= resolution <= 1001:
+        raise ParameterError(f"pose grid resolution {resolution} must be in 10 ... 1001")
+    if not modes:
+        raise ParameterError("no working mode to choose poses in")
+    sign = parse_assembly_mode(assembly)
+    r = nominal.robot
+    if spacing is None:
+        spacing = 0.02 * (r.l1 + r.L1 + r.l2 + r.L2)
+    rng = np.random.default_rng(seed)
+    mode_names, cand = candidates(nominal, modes, sign, margin=margin,
+                                  closure_slack=closure_slack, resolution=resolution, rng=rng)
+    n_c = len(cand.q)
+    if n_c < count:
+        raise ParameterError(
+            f"{n_c} candidate poses in working mode{'s' if len(mode_names) > 1 else ''} "
+            f"{', '.join(mode_names)} (assembly {assembly}, margin {margin:g} from the "
+            f"singularities), fewer than the {count} asked for: lower the margin or the count")
+    idx = [NAMES.index(x) for x in names]
+    ident = identifiability(cand.J, names)
+    if ident.not_identifiable:
+        names = ident.identifiable
+        idx = [NAMES.index(x) for x in names]
+    S = characteristic_scales(r)
+    Js = cand.J[:, :, idx] * S[idx]
+    if point_std is not None and reading_std is not None:
+        Jq = cand.J[:, :, 5:7]
+        Sig = point_std ** 2 * np.eye(2) + reading_std ** 2 * np.einsum("cik,cjk->cij", Jq, Jq)
+        Lc = np.linalg.cholesky(Sig)
+        Js = np.linalg.solve(Lc, Js) * point_std
+    chosen, spaced = _d_optimal(Js, cand.modes, cand.P, int(count), float(spacing),
+                                passes)
+    # visiting order
+    order: list[int] = []
+    prev = None
+    for m in _gray_order([mode_names[i] for i in cand.modes[chosen]],
+                         canonical_working_mode(start_mode)):
+        sel = chosen[cand.modes[chosen] == mode_names.index(m)]
+        q = cand.q[sel]
+        begin = q[0] if prev is None else prev
+        tour = _tour(q, begin)
+        order.extend(int(sel[t]) for t in tour)
+        prev = q[tour[-1]]
+    o = np.array(order)
+    obs = observability(cand.J[o], names, S)
+    status = 0 if spaced else 1
+    msg = (f"{count} poses in {len(set(cand.modes[o].tolist()))} working modes from {n_c} "
+           f"candidates: O1 {obs.o1:.4g}, O3 {obs.o3:.4g}, condition number "
+           f"{obs.condition_number:.4g}")
+    if not spaced:
+        msg += f"; fewer candidates than poses {1e3 * spacing:.3g} mm apart: spacing relaxed"
+    return PoseSelection(tuple(mode_names[i] for i in cand.modes[o]),
+                         "up" if sign > 0 else "down",
+                         cand.q[o] - nominal.offsets, cand.P[o], cand.type1[o],
+                         cand.type2[o], tuple(names), obs, "O1", n_c, status, msg)

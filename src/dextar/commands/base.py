@@ -1,0 +1,130 @@
+"""What every command shares: its result, the ``--out`` file rules, the options of a command
+that writes a directory, and the words of a law and of the run's units.
+
+A command module (one per command, listed in :data:`dextar.commands.COMMANDS`) holds ``NAME``,
+``HELP``, ``add_arguments(parser)`` and ``run(args) -> Result``; ``run`` only chains config ->
+domain -> output and says what to print. Modules import what their ``run`` needs when it runs,
+so that the command line starts at once.
+"""
+
+from __future__ import annotations
+
+import argparse
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from ..errors import ConfigError
+
+if TYPE_CHECKING:
+    from ..config import Scenario
+    from ..laws import Law
+
+
+@dataclass(frozen=True)
+class Result:
+    """What a command reports: a JSON payload, the same in words, warnings for stderr, for
+    ``--out -`` the data for stdout, and the exit status (0, or 1 for a result computed but
+    beyond a limit or fitting poorly)."""
+
+    payload: dict[str, Any]
+    text: str
+    warnings: list[str] = field(default_factory=list)
+    data: str | None = None
+    code: int = 0
+
+
+def shown(path: str | Path, name: str | None = None) -> str:
+    """A path as printed: no doubled or trailing separators."""
+    p = Path(path)
+    return str(p / name) if name else str(p)
+
+
+def out_file(out: str, *suffixes: str) -> Path | None:
+    """The ``--out`` file, refused unless it ends in one of ``suffixes``; None for ``-``."""
+    if out == "-":
+        return None
+    p = Path(out)
+    if p.suffix.lower() not in suffixes:
+        raise ConfigError(f"--out {out!r} must end in {' or '.join(suffixes)} (or be - for "
+                          "stdout)")
+    if p.is_dir():
+        raise ConfigError(f"--out {out!r} is a directory")
+    return p
+
+
+def write_or_hand_back(out: Path | None, text: str) -> tuple[str, str | None]:
+    """Write ``text`` atomically to ``out``; for None (stdout) hand it back as data. Returns
+    where it went (for the words) and the data."""
+    from ..output.files import write_text
+
+    if out is None:
+        return "stdout", text
+    write_text(out, text)
+    return str(out), None
+
+
+def into_directory(sp: argparse.ArgumentParser, force: str = "write into an existing "
+                   "directory (this run's files replace an earlier run's)",
+                   default: str | None = None) -> None:
+    """The options of a command that writes a directory: --out, --force, --quiet, --json."""
+    if default is None:
+        sp.add_argument("--out", required=True, help="output directory")
+    else:
+        sp.add_argument("--out", default=default, help=f"output directory (default {default})")
+    sp.add_argument("--force", action="store_true", help=force)
+    sp.add_argument("--quiet", action="store_true", help="no progress or summary output")
+    sp.add_argument("--json", action="store_true", help="print one JSON object")
+
+
+def config_argument(sp: argparse.ArgumentParser, *, required: bool = False,
+                    help: str = "TOML config (default: the paper's example)") -> None:
+    """The config file of a command (positional, optional unless ``required``)."""
+    if required:
+        sp.add_argument("config", help=help)
+    else:
+        sp.add_argument("config", nargs="?", help=help)
+
+
+def json_flag(sp: argparse.ArgumentParser) -> None:
+    """``--json``: print one JSON object."""
+    sp.add_argument("--json", action="store_true", help="print one JSON object")
+
+
+def units_argument(sp: argparse.ArgumentParser) -> None:
+    """``--units si|paper``: the unit system of the outputs (default ``[output].units``)."""
+    sp.add_argument("--units", choices=["si", "paper"], default=None,
+                    help="unit system of the output (default: the config's [output].units)")
+
+
+def units_note(sc: Scenario) -> str:
+    """The run's unit system in words."""
+    u = sc.units
+    n = u.names
+    if u.system == "paper":
+        return (f"paper units: length L = {u.length_mm:g} mm, mass m = {u.mass_kg:g} kg, "
+                f"time T = {u.time_s:g} s; angles in rad")
+    return f"SI units: {n['length']}, {n['mass']}, {n['time']}; torques in N m; angles in rad"
+
+
+def law_line(sc: Scenario, law: Law) -> str:
+    """The law, its motion time and its solver's status in words."""
+    u = sc.units
+    secs = law.duration * u.time_s
+    time = (f"{secs:.6g} s" if u.system == "si"
+            else f"{law.duration:.6g} {u.names['time']} ({secs:.6g} s)")
+    return f"{law.name} law: motion time {time}; status {law.status}: {law.message}"
+
+
+def law_payload(sc: Scenario, law: Law) -> dict[str, Any]:
+    """The law's fields of a command's JSON payload."""
+    return {"law": law.name, "duration": law.duration,
+            "duration_s": law.duration * sc.units.time_s, "status": int(law.status),
+            "success": bool(law.success), "message": law.message}
+
+
+def law_warnings(command: str, law: Law) -> list[str]:
+    """A warning when the law's solver did not meet its tolerance."""
+    if law.success:
+        return []
+    return [f"dextar {command}: warning: {law.name} law status {law.status}: {law.message}"]

@@ -1,0 +1,56 @@
+"""``dextar excite CONFIG.toml``: an exciting trajectory for identification (a Fourier series
+per motor, the base regressor's condition number minimised), written as CSV at the servo
+rate with the torques the config's model predicts."""
+
+from __future__ import annotations
+
+import argparse
+
+from .base import Result, config_argument, json_flag, out_file, write_or_hand_back
+
+NAME = "excite"
+HELP = ("an exciting trajectory for identification (a Fourier series per motor, regressor "
+        "condition number minimised) to CSV")
+
+
+def add_arguments(sp: argparse.ArgumentParser) -> None:
+    """``config``, ``--out``, ``--duration``, ``--harmonics``, ``--base-hz``, ``--seed``."""
+    config_argument(sp, required=True, help="TOML config: the robot, its prior masses, "
+                    "[motors]")
+    json_flag(sp)
+    sp.add_argument("--out", required=True, help="CSV file (- for stdout)")
+    sp.add_argument("--duration", type=float, default=20.0,
+                    help="seconds, rounded up to whole periods (default 20)")
+    sp.add_argument("--harmonics", type=int, default=5, help="harmonics per motor (default 5)")
+    sp.add_argument("--base-hz", type=float, default=0.2,
+                    help="base frequency, Hz (default 0.2: a 5 s period)")
+    sp.add_argument("--seed", type=int, default=0, help="seed of the optimiser's starts")
+    sp.add_argument("--quiet", action="store_true", help="no summary output")
+
+
+def run(args: argparse.Namespace) -> Result:
+    """Design the motion, sample it at the servo rate, write it."""
+    from ..config import load_scenario
+    from ..identification.excite import design_excitation
+    from ..output.identification import excitation_columns, excitation_payload
+    from ..output.tables import csv_text
+
+    target = out_file(args.out, ".csv")
+    sc = load_scenario(args.config)
+    model = sc.si_model
+    res = design_excitation(model, sc.mode, harmonics=args.harmonics, base_hz=args.base_hz,
+                            duration=args.duration, motors=sc.si_motors, seed=args.seed)
+    rate = sc.output.servo_rate_hz
+    cols = excitation_columns(model, res, rate)
+    where, data = write_or_hand_back(target, csv_text(cols))
+    payload = excitation_payload(res, args.harmonics, args.base_hz, len(cols["t_s"]), rate,
+                                 where)
+    text = (f"exciting trajectory: condition number {res.condition_number:.4g} (base "
+            f"regressor, unit-norm columns); {res.periods} period(s) of "
+            f"{res.trajectory.period:g} s, {args.harmonics} harmonics; peak torques "
+            f"{res.peak_torque[0]:.4g}, {res.peak_torque[1]:.4g} N m; min singularity "
+            f"distances type 1 {res.min_type1_distance:.3g}, type 2 "
+            f"{res.min_type2_distance:.3g}; wrote {where} ({payload['samples']} samples at "
+            f"{rate:g} Hz)")
+    warnings = [] if res.status == 0 else [f"dextar excite: warning: {res.message}"]
+    return Result(payload, text, warnings, data=data)

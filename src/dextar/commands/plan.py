@@ -1,0 +1,57 @@
+"""``dextar plan``: the configured law along the path, its samples to CSV, the motion time
+and the solver's status (and the optimal law's cost)."""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+from .base import (
+    Result,
+    config_argument,
+    json_flag,
+    law_line,
+    law_payload,
+    law_warnings,
+    out_file,
+    units_argument,
+    units_note,
+    write_or_hand_back,
+)
+
+NAME = "plan"
+HELP = "law of motion along the path: samples to CSV, cost"
+REGISTRIES_HELP = True
+
+
+def add_arguments(sp: argparse.ArgumentParser) -> None:
+    """``[config]``, ``--out``, ``--json``."""
+    config_argument(sp)
+    json_flag(sp)
+    sp.add_argument("--out", required=True, help="CSV file (- for stdout)")
+    units_argument(sp)
+
+
+def run(args: argparse.Namespace) -> Result:
+    """Plan, write the samples, word the law."""
+    from ..config import load_scenario
+    from ..output.tables import csv_text, trajectory_columns
+
+    path = out_file(args.out, ".csv")
+    sc = load_scenario(args.config).in_units(args.units)
+    law = sc.law()
+    tr = sc.trajectory(law)
+    where, data = write_or_hand_back(path, csv_text(trajectory_columns(tr, sc.units)))
+    payload: dict[str, Any] = {"out": where, "samples": int(tr.t.size), **law_payload(sc, law),
+                               "units": sc.units.describe()}
+    lines = [law_line(sc, law)]
+    cost = law.cost_report()
+    if cost is not None:
+        payload.update(cost=cost["total"], cost_kinetic=cost["kinetic"],
+                       cost_inertial=cost["inertial"])
+        lines.append(f"cost Phi = {cost['total']:.10g} (kinetic {cost['kinetic']:.10g}, "
+                     f"inertial {cost['inertial']:.10g}) [{sc.units.names['energy']} x "
+                     f"{sc.units.names['time']}]")
+    lines.append(f"wrote {where}: {tr.t.size} samples, working mode {tr.mode} "
+                 f"({units_note(sc)})")
+    return Result(payload, "\n".join(lines), law_warnings("plan", law), data)

@@ -1,0 +1,36 @@
+"""``dextar program TASK.toml``: a robot program planned under the motors: setpoints, sizing,
+figures and the report (exit status 1 when a motor limit is exceeded)."""
+
+from __future__ import annotations
+
+import argparse
+
+from .base import Result, config_argument, into_directory
+
+NAME = "program"
+HELP = ("plan a robot program under the motors: setpoints and sizing (exit 1 when a motor "
+        "limit is exceeded)")
+
+
+def add_arguments(sp: argparse.ArgumentParser) -> None:
+    """``config``, ``--out``, ``--force``, ``--quiet``, ``--json``."""
+    config_argument(sp, required=True,
+                    help="TOML task file with [program], [[move]] and [motors]")
+    into_directory(sp)
+
+
+def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
+    """Plan, size, write, word."""
+    from ..config import load_scenario
+    from ..output.program import ProgramSummary, write_program
+    from ..program import sizing
+
+    sc = load_scenario(args.config)
+    res = sc.program_request().plan()
+    summary = ProgramSummary(args.config, res.cycle_time_s, sc.output.servo_rate_hz,
+                             tuple(res.timeline()), sizing(res))
+    write_program(args.out, res, summary, sc.robot_mm, sc.program_mode, force=args.force,
+                  with_figures=figures)
+    warnings = [f"dextar program: {v.text()}" for v in summary.sizing.violations]
+    return Result(summary.as_json(), "\n".join(summary.lines(args.out, res.t.size)), warnings,
+                  code=0 if summary.sizing.fits else 1)

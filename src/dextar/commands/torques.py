@@ -1,0 +1,66 @@
+"""``dextar torques``: exact (and paper-model) torques, powers, energy and joint forces to
+CSV."""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+from .base import (
+    Result,
+    config_argument,
+    json_flag,
+    law_line,
+    law_payload,
+    law_warnings,
+    out_file,
+    units_argument,
+    units_note,
+    write_or_hand_back,
+)
+
+NAME = "torques"
+HELP = "exact and paper-model motor torques to CSV"
+REGISTRIES_HELP = True
+
+
+def add_arguments(sp: argparse.ArgumentParser) -> None:
+    """``[config]``, ``--out``, ``--json``."""
+    config_argument(sp)
+    json_flag(sp)
+    sp.add_argument("--out", required=True, help="CSV file (- for stdout)")
+    units_argument(sp)
+
+
+def run(args: argparse.Namespace) -> Result:
+    """Analyse, write the columns, word the peaks and the paper model's error."""
+    import numpy as np
+
+    from ..analysis import analyze
+    from ..config import load_scenario
+    from ..dynamics.paper import paper_model_limits
+    from ..output.tables import csv_text, torque_columns
+
+    path = out_file(args.out, ".csv")
+    sc = load_scenario(args.config).in_units(args.units)
+    an = analyze(sc.inputs(), sc.law())
+    where, data = write_or_hand_back(path, csv_text(torque_columns(an)))
+    peak = np.abs(an.tau).max(axis=0)
+    payload: dict[str, Any] = {"out": where, "samples": int(an.trajectory.t.size),
+                               **law_payload(sc, an.law),
+                               "peak_torque": [float(v) for v in peak],
+                               "units": sc.units.describe()}
+    text = (f"{law_line(sc, an.law)}\nwrote {where}: {an.trajectory.t.size} samples; peak "
+            f"|tau| = {peak[0]:.6g}, {peak[1]:.6g} [{sc.units.names['torque']}] "
+            f"({units_note(sc)})")
+    if an.paper is not None:
+        payload["paper_model_error"] = an.paper.error
+        left = an.paper.leaves_out
+        text += (f"\npaper model (42) error: max {an.paper.error['max_relative']:.1%}, RMS "
+                 f"{an.paper.error['rms_relative']:.1%} of the peak exact torque"
+                 + (f" (against the exact torques without {' and '.join(left)}, which (42) "
+                    "leaves out)" if left else ""))
+    else:
+        why = paper_model_limits(sc.robot, sc.inertia)
+        text += f"\nno paper-model columns: the paper's simplified model does not apply ({why})"
+    return Result(payload, text, law_warnings("torques", an.law), data)

@@ -1,0 +1,342 @@
+"""Limits of a law planned on the robot's dynamics along a path, one object per limit.
+
+Along the path (arc length ``s``) the joint motion is ``qdot = q' sdot`` and
+``qddot = q' sddot + q'' sdot^2``, so with ``x = sdot^2`` and ``u = sddot`` the exact inverse
+dynamics are affine in ``(x, u)`` up to friction:
+
+    tau(s) = a(s) u + b(s) x + g(s) + f(s, sdot),
+    a = M q',  b = M q'' + c(q, q'),  g = gravity,  f = friction (viscous + Coulomb).
+
+A constraint turns this into linear rows ``pu u + px x <= ph`` at every grid point
+(:meth:`Constraint.rows`) or a cap on the squared speed (:meth:`Constraint.speed_cap`), and
+measures how far a planned law goes against it on check samples (:meth:`Constraint.ratio`).
+A caller composes them (:func:`motor_constraints` for the motors' limits); the time-optimal
+solver (:mod:`dextar.laws.time_optimal`) takes any sequence of them. The kinds:
+
+* :class:`TorqueLimit`: ``|tau_i| <= peak_i`` with friction bounded, not linearised: the
+  regularised Coulomb torque always lies between 0 and ``coulomb * sign(q')`` and the viscous
+  torque ``viscous q' sqrt(x)`` between 0 and its tangent upper bound at a tangent point
+  ``x0`` (the previous iterate's speeds), so the limits hold for every friction value in the
+  interval; where a joint reverses the interval is ``[-coulomb, coulomb]``; at the two rest
+  points friction is zero.
+* :class:`SpeedLimit`: ``|qdot_i| <= max_speed_i``, a cap ``x <= (max_speed / |q'|)^2``.
+* :class:`TorqueSpeedEnvelope`: full torque up to the knee speed, then linearly down to zero
+  at the maximum speed: ``|tau| + sigma |q'| sqrt(x) <= T + sigma knee``
+  (``sigma = T / (max_speed - knee)``), ``sqrt(x)`` bounded above by its tangent at
+  ``max(x0, x_knee)``: conservative, and exact at the tangent point.
+
+Each constraint has a ``kind`` (the quantity it limits: ``"torque"``, ``"speed"``); when the
+check finds an excess of a kind, the solver tightens every constraint of that kind by it
+(:meth:`Constraint.scaled`).
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, replace
+from functools import cached_property
+from typing import Protocol
+
+import numpy as np
+
+from .._arrays import Array
+from ..motors import MotorLimits
+from .base import Law
+
+
+@dataclass(frozen=True)
+class PathCoefficients:
+    """The path dynamics on a grid of arc lengths: ``tau = a u + b x + g + f``.
+
+    Attributes
+    ----------
+    s : ndarray, shape (N + 1,)
+        Arc lengths of the grid, increasing from 0 to the path's length.
+    P : ndarray, shape (N + 1, 2)
+        End-effector positions (for the words of an error).
+    a, b, g : ndarray, shape (N + 1, 2)
+        ``M q'``, ``M q'' + c(q, q')`` and the gravity torques.
+    dq_ds : ndarray, shape (N + 1, 2)
+        ``q'``, the joint rates per unit arc length.
+    coulomb, viscous : ndarray, shape (2,)
+        The motors' friction coefficients.
+    """
+
+    s: Array
+    P: Array
+    a: Array
+    b: Array
+    g: Array
+    dq_ds: Array
+    coulomb: Array
+    viscous: Array
+
+    @cached_property
+    def friction_sides(self) -> tuple[Array, Array]:
+        """Where each joint's friction may push up (forward motion, or a reversal near) and
+        down: two arrays (N + 1, 2) of 1.0 and 0.0, both 0 at the two rest points (where
+        friction is exactly zero)."""
+        sg = np.sign(self.dq_ds)
+        steady = (sg == np.roll(sg, 1, axis=0)) & (sg == np.roll(sg, -1, axis=0)) & (sg != 0)
+        steady[[0, -1]] = (sg[[0, -1]] == sg[[1, -2]]) & (sg[[0, -1]] != 0)
+        up = ((steady & (sg > 0)) | ~steady).astype(float)
+        down = ((steady & (sg < 0)) | ~steady).astype(float)
+        up[[0, -1]] = down[[0, -1]] = 0.0
+        return up, down
+
+
+@dataclass(frozen=True)
+class JointSamples:
+    """A law's motion sampled through the exact model: the torques and the joint rates.
+
+    Attributes
+    ----------
+    tau, dq : ndarray, shape (n, 2)
+    """
+
+    tau: Array
+    dq: Array
+
+
+class PathDynamics(Protocol):
+    """The robot along a path, as the laws planned on its dynamics need it."""
+
+    @property
+    def length(self) -> float:
+        """The path's length."""
+        ...
+
+    def coefficients(self, s: Array) -> PathCoefficients:
+        """The coefficients at the arc lengths ``s`` (N + 1,), from 0 to the length."""
+        ...
+
+    def samples(self, law: Law, times: Array) -> JointSamples:
+        """``law`` at ``times`` through the exact model (gravity and friction included)."""
+        ...
+
+
+@dataclass(frozen=True)
+class PointRows:
+    """Rows ``pu u + px x <= ph`` at every grid point, each array (N + 1, m)."""
+
+    pu: Array
+    px: Array
+    ph: Array
+
+
+@dataclass(frozen=True)
+class Tangent:
+    """The grid's coefficients with the tangent point ``x0`` (N + 1,) of the speed-dependent
+    bounds (None before there is one), shared by the constraints of one solve."""
+
+    co: PathCoefficients
+    x0: Array | None
+
+    @cached_property
+    def friction(self) -> tuple[Array, Array, Array, Array]:
+        """Friction ``f`` in ``[phi_lo + psi_lo x, phi_hi + psi_hi x]`` at each grid point,
+        arrays (N + 1, 2)."""
+        co, x0 = self.co, self.x0
+        up, down = co.friction_sides
+        if x0 is None:
+            far_phi, far_psi = np.broadcast_to(co.coulomb, up.shape), np.zeros(up.shape)
+        else:  # viscous |f| <= w sqrt(x) <= w (x + x0) / (2 sqrt(x0)), tangent at x0
+            r = np.sqrt(np.maximum(x0, 1e-9 * max(float(x0.max()), 1e-300)))[:, None]
+            w = co.viscous * np.abs(co.dq_ds)
+            far_phi, far_psi = co.coulomb + 0.5 * w * r, 0.5 * w / r
+        return -down * far_phi, -down * far_psi, up * far_phi, up * far_psi
+
+
+class Constraint(ABC):
+    """One limit of a law along a path (see the module doc)."""
+
+    #: The quantity limited; the check's excess of a kind tightens every constraint of it.
+    kind: str = ""
+
+    def rows(self, tangent: Tangent) -> PointRows | None:
+        """Rows at every grid point (None: this constraint has none)."""
+        return None
+
+    def speed_cap(self, co: PathCoefficients) -> Array | None:
+        """The largest squared path speed (N + 1,) it allows (None: no cap)."""
+        return None
+
+    def needs_tangent(self, co: PathCoefficients) -> bool:
+        """True when its rows bound a ``sqrt(x)`` by a tangent (speed-dependent bounds)."""
+        return False
+
+    @abstractmethod
+    def ratio(self, js: JointSamples) -> float:
+        """Largest ratio of the limited quantity to its limit on the samples."""
+
+    @abstractmethod
+    def scaled(self, scales: Mapping[str, float]) -> Constraint:
+        """The constraint with its limits multiplied by ``scales[kind]`` (tightened)."""
+
+    @property
+    def torque_limit(self) -> tuple[float, float] | None:
+        """The peak torques it imposes, for the words of an error (None: not a torque)."""
+        return None
+
+    @property
+    def speed_limit(self) -> tuple[float, float] | None:
+        """The joint speeds it imposes (None: not a speed limit)."""
+        return None
+
+
+def _pair(v: Array) -> tuple[float, float]:
+    return float(v[0]), float(v[1])
+
+
+@dataclass(frozen=True)
+class TorqueLimit(Constraint):
+    """``|tau_i| <= peak_i`` at every point, friction bounded (see the module doc)."""
+
+    peak: tuple[float, float]
+    kind: str = "torque"
+
+    def rows(self, tangent: Tangent) -> PointRows:
+        """``a u + b x + g + f <= T`` and ``-(a u + b x + g + f) <= T`` at every point."""
+        co, tmax = tangent.co, np.asarray(self.peak, float)
+        phi_lo, psi_lo, phi_hi, psi_hi = tangent.friction
+        return PointRows(np.concatenate([co.a, -co.a], axis=1),
+                         np.concatenate([co.b + psi_hi, -(co.b + psi_lo)], axis=1),
+                         np.concatenate([tmax - co.g - phi_hi, tmax + co.g + phi_lo], axis=1))
+
+    def needs_tangent(self, co: PathCoefficients) -> bool:
+        """A viscous friction's bound is a tangent."""
+        return bool(np.any(co.viscous > 0))
+
+    def ratio(self, js: JointSamples) -> float:
+        """Largest ``|tau_i| / peak_i``."""
+        return MotorLimits(self.peak).torque_ratio(js.tau, js.dq)
+
+    def scaled(self, scales: Mapping[str, float]) -> TorqueLimit:
+        """The peak torques tightened by ``scales["torque"]``."""
+        return replace(self, peak=_pair(np.asarray(self.peak, float) * scales.get("torque", 1.0)))
+
+    @property
+    def torque_limit(self) -> tuple[float, float]:
+        """The peak torques."""
+        return self.peak
+
+
+@dataclass(frozen=True)
+class SpeedLimit(Constraint):
+    """``|qdot_i| <= max_speed_i``: a cap on the squared path speed."""
+
+    max_speed: tuple[float, float]
+    kind: str = "speed"
+
+    def speed_cap(self, co: PathCoefficients) -> Array:
+        """``min_i (max_speed_i / |q'_i|)^2`` (``inf`` where neither joint moves)."""
+        wmax = np.asarray(self.max_speed, float)
+        with np.errstate(divide="ignore"):
+            return np.asarray(np.min(np.where(co.dq_ds != 0, (wmax / np.abs(co.dq_ds)) ** 2,
+                                              np.inf), axis=1))
+
+    def ratio(self, js: JointSamples) -> float:
+        """Largest ``|qdot_i| / max_speed_i``."""
+        return float((np.abs(js.dq) / np.asarray(self.max_speed, float)).max())
+
+    def scaled(self, scales: Mapping[str, float]) -> SpeedLimit:
+        """The speeds tightened by ``scales["speed"]``."""
+        return replace(self, max_speed=_pair(np.asarray(self.max_speed, float)
+                                             * scales.get("speed", 1.0)))
+
+    @property
+    def speed_limit(self) -> tuple[float, float]:
+        """The maximum speeds."""
+        return self.max_speed
+
+
+@dataclass(frozen=True)
+class TorqueSpeedEnvelope(Constraint):
+    """Full torque up to ``knee``, then linearly down to zero at ``max_speed``: a torque
+    limit whose tightening scales the peak by ``scales["torque"]`` and the speeds by
+    ``scales["speed"]``."""
+
+    peak: tuple[float, float]
+    max_speed: tuple[float, float]
+    knee: tuple[float, float]
+    kind: str = "torque"
+
+    def rows(self, tangent: Tangent) -> PointRows | None:
+        """``|tau| + sigma |q'| sqrt(x) <= T + sigma knee`` with ``sqrt(x)`` bounded by its
+        tangent at ``max(x0, x_knee)`` (none before the first tangent point)."""
+        co, x0 = tangent.co, tangent.x0
+        if x0 is None:
+            return None
+        tmax, wmax = np.asarray(self.peak, float), np.asarray(self.max_speed, float)
+        knee = np.asarray(self.knee, float)
+        phi_lo, psi_lo, phi_hi, psi_hi = tangent.friction
+        sigma = tmax / (wmax - knee)
+        qabs = np.abs(co.dq_ds)
+        with np.errstate(divide="ignore"):
+            xk = np.where(qabs > 0, (knee / qabs) ** 2, np.inf)
+        r = np.sqrt(np.minimum(np.maximum(x0[:, None], xk), 1e300))
+        slope = np.where(qabs > 0, sigma * qabs / (2 * r), 0.0)
+        offset = np.where(qabs > 0, sigma * qabs * r / 2, 0.0)
+        cap = tmax + sigma * knee - offset
+        return PointRows(np.concatenate([co.a, -co.a], axis=1),
+                         np.concatenate([co.b + psi_hi + slope, -(co.b + psi_lo) + slope],
+                                        axis=1),
+                         np.concatenate([cap - co.g - phi_hi, cap + co.g + phi_lo], axis=1))
+
+    def needs_tangent(self, co: PathCoefficients) -> bool:
+        """The envelope's ``sqrt(x)`` is bounded by a tangent."""
+        return True
+
+    def ratio(self, js: JointSamples) -> float:
+        """Largest ``|tau_i|`` over the torque available at the sample's speed."""
+        return MotorLimits(self.peak, self.max_speed, self.knee).torque_ratio(js.tau, js.dq)
+
+    def scaled(self, scales: Mapping[str, float]) -> TorqueSpeedEnvelope:
+        """Peak tightened by ``scales["torque"]``, speeds by ``scales["speed"]``."""
+        t, w = scales.get("torque", 1.0), scales.get("speed", 1.0)
+        return replace(self, peak=_pair(np.asarray(self.peak, float) * t),
+                       max_speed=_pair(np.asarray(self.max_speed, float) * w),
+                       knee=_pair(np.asarray(self.knee, float) * w))
+
+    @property
+    def torque_limit(self) -> tuple[float, float]:
+        """The peak torques."""
+        return self.peak
+
+
+def motor_constraints(motors: MotorLimits) -> tuple[Constraint, ...]:
+    """The motors' limits as constraints: the peak torque, the speed limit (when finite) and
+    the torque-speed envelope (when it has a knee)."""
+    out: list[Constraint] = [TorqueLimit(motors.peak_torque)]
+    if np.isfinite(np.asarray(motors.max_speed, float)).any():
+        out.append(SpeedLimit(motors.max_speed))
+    if motors.knee_speed is not None:
+        out.append(TorqueSpeedEnvelope(motors.peak_torque, motors.max_speed, motors.knee_speed))
+    return tuple(out)
+
+
+def point_rows(constraints: Sequence[Constraint], tangent: Tangent) -> PointRows:
+    """Every constraint's rows at every point, side by side (N + 1, m)."""
+    rows = [r for c in constraints if (r := c.rows(tangent)) is not None]
+    return PointRows(*(np.concatenate([getattr(r, k) for r in rows], axis=1)
+                       for k in ("pu", "px", "ph")))
+
+
+def speed_cap(constraints: Sequence[Constraint], co: PathCoefficients) -> Array:
+    """The squared-speed cap (N + 1,) of all constraints (``inf`` where none caps it)."""
+    cap = np.full(len(co.s), np.inf)
+    for c in constraints:
+        x = c.speed_cap(co)
+        if x is not None:
+            cap = np.minimum(cap, x)
+    return cap
+
+
+def ratios_by_kind(constraints: Sequence[Constraint], js: JointSamples) -> dict[str, float]:
+    """The largest ratio of each kind of constraint on the samples."""
+    out: dict[str, float] = {}
+    for c in constraints:
+        r = c.ratio(js)
+        out[c.kind] = max(out.get(c.kind, 0.0), r)
+    return out

@@ -1,0 +1,125 @@
+"""Motor sizing of a planned program: per motor the peak and RMS torque, the peak speed and
+power, the energy delivered, their ratios to the motors' limits, and the violations."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+from typing import Any
+
+import numpy as np
+
+from .plan import ProgramResult
+
+#: Relative excess over a limit that counts as a violation.
+SIZING_TOL = 1e-3
+
+
+@dataclass(frozen=True)
+class MotorSizing:
+    """One motor over the cycle (SI).
+
+    Attributes
+    ----------
+    motor : str
+        ``"A"`` or ``"D"``.
+    peak_torque_Nm, rms_torque_Nm, peak_speed_rad_s, peak_power_W, energy_J : float
+        The energy is the positive work the motor delivers.
+    peak_torque_ratio, peak_speed_ratio : float, optional
+        Against the torque available at the speed (the envelope) and the maximum speed
+        (None without motors).
+    rms_torque_ratio : float, optional
+        Against the continuous rating (None without one).
+    """
+
+    motor: str
+    peak_torque_Nm: float
+    rms_torque_Nm: float
+    peak_speed_rad_s: float
+    peak_power_W: float
+    energy_J: float
+    peak_torque_ratio: float | None = None
+    peak_speed_ratio: float | None = None
+    rms_torque_ratio: float | None = None
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready, the ratios that do not apply left out."""
+        return {k: v for k, v in asdict(self).items() if v is not None}
+
+
+@dataclass(frozen=True)
+class Violation:
+    """A limit a motor exceeds: where (the move and the time; None for the RMS rating, a
+    property of the whole cycle), the value and the limit (SI)."""
+
+    motor: str
+    quantity: str
+    value: float
+    limit: float
+    move: int | None
+    t_s: float | None
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready."""
+        return asdict(self)
+
+    def text(self) -> str:
+        """The violation in words."""
+        where = (f" at t = {self.t_s:.4g} s in move {self.move}" if self.t_s is not None
+                 else "")
+        return (f"motor {self.motor} {self.quantity} {self.value:.4g} above its limit "
+                f"{self.limit:.4g}{where}")
+
+
+@dataclass(frozen=True)
+class Sizing:
+    """The motors over the cycle and the limits they exceed."""
+
+    motors: tuple[MotorSizing, MotorSizing]
+    violations: tuple[Violation, ...]
+
+    @property
+    def fits(self) -> bool:
+        """True when no limit is exceeded."""
+        return not self.violations
+
+
+def sizing(res: ProgramResult) -> Sizing:
+    """Per motor: peak and RMS torque, peak speed, peak power, energy (with their ratios to
+    the limits), and the violations."""
+    t, tau, dq = res.t, res.tau, res.dq
+    power = tau * dq
+    dt = np.diff(t)
+    motors_out: list[MotorSizing] = []
+    violations: list[Violation] = []
+    for i, name in enumerate(("A", "D")):
+        pos = np.maximum(power[:, i], 0.0)
+        rms = float(math.sqrt(np.sum(0.5 * (tau[1:, i] ** 2 + tau[:-1, i] ** 2) * dt)
+                              / max(t[-1], 1e-300)))
+        ratios: dict[str, float] = {}
+        if res.motors is not None:
+            m = res.motors
+            avail = m.available_torque(dq)[:, i]
+            ratio = np.abs(tau[:, i]) / np.maximum(avail, 1e-300)
+            ratios["peak_torque_ratio"] = float(ratio.max())
+            ratios["peak_speed_ratio"] = float(np.abs(dq[:, i]).max() / m.max_speed[i])
+            k = int(np.argmax(ratio))
+            if ratio[k] > 1.0 + SIZING_TOL:
+                violations.append(Violation(name, "torque", float(abs(tau[k, i])),
+                                            float(avail[k]), int(res.move_index[k]),
+                                            float(t[k])))
+            k = int(np.argmax(np.abs(dq[:, i])))
+            if abs(dq[k, i]) > m.max_speed[i] * (1 + SIZING_TOL):
+                violations.append(Violation(name, "speed", float(abs(dq[k, i])),
+                                            float(m.max_speed[i]), int(res.move_index[k]),
+                                            float(t[k])))
+        if res.rms_limit is not None:
+            ratios["rms_torque_ratio"] = rms / res.rms_limit[i]
+            if rms > res.rms_limit[i] * (1 + SIZING_TOL):
+                violations.append(Violation(name, "rms_torque", rms, float(res.rms_limit[i]),
+                                            None, None))
+        motors_out.append(MotorSizing(
+            name, float(np.abs(tau[:, i]).max()), rms, float(np.abs(dq[:, i]).max()),
+            float(np.abs(power[:, i]).max()), float(np.sum(0.5 * (pos[1:] + pos[:-1]) * dt)),
+            **ratios))
+    return Sizing((motors_out[0], motors_out[1]), tuple(violations))

@@ -1,0 +1,234 @@
+"""The traps a new user fell into (issue "No plausible-looking wrong answers"), each where
+the user met it: at the command line, or in the Python API for the API's own items. Every
+test here failed before its fix."""
+
+import json
+import os
+import re
+import stat
+
+import numpy as np
+import pytest
+
+from dextar.cli import main
+
+from ..program.test_program import EXAMPLES
+
+
+def read_csv(path):
+    return np.genfromtxt(path, delimiter=",", names=True)
+
+
+# ---------------------------------------------------------------- wrong numbers that look right
+def test_a_users_run_draws_what_applies_and_names_what_42_leaves_out(tmp_path, capsys):
+    """line_si.toml (gravity, friction, payload): no Fig. 3 (the paper's uniform law) or Fig.
+    7 (the paper's masses); the paper model's error is measured against the exact torques
+    without gravity and friction, and says so."""
+    cfg = tmp_path / "line.toml"  # line_si.toml, fewer samples and animation frames
+    cfg.write_text((EXAMPLES / "line_si.toml").read_text().replace(
+        "samples = 501", "samples = 101\nanimation_frames = 2"))
+    out = tmp_path / "run"
+    assert main(["run", str(cfg), "--out", str(out), "--quiet"]) == 0
+    names = {p.name for p in out.iterdir()}
+    assert "fig9.png" in names and not {"fig3.png", "fig7.png"} & names
+    s = json.loads((out / "summary.json").read_text())
+    assert s["paper_model"]["leaves_out"] == ["gravity", "friction"]
+    assert "without gravity and friction" in s["paper_model"]["error_note"]
+    assert main(["torques", str(cfg), "--out", str(tmp_path / "t.csv")]) == 0
+    assert "without gravity and friction, which (42) leaves out" in capsys.readouterr().out
+
+
+def test_identify_without_config_says_what_it_assumed(tmp_path, capsys, excite_csv):
+    main(["identify", str(excite_csv), "--out", str(tmp_path / "id"), "--quiet"])
+    err = capsys.readouterr().err
+    assert "no --config: the robot is assumed to be the DexTAR" in err and "gravity" in err
+
+
+# ---------------------------------------------------------------- no answer where there is one
+@pytest.mark.parametrize("limits", ['vmax = 300.0\namax = 3000.0\n', ''])
+def test_a_fitted_trapezoid_is_the_shortest_within_the_motors(tmp_path, limits):
+    """pick_place.toml with move 6 a trapezoid fitted to the motors (with and without its own
+    vmax and amax): planned, within the motors on dense samples, and 1 % shorter it is not."""
+    from dextar.config import load_scenario
+    from dextar.dynamics import inverse_dynamics
+    from dextar.laws import TrapezoidalLaw
+
+    text = (EXAMPLES / "pick_place.toml").read_text().replace(
+        'law = "min-jerk"\n', f'law = "trapezoid"\n{limits}')
+    cfg = tmp_path / "task.toml"
+    cfg.write_text(text)
+    assert main(["program", str(cfg), "--out", str(tmp_path / "o"), "--quiet"]) == 0
+    sc = load_scenario(cfg)
+    res = sc.program_request().plan()
+    pm = next(p for p in res.moves if p.index == 6)
+    law = pm.law
+    rho = law.cruise / law.amax / law.duration
+    if limits:  # the given limits hold and one of them binds
+        assert law.cruise <= 0.3 * (1 + 1e-9) and law.amax <= 3.0 * (1 + 1e-9)
+        assert max(law.cruise / 0.3, law.amax / 3.0) > 0.999
+        return
+    motors, model = sc.si_motors, sc.si_model
+
+    def ratio(duration):
+        lw = TrapezoidalLaw.shaped(law.distance, duration, rho)
+        t = np.linspace(0.0, duration, 4001)
+        t = np.sort(np.concatenate([t, lw.breakpoints() - 1e-12, lw.breakpoints() + 1e-12]))
+        from dextar.paths import Line
+
+        path = Line((0.04, 0.09), (0.04, 0.11))
+        from dextar.trajectory import sample_trajectory
+
+        tr = sample_trajectory(model.robot, path, lw, mode="+-", times=t)
+        return max(motors.ratios(inverse_dynamics(model, tr.q, tr.dq, tr.ddq), tr.dq))
+
+    # measured: 0.999 at the fitted duration, 1.02 at 99 % of it
+    assert ratio(law.duration) <= 1.0 + 1e-3
+    assert ratio(0.99 * law.duration) > 1.0
+
+
+def test_a_trapezoid_error_speaks_the_configs_units(tmp_path, capsys):
+    cfg = tmp_path / "t.toml"
+    cfg.write_text('[law]\ntype = "trapezoid"\namax = 3000.0\nduration = 0.05\n'
+                   '[output]\nunits = "si"\n')
+    assert main(["plan", str(cfg), "--out", str(tmp_path / "p.csv")]) == 2
+    err = capsys.readouterr().err
+    assert re.search(r"trapezoid: 376\.99\d* mm cannot be covered in 0\.05 s with amax 3000 "
+                     r"mm/s\^2", err), err
+
+
+def test_a_plant_that_meets_a_singularity_is_a_result(tmp_path, capsys):
+    """line_si.toml with a 0.1 N m torque limit: the saturated plant runs into a parallel
+    singularity; what was simulated up to then is written, exit 1, the time named."""
+    cfg = tmp_path / "sat.toml"
+    cfg.write_text((EXAMPLES / "line_si.toml").read_text().replace("torque_limit = 2.0",
+                                                                     "torque_limit = 0.1"))
+    out = tmp_path / "sim"
+    assert main(["simulate", str(cfg), "--out", str(out), "--quiet"]) == 1
+    err = capsys.readouterr().err
+    assert re.search(r"left the motion at t = 0\.2\d* s of 0\.25 s \(.*parallel", err), err
+    assert "saturated a motor during" in err and err.count("\n") == 1
+    d = read_csv(out / "tracking.csv")
+    assert 0.2 < d["t_s"][-1] < 0.25 and np.isfinite(d["phi_rad"]).all()
+    s = json.loads((out / "tracking.json").read_text())
+    assert s["status"] == 1 and s["saturated_fraction"] > 0.5
+
+
+@pytest.mark.parametrize("key, value", [("natural_frequency_hz", "1e300"), ("damping", "1e300"),
+                                        ("mass_error", "1e300"), ("payload", "1e300"),
+                                        ("initial_error_deg", "[1e300, 0.0]")])
+def test_control_settings_out_of_range_are_refused_by_key(tmp_path, capsys, key, value):
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(f"[control]\n{key} = {value}\n")
+    assert main(["simulate", str(cfg), "--out", str(tmp_path / "s")]) == 2
+    err = capsys.readouterr().err
+    assert f"[control].{key}" in err and err.count("\n") == 1 and "internal" not in err
+
+
+# ---------------------------------------------------------------- files and messages
+def test_every_output_follows_the_umask(tmp_path, excite_csv):
+    small = tmp_path / "small.toml"
+    small.write_text('[output]\nfigures = ["fig4", "animation"]\nanimation_frames = 2\n'
+                     'samples = 101\n')
+    old = os.umask(0o022)
+    try:
+        main(["program", str(EXAMPLES / "mode_change.toml"), "--out", str(tmp_path / "p"),
+              "--quiet"])
+        main(["run", str(small), "--out", str(tmp_path / "r"), "--quiet"])
+        main(["identify", str(excite_csv), "--config", str(EXAMPLES / "pick_place.toml"),
+              "--out", str(tmp_path / "i"), "--quiet"])
+    finally:
+        os.umask(old)
+    files = [*(tmp_path / "p").iterdir(), *(tmp_path / "r").iterdir(),
+             *(tmp_path / "i").iterdir()]
+    assert len(files) > 10
+    assert {stat.S_IMODE(p.stat().st_mode) for p in files} == {0o644}
+
+
+def test_a_forced_run_holds_this_runs_files_only(tmp_path):
+    out = tmp_path / "d"
+    a, b = tmp_path / "a.toml", tmp_path / "b.toml"
+    a.write_text('[output]\nfigures = ["fig4", "animation"]\nanimation_frames = 2\n'
+                 'samples = 101\n')
+    b.write_text('[output]\nfigures = ["fig5"]\nsamples = 101\n')
+    assert main(["run", str(a), "--out", str(out), "--quiet"]) == 0
+    assert (out / "animation.gif").exists()
+    (out / "my_notes.txt").write_text("the user's own file")
+    assert main(["run", str(b), "--out", str(out), "--force", "--quiet"]) == 0
+    names = {p.name for p in out.iterdir()}
+    assert {"fig5.png", "fig5.svg", "my_notes.txt"} <= names
+    assert not {"animation.gif", "fig4.png", "fig4.svg"} & names
+
+
+def test_csv_numbers_are_shortest_and_never_negative_zero(tmp_path):
+    cfg = tmp_path / "task.toml"
+    cfg.write_text((EXAMPLES / "mode_change.toml").read_text()
+                   + "\n[output]\nservo_rate_hz = 2000\n")
+    assert main(["program", str(cfg), "--out", str(tmp_path / "o"), "--quiet"]) == 0
+    lines = (tmp_path / "o" / "setpoints.csv").read_text().splitlines()[1:]
+    cells = [c for line in lines for c in line.split(",")]
+    assert "0.0005" in cells and not [c for c in cells if c in ("-0", "-0.0")]
+    assert max(len(c.lstrip("-").replace(".", "").split("e")[0].lstrip("0")) for c in cells) <= 17
+    assert all(float(repr(float(c))) == float(c) and repr(float(c)) == c for c in cells[:2000])
+
+
+def test_program_figures_and_report_count_and_name_the_moves(tmp_path):
+    from dextar.config import load_scenario
+    from dextar.output.program import moves_figure
+
+    out = tmp_path / "o"
+    assert main(["program", str(EXAMPLES / "pick_place.toml"), "--out", str(out),
+                 "--quiet"]) == 0
+    title = re.search(r"<title>(.*?)</title>", (out / "report.html").read_text()).group(1)
+    assert title == "Program pick_place.toml: fits the motors"
+    sc = load_scenario(EXAMPLES / "pick_place.toml")
+    fig = moves_figure(sc.program_request().plan(), sc.robot_mm, "+-")
+    assert fig.axes[0].get_title().startswith("Program: 8 moves")
+
+
+def test_a_blended_chain_names_the_move_at_fault(tmp_path, capsys):
+    cfg = tmp_path / "task.toml"
+    cfg.write_text('[motors]\npeak_torque = 3.4\n[program]\nstart = [-40.0, 110.0]\n'
+                   '[[move]]\ntype = "line"\nto = [-40.0, 120.0]\nblend = 3.0\n'
+                   '[[move]]\ntype = "line"\nto = [0.0, 130.0]\nblend = 3.0\n'
+                   '[[move]]\ntype = "line"\nto = [0.0, 400.0]\n')
+    assert main(["program", str(cfg), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert "move 2 (line), in the motion blended from move 0" in err, err
+
+
+def test_ik_words_units_near_singularities_and_subcommand_help(capsys):
+    assert main(["ik", "0", "500"]) == 2
+    err = capsys.readouterr().err
+    assert re.search(r"out of reach of leg 1 by [\d.]+ mm .*reach [\d.]+ mm to [\d.]+ mm", err)
+    assert main(["ik", "0", "44", "--json"]) == 0
+    captured = capsys.readouterr()
+    payload = json.loads(captured.out)
+    assert payload["type2_distance"] < 0.05 and "type1_distance" in payload
+    assert "near a parallel (type 2) singularity" in captured.err
+    assert main(["ik", "0"]) == 2
+    assert "(see dextar ik --help)" in capsys.readouterr().err
+
+
+def test_the_python_api_speaks_si():
+    """plan_program takes the start in metres like the robot; MotorLimits is importable from
+    dextar.motors; sizing is typed."""
+    from dextar.dynamics import paper_inertia
+    from dextar.geometry import DEXTAR_MM
+    from dextar.motors import MotorLimits
+    from dextar.program import Move, plan_program, sizing
+
+    robot = DEXTAR_MM.scaled(1e-3)
+    res = plan_program(robot, paper_inertia(robot).scaled_masses(0.1),
+                       [Move("line", {"to": (0.04, 0.11)})], start=(-0.04, 0.11),
+                       working_mode="+-", motors=MotorLimits((2.0, 2.0)))
+    size = sizing(res)
+    assert res.P[-1] == pytest.approx((0.04, 0.11)) and size.fits
+    assert size.motors[0].peak_torque_Nm <= 2.0 * (1 + 1e-3)
+
+
+def test_plan_and_torques_take_units(tmp_path, capsys):
+    assert main(["torques", "--out", str(tmp_path / "t.csv"), "--units", "si"]) == 0
+    head = (tmp_path / "t.csv").read_text().splitlines()[0]
+    assert "t_s," in head and "tau1_Nm" in head
+    assert main(["plan", "--out", str(tmp_path / "p.csv"), "--units", "paper"]) == 0
+    assert (tmp_path / "p.csv").read_text().startswith("t_T,")
