@@ -10,12 +10,14 @@ import numpy as np
 
 from .. import __version__
 from .._arrays import Array
+from ..dynamics import Inertia
 from ..dynamics.paper import paper_model_limits
 from ..geometry import DEXTAR_MM
 from ..laws import LAW_TYPES, Law, law_type
 from ..trajectory import Trajectory
 from .core import (
     Analysis,
+    PaperComparison,
     RunInputs,
     forward_error,
     power_balance_residual,
@@ -78,12 +80,24 @@ def _stats(tau: Array) -> dict[str, list[float]]:
             "rms": [float(v) for v in np.sqrt(np.mean(tau**2, axis=0))]}
 
 
+#: What a run assumes where the config is silent.
+ASSUMPTIONS = [
+    "rods are uniform unless the config says otherwise (com at mid-length, I = m L^2/12)",
+    "the end-effector is a point mass at P; no rotor inertia, friction or gravity unless "
+    "configured",
+    "beta0 is the base angle of triangle CPB at t = T/2 (the paper's middle position)",
+    "the paper's (23) and (30) are used with d/l in the bracket; the sign of the beta-dot "
+    "term in (30) follows (28)",
+    "T_fd uses second-order central differences of the sampled angles",
+    "Coulomb friction is regularised, coulomb * tanh(qdot / coulomb_speed): zero at rest",
+]
+
+
 def run_summary(an: Analysis, checks: dict[str, Any], uniform: Trajectory) -> dict[str, Any]:
     """Everything a run computed and claims, JSON-ready: parameters, the law, torques,
     powers, joint forces, the physics checks and, for the paper's example, its claims
     (``uniform``: the uniform law sampled for the Fig. 3 claim)."""
     sc, law, tr = an.inputs, an.law, an.trajectory
-    ine = sc.inertia
     s: dict[str, Any] = {
         "dextar_version": __version__,
         "config": sc.source,
@@ -92,29 +106,13 @@ def run_summary(an: Analysis, checks: dict[str, Any], uniform: Trajectory) -> di
                   "working_mode": tr.mode, "assembly_mode": tr.assembly},
         "path": {**sc.path_spec, "length": sc.path.length},
         "law": law_summary(sc, law, an),
-        "inertia": {
-            "effector_mass": ine.effector_mass, "payload": ine.payload,
-            "proximal": [vars(r) for r in ine.proximal], "distal": [vars(r) for r in ine.distal],
-            "rotor": list(ine.rotor), "viscous": list(ine.viscous), "coulomb": list(ine.coulomb),
-            "gravity": list(ine.gravity), "coulomb_speed": ine.coulomb_speed,
-            "note": "rods: mass, com (distance from the proximal joint), inertia about the com",
-        },
+        "inertia": _inertia(sc.inertia),
         "output": {"samples": int(tr.t.size)},
         "torques": {"exact": _stats(an.tau)},
         "peak_power": [float(v) for v in np.abs(an.power).max(axis=0)],
         "peak_joint_forces": {k: float(v.max()) for k, v in an.reaction_magnitudes().items()},
         "validation": checks,
-        "assumptions": [
-            "rods are uniform unless the config says otherwise (com at mid-length, I = m L^2/12)",
-            "the end-effector is a point mass at P; no rotor inertia, friction or gravity "
-            "unless configured",
-            "beta0 is the base angle of triangle CPB at t = T/2 (the paper's middle position)",
-            "the paper's (23) and (30) are used with d/l in the bracket; the sign of the "
-            "beta-dot term in (30) follows (28)",
-            "T_fd uses second-order central differences of the sampled angles",
-            "Coulomb friction is regularised, coulomb * tanh(qdot / coulomb_speed): zero at "
-            "rest",
-        ],
+        "assumptions": ASSUMPTIONS,
     }
     cost = law.cost_report()
     if cost is not None:  # the paper's functional belongs to the paper's law
@@ -123,28 +121,42 @@ def run_summary(an: Analysis, checks: dict[str, Any], uniform: Trajectory) -> di
     if an.paper is None:
         s["paper_model"] = {"not_applicable": paper_model_limits(sc.robot, sc.inertia)}
     else:
-        p = an.paper
-        pm = p.model
-        s["torques"]["paper"] = _stats(p.tau)
-        s["paper_model"] = {
+        s.update(_paper(an.paper))
+        s["torques"]["paper"] = _stats(an.paper.tau)
+        if is_paper_example(sc):
+            s["claims"] = _claims(s, uniform)
+    return s
+
+
+def _inertia(ine: Inertia) -> dict[str, Any]:
+    return {
+        "effector_mass": ine.effector_mass, "payload": ine.payload,
+        "proximal": [vars(r) for r in ine.proximal], "distal": [vars(r) for r in ine.distal],
+        "rotor": list(ine.rotor), "viscous": list(ine.viscous), "coulomb": list(ine.coulomb),
+        "gravity": list(ine.gravity), "coulomb_speed": ine.coulomb_speed,
+        "note": "rods: mass, com (distance from the proximal joint), inertia about the com"}
+
+
+def _paper(p: PaperComparison) -> dict[str, Any]:
+    """The paper's model beside the exact one: its constants, its torque error, the energy
+    comparisons of Figs. 6 and 7."""
+    pm = p.model
+    peakT = float(p.T_exact.max())
+    return {
+        "paper_model": {
             "beta0_deg": math.degrees(pm.beta0), "lambda": pm.lam, "C1": pm.C1, "C2": pm.C2,
             "C3": pm.C3, "C4": pm.C4, "error_vs_exact": p.error,
             "leaves_out": list(p.leaves_out),
             "error_note": ("against the exact torques without "
                            f"{' and '.join(p.leaves_out)}, which (42) leaves out"
-                           if p.leaves_out else "against the exact torques")}
-        s["beta_range_deg"] = [float(np.degrees(p.beta.min())), float(np.degrees(p.beta.max()))]
-        peakT = float(p.T_exact.max())
-        s["energies"] = {
+                           if p.leaves_out else "against the exact torques")},
+        "beta_range_deg": [float(np.degrees(p.beta.min())), float(np.degrees(p.beta.max()))],
+        "energies": {
             "T_fd_vs_exact_max_relative": float(np.abs(p.T_fd - p.T_exact).max() / peakT),
             "T_approx_vs_exact_max_relative": float(np.abs(p.T_approx - p.T_exact).max() / peakT),
             "fig7": {**p.fig7, "peak_T_P_plus_T_S": float((p.T_exact + p.T_S).max()),
                      "peak_T_r": float(p.T_r.max()),
-                     "ratio": float(p.T_r.max() / (p.T_exact + p.T_S).max())},
-        }
-        if is_paper_example(sc):
-            s["claims"] = _claims(s, uniform)
-    return s
+                     "ratio": float(p.T_r.max() / (p.T_exact + p.T_S).max())}}}
 
 
 def _verdict(value: float, holds: float, approximate: float) -> dict[str, Any]:
