@@ -9,10 +9,18 @@ base frequency ``f``, ``w = 2 pi f``:
 periodic with period ``1 / f``. With ``sum_l a_kl = 0`` and ``sum_l l b_kl = 0`` (imposed by
 the last harmonic's coefficients) it starts and ends each period at rest in ``q0``. The
 coefficients minimise the condition number of the stacked base regressor (columns scaled to
-unit norm) on a time grid of one period (SLSQP from a few random starts), subject to staying
-:data:`MARGIN` away from both singularity types (so in the working and assembly modes of the
+unit norm) on a time grid of one period, subject to staying :data:`MARGIN` away from both
+singularity types (checked on a grid 4x finer: so in the working and assembly modes of the
 start) and, given motors, within :data:`SAFETY` of their torque (at each speed) and of their
-maximum speed; the model's torques may be short of the real robot's by that margin.
+maximum speed; the model's torques may be short of the real robot's by that margin. Each of a
+few random starts is grown to the largest feasible size, then COBYLA (derivative-free: the
+cost has corners) improves it; the best feasible point any start met is kept. Which optimum
+is found depends on the last rounding unit (another BLAS, another excitation): test the
+result's properties, not the coefficients.
+
+Measured on the pick-and-place robot (5 harmonics, 3 starts, 10 seeds): condition numbers
+4.6-5.3, each motor using 69-80 % of its limits; with the pick-and-place program's region,
+4.7-5.9, 76-80 %, 86-100 % of the region's poses covered; 1.4-7 s each.
 
 Two more terms in the cost, each zero when met:
 
@@ -59,8 +67,13 @@ HEADROOM_TARGET = 0.9
 #: Weights of the headroom and region penalties against the log condition number.
 HEADROOM_WEIGHT = 2.0
 REGION_WEIGHT = 5.0
-#: Restarts of the optimiser from its best feasible point when its line search fails.
-RESTARTS = 2
+#: Runs of samples over which each constraint holds as one (the optimiser's linear
+#: subproblems grow with the number of constraints).
+WINDOWS = 12
+#: Restarts of the optimiser from its best feasible point when it stops short.
+RESTARTS = 1
+#: Cost evaluations of one run of the optimiser (COBYLA).
+MAX_EVALUATIONS = 500
 #: A motion grown towards the motors' headroom may lose this factor of condition number.
 GROW_COND = 1.25
 
@@ -236,6 +249,11 @@ def region_rest_pose(model: Model, region: JointRegion) -> Array | None:
     return np.asarray(q[i]) if score[i] > MARGIN else None
 
 
+def _windows(x: Array) -> Array:
+    """The minimum of ``x`` (n,) over each of :data:`WINDOWS` consecutive runs of samples."""
+    return np.asarray(x.reshape(WINDOWS, -1).min(axis=1))
+
+
 def _within(model: Model, motors: MotorLimits, q: Array, dq: Array, ddq: Array,
             safety: float = 1.0) -> bool:
     """True when the motion needs no more than ``safety`` of what the motors give (torque
@@ -316,12 +334,12 @@ def design_excitation(model: Model, mode: str, *, harmonics: int = 5, base_hz: f
     m = GRID_PER_HARMONIC * n
     t = np.arange(m) / (m * base_hz)
     t_fine = np.arange(4 * m) / (4 * m * base_hz)
-    nfine = 2 * len(t_fine)
+    nfine = 2 * WINDOWS
     vmax = None if motors is None else np.asarray(motors.max_speed, float)
     safe_speed = (np.full(2, np.inf) if vmax is None else safety * vmax)
     cache: dict[bytes, tuple[float, Array]] = {}
 
-    nlim = 0 if motors is None else 2 * m
+    nlim = 0 if motors is None else 2 * WINDOWS
 
     seen: list[tuple[float, Array]] = []  # the best feasible point evaluated
 
@@ -342,7 +360,7 @@ def design_excitation(model: Model, mode: str, *, harmonics: int = 5, base_hz: f
         f = _feasibility(model, qf)
         if f is None:  # the rods cannot meet somewhere
             return 1e3, -np.ones(nfine + nlim)
-        cons = [f[0] - MARGIN, f[1] - MARGIN]
+        cons = [_windows(f[0]) - MARGIN, _windows(f[1]) - MARGIN]
         if f[1].min() < 0.1 * MARGIN:  # too near a parallel singularity for the dynamics
             return 1e3, np.concatenate(cons + [-np.ones(nlim)])
         q, dq, ddq = tr.evaluate(t)
@@ -354,7 +372,7 @@ def design_excitation(model: Model, mode: str, *, harmonics: int = 5, base_hz: f
             cost = float(np.log(sv[0] / max(sv[-1], 1e-300)))
         if motors is not None:
             use = _use(model, motors, q, dq, ddq)
-            cons.append(np.minimum(safety - use, 1.0).ravel())
+            cons.append(np.minimum(safety - np.concatenate([-_windows(-use[:, 0]), -_windows(-use[:, 1])]), 1.0))
             short = np.maximum(1.0 - use.max(axis=0) / (HEADROOM_TARGET * safety), 0.0)
             cost += HEADROOM_WEIGHT * float((short ** 2).sum())
         if region is not None:
@@ -367,22 +385,33 @@ def design_excitation(model: Model, mode: str, *, harmonics: int = 5, base_hz: f
     converged = False  # some start converged (the best point found is at least as good)
     for _ in range(max(starts, 1)):
         x = rng.normal(size=4 * (n - 1))
-        # shrink the start until it is feasible
+        # shrink the start until it is feasible, then grow it to the largest feasible size
+        # (a start at the limits uses the headroom the cost asks for)
         for _k in range(60):
             if (evaluate(x)[1] > 0).all():
                 break
             x = 0.7 * x
         else:
             continue
+        lo, hi = 1.0, 1.0 / 0.7 if _k else 8.0
+        while hi / lo > 1.02:
+            mid = math.sqrt(lo * hi)
+            if (evaluate(mid * x)[1] > 0).all():
+                lo = mid
+            else:
+                hi = mid
+        x = lo * x
         seen.clear()
         evaluate(x)
         for _restart in range(RESTARTS + 1):
-            # a line search that fails (the cost jumps where the rods cannot meet) restarts
-            # from the best feasible point met
-            r = optimize.minimize(lambda x: evaluate(x)[0], x, method="SLSQP",
+            # derivative-free (the cost has corners: minima over samples, the rods that
+            # cannot meet); a run stopped by its budget restarts from the best feasible point
+            r = optimize.minimize(lambda x: evaluate(x)[0], x, method="COBYLA",
                                   constraints=[{"type": "ineq",
                                                 "fun": lambda x: evaluate(x)[1]}],
-                                  options={"maxiter": 100, "ftol": 1e-3})
+                                  options={"maxiter": MAX_EVALUATIONS,
+                                           "rhobeg": 0.1 * float(np.abs(x).max()),
+                                           "tol": 1e-3})
             if r.success and (evaluate(r.x)[1] >= 0).all():
                 converged = True
                 break
