@@ -26,22 +26,27 @@ Steps of :func:`identify` (each a small function below):
    another unit. Base parameters whose relative standard deviation exceeds
    :data:`REL_STD_FLAG` are listed in ``poorly_determined``.
 
-How :data:`POOR_FIT` was chosen: the fit quality (motor A / motor D) over 20 excitations of
-the pick-and-place robot, 10 s at 1 kHz, 17-bit angles:
+How :data:`POOR_FIT` was chosen (``benchmarks/bench_identify_mujoco.py``): the fit quality,
+motor A / motor D, 10 s at 1 kHz, 17-bit angles:
 
-* good fits: MuJoCo's robot, exact torques: at most 0.15 % / 0.16 %; our model with 5 mN m of
-  torque noise: 1.8 % / 2.0 %, with 20 mN m: 7.1 % / 8.0 %; a 100/140 mm robot with its own
-  model, 5 mN m: 1.0 % / 1.5 %;
-* wrong models: gravity left out of the prior: at least 66 % / 61 % (the 100/140 mm robot:
-  95 % / 84 %); the default prior (the paper's DexTAR, no gravity, no friction): 73 % / 77 %;
-  torques of the other sign: 127 % / 63 %; motors swapped: 15 % to 99 % (status 2 where below
-  the limit); the 100/140 mm robot's data as the DexTAR: refused (the rods cannot meet);
-* the limit 20 % is 2.5x above the noisiest good fit and 3x below the wrong models but two:
-  the DexTAR's data identified as the 100/140 mm robot fit within 3.2 % to 69 % (status 0 on
-  some excitations), so a similar geometry is told only by a validation on another motion.
+* good fits: MuJoCo's robot, exact torques, 20 excitations: at most 0.12 % / 0.11 %; our model
+  with 5 mN m of torque noise: 1.8 % / 2.0 %, with 20 mN m: 7.1 % / 8.0 % (20 excitations of
+  the former design), 4-9 % (the three stored in the tests); a 100/140 mm five-bar with its
+  own model, 5 mN m: 1.1 % / 1.1 %;
+* wrong models, the same 20 MuJoCo runs: gravity left out of the prior: at least 71 % / 72 %
+  (the 100/140 mm five-bar's data: 86 % / 91 %); the default prior (the paper's DexTAR, no
+  gravity, no friction): 81 % / 84 %; torques of the other sign: 80 % / 64 %; motors
+  swapped: 17-50 % / 17-52 %, never both below the limit; identified as the 100/140 mm
+  five-bar: 11-31 % / 9.5-46 % (status 3 in 5 runs, status 2 in the 15 others: no physical
+  parameter set has those base parameters); the 100/140 mm five-bar's data as the default
+  DexTAR: refused (the rods cannot meet), or 88 % / 95 % where they can;
+* the limit 20 % is 2.5x above the noisiest good fit and at least 3.2x below the wrong priors
+  and gravity; a geometry within tens of mm of the true one may fit within the limit (as
+  the 100/140 mm five-bar's model of the DexTAR's data does on one motor): then only the
+  physical consistency (status 2) and a validation on another motion tell.
 
-Torques in mN m fit as well as in N m (0.15 %), but their identified torques are 1050 to 1100
-times the prior's (good fits: 1.05 to 1.10): status 3 through :data:`TORQUE_SCALE`.
+Torques in mN m fit as well as in N m (0.05-0.12 %), but their identified torques are 1060 to
+1090 times the prior's (good fits: 1.05 to 1.10): status 3 through :data:`TORQUE_SCALE`.
 """
 
 from __future__ import annotations
