@@ -39,15 +39,18 @@ How the filters are chosen, from the sample rate ``fs`` and the measured motion:
   state filter's bandwidth.
 
 Measured (``tests/identification/mujoco_harness.py``: MuJoCo's robot under a 100 Hz PD loop,
-exact torques, 20 excitation seeds of the pick-and-place robot, 10 s at 1 kHz each): the worst
-prediction error over the seeds on the paper's semicircle and on the pick-and-place program,
-motor A / motor D in % of the RMS torque, the validation data conditioned alike for every row
-(100 / 40 Hz, the rows whose sign is told); angles exact, or quantised to 17 or 14 bits:
+exact torques, 20 excitation seeds of the pick-and-place robot from the former design, 10 s
+at 1 kHz each): the worst prediction error over the seeds on the paper's semicircle and on
+the pick-and-place program, motor A / motor D in % of the RMS torque, the validation data
+conditioned alike for every row (100 / 40 Hz, the rows whose sign is told); angles exact, or
+quantised to 17 or 14 bits:
 
 ========================================  ===============  ===============  ===============
 identification's filters                  exact            17-bit           14-bit
 (semicircle; program)
 ========================================  ===============  ===============  ===============
+the former default (one filter at 5 Hz,    0.25 / 0.29;     0.37 / 0.20;     0.64 / 1.1;
+rows below 5 % of the peak speed out)      0.32 / 0.32      0.41 / 0.33      1.3 / 1.2
 one filter at 5 Hz, no rows left out       4.8 / 7.2;       8.0 / 8.0;       9.8 / 9.2;
                                            4.1 / 2.8        7.1 / 3.0        8.5 / 3.9
 one filter at 100 Hz                       3.8 / 9.0;       3.4 / 7.6;       13 / 21;
@@ -66,9 +69,12 @@ the true parameters                        0.005 / 0.018;   0.062 / 0.14;    0.4
 
 The default reaches the true parameters' floor (set by the validation's own conditioning:
 the program's accelerations jump at the speed limits); the prior misses the semicircle by
-4.1 / 8.0 %. The default drops 16 % (exact), 19 % (17-bit) and 36 %
-(14-bit: ``f_s`` 32-56 Hz) of the rows; a parallel filter at ``f_s / 5`` instead of
-``f_s / 2.5`` gives the same errors and drops 30 %.
+4.1 / 8.0 %. A softer loop holds the joints longer at each reversal: under a 10 Hz loop
+(0.2 deg of tracking) on six of these excitations, 17-bit angles, the former default errs
+by up to 1.2 % on the semicircle (3.4 % under a 5 Hz loop), the default by 0.066 / 0.153 %
+at most. The default drops 16 % (exact), 19 % (17-bit) and 36 % (14-bit: ``f_s`` 32-56 Hz)
+of the rows; a parallel filter at ``f_s / 5`` instead of ``f_s / 2.5`` gives the same
+errors and drops 30 %.
 """
 
 from __future__ import annotations
