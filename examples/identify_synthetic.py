@@ -17,7 +17,7 @@ from dextar.dynamics.regressor import regressor, standard_parameters
 from dextar.identification.base import base_parameters
 from dextar.identification.data import MotionData
 from dextar.identification.excite import design_excitation
-from dextar.identification.fit import identify
+from dextar.identification.fit import identify, validate
 
 sc = load_scenario(Path(__file__).with_name("pick_place.toml"))
 prior = sc.si_model  # the config's robot: DexTAR, light rods, a gripper and its part
@@ -49,6 +49,16 @@ z = (res.beta - base.of(standard_parameters(true.inertia))) / res.std
 for name, value, std, zi in zip(base.names, res.beta, res.std, z, strict=True):
     print(f"  {name:6s} = {value: .5g} +- {std:.2g}   (error {zi:+.2f} std)")
 assert np.abs(z).max() < 4, "the truth lies within the identified deviations"
+print(f"verdict: {res.status_text}; fit quality {100 * res.fit_quality[0]:.2f} % / "
+      f"{100 * res.fit_quality[1]:.2f} % of the RMS torques; the data hardly pin "
+      f"{', '.join(res.poorly_determined) or 'nothing'} (relative std above 50 %)")
+assert res.status == 0 and (res.fit_quality < 0.2).all()
+
+# 4b. the same data with gravity left out of the prior: the verdict is a poor fit
+flat = Model(prior.robot, prior.inertia.with_(gravity=(0.0, 0.0)))
+poor = identify(data, flat, mode=sc.mode)
+print(f"gravity left out: {poor.status_text} (fit quality {100 * poor.fit_quality.max():.0f} %)")
+assert poor.status == 3 and "gravity" in poor.message
 
 # 5. predict a motion not used in the fit: a faster exciting trajectory
 t2 = np.arange(2001) / 1000.0
@@ -60,4 +70,15 @@ err_prior = np.abs(inverse_dynamics(prior, q2, dq2, ddq2) - measured)
 print(f"prediction error: identified {err_id.max():.2e} N m, config's model "
       f"{err_prior.max():.2e} N m")
 assert err_id.max() < 0.1 * err_prior.max()
+
+# 6. the same through validate(): the data conditioned with the identification's filters, the
+# rows whose friction sign they tell, and whether the motion stays in the excited region
+# (a faster motion does not: its speeds are beyond the excitation's)
+t3 = np.arange(2001) / 1000.0
+other = MotionData(t3, np.round(q2 / count) * count, measured)
+v = validate(res, other, prior, mode=sc.mode)
+print(f"validate: error {100 * v.error[0]:.2f} % / {100 * v.error[1]:.2f} % (prior "
+      f"{100 * v.error_prior[0]:.1f} % / {100 * v.error_prior[1]:.1f} %); "
+      f"{100 * v.coverage.fraction:.0f} % of it inside the excited region")
+assert (v.error < 0.1 * v.error_prior).all() and v.coverage.fraction < 1 and v.warnings
 print("identification checks passed")

@@ -5,9 +5,9 @@ from dextar.config import load_scenario
 from dextar.dynamics import inverse_dynamics
 from dextar.identification.base import base_parameters
 from dextar.identification.data import MotionData
-from dextar.identification.excite import design_excitation
 
 from ..program.test_program import EXAMPLES
+from .excitations import EXCITATIONS
 
 #: 17-bit encoder: one count in rad
 COUNT = 2 * np.pi / 2**17
@@ -21,9 +21,9 @@ def prior():
 
 
 @pytest.fixture(scope="session")
-def excitation(prior):
-    model, mode, motors = prior
-    return design_excitation(model, mode, duration=10.0, motors=motors)
+def excitation():
+    """A stored exciting trajectory (tests/identification/excitations.py)."""
+    return EXCITATIONS[0]
 
 
 @pytest.fixture(scope="session")
@@ -31,12 +31,12 @@ def base(prior):
     return base_parameters(prior[0])
 
 
-def synthetic(model, excitation, seconds, *, seed, noise=0.005, rate=1000.0):
+def synthetic(model, trajectory, seconds, *, seed, noise=0.005, rate=1000.0):
     """Our exact model along the exciting trajectory: Gaussian noise (N m) on the torques,
     angles quantised to a 17-bit encoder."""
     rng = np.random.default_rng(seed)
     t = np.arange(int(round(seconds * rate)) + 1) / rate
-    q, dq, ddq = excitation.trajectory.evaluate(t)
+    q, dq, ddq = trajectory.evaluate(t)
     tau = inverse_dynamics(model, q, dq, ddq)
     return MotionData(t, np.round(q / COUNT) * COUNT, tau + rng.normal(scale=noise,
                                                                       size=tau.shape))

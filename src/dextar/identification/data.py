@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import csv
+import io
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -104,8 +106,33 @@ def check_motion(d: MotionData) -> None:
             f"{dt[i]:.6g} s at row {i + 3} against the median {step:.6g} s")
 
 
+def _fast_table(p: Path, raw: bytes, width: int) -> Array | None:
+    """Every column of the data rows of ``p`` as floats (n, width) by ``np.loadtxt``, or None
+    when the file is not a plain table of numbers with one row per line (a blank line, a
+    short row, a quote, a bad value): then :func:`read_motion_csv` reads it row by row and
+    names the problem."""
+    lines = raw.count(b"\n") + (0 if raw.endswith(b"\n") else 1)
+    if lines < 2:
+        return None
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            with p.open(newline="") as fh:
+                fh.readline()
+                values = np.loadtxt(fh, delimiter=",", comments=None, ndmin=2, dtype=float)
+    except (ValueError, Warning, OSError, UnicodeDecodeError):
+        return None
+    # loadtxt skips blank lines, which would shift the rows named in errors
+    if values.shape != (lines - 1, width):
+        return None
+    return np.asarray(values)
+
+
 def read_motion_csv(path: str | Path) -> MotionData:
     """Read a data file (CSV with a header; see :data:`REQUIRED` and :data:`OPTIONAL`).
+
+    A plain table of numbers is read by ``np.loadtxt`` (60,001 rows in about 1.2x its own
+    time); anything else row by row, naming the first bad row and column.
 
     Raises
     ------
@@ -116,41 +143,27 @@ def read_motion_csv(path: str | Path) -> MotionData:
     """
     p = Path(path)
     try:
-        with p.open(newline="") as fh:
-            rows = list(csv.reader(fh))
+        raw = p.read_bytes()
+        text_head = raw.split(b"\n", 1)[0].decode()
     except OSError as exc:
         raise ConfigError(f"data file {str(p)!r} cannot be read: {exc.strerror or exc}") from None
     except UnicodeDecodeError:
         raise ConfigError(f"data file {str(p)!r} is not a text (CSV) file") from None
-    if not rows:
+    if not raw:
         raise ConfigError(f"data file {str(p)!r} is empty")
-    head = [h.strip() for h in rows[0]]
+    head = [h.strip() for h in next(csv.reader([text_head.rstrip("\r")]), [])]
     missing = [c for c in REQUIRED if c not in head]
     if missing:
         raise ConfigError(f"data file {str(p)!r} lacks the column{'s' if len(missing) > 1 else ''} "
                           f"{', '.join(missing)} (it has {', '.join(head) or 'none'})")
     wanted = [c for c in REQUIRED + OPTIONAL if c in head]
     cols = {c: head.index(c) for c in wanted}
-    body = rows[1:]
-    short = [r for r, row in enumerate(body) if len(row) != len(head)]
-    if short:
-        r = short[0]
-        raise ParameterError(f"{p}: row {r + 2} has {len(body[r])} fields, the header "
-                             f"{len(head)}")
     idx = [cols[c] for c in wanted]
-    try:
-        values = np.array([[row[i] for i in idx] for row in body], dtype=float)
-    except ValueError:
-        for r, row in enumerate(body):
-            for c in wanted:
-                text = row[cols[c]].strip()
-                try:
-                    float(text)
-                except ValueError:
-                    raise ParameterError(f"{p}: row {r + 2}, column {c}: {text!r} is not "
-                                         "a number") from None
-        raise
-    values = values.reshape(len(body), len(wanted))
+    table = _fast_table(p, raw, len(head))
+    if table is not None:
+        values = table[:, idx]
+    else:
+        values = _slow_values(p, raw, head, wanted, cols, idx)
     v = {c: values[:, k] for k, c in enumerate(wanted)}
 
     def pair(a: str, b: str) -> Array | None:
@@ -166,3 +179,32 @@ def read_motion_csv(path: str | Path) -> MotionData:
     return MotionData(v["t_s"], q, tau, pair("dphi_rad_s", "dpsi_rad_s"),
                       pair("ddphi_rad_s2", "ddpsi_rad_s2"), source=str(p))
 
+
+def _slow_values(p: Path, raw: bytes, head: list[str], wanted: list[str],
+                 cols: dict[str, int], idx: list[int]) -> Array:
+    """The wanted columns (n, len(wanted)) read row by row with :mod:`csv`, raising
+    :class:`ParameterError` at the first row of the wrong width or value that is not a
+    number."""
+    try:
+        rows = list(csv.reader(io.StringIO(raw.decode(), newline="")))
+    except UnicodeDecodeError:
+        raise ConfigError(f"data file {str(p)!r} is not a text (CSV) file") from None
+    body = rows[1:]
+    short = [r for r, row in enumerate(body) if len(row) != len(head)]
+    if short:
+        r = short[0]
+        raise ParameterError(f"{p}: row {r + 2} has {len(body[r])} fields, the header "
+                             f"{len(head)}")
+    try:
+        values = np.array([[row[i] for i in idx] for row in body], dtype=float)
+    except ValueError:
+        for r, row in enumerate(body):
+            for c in wanted:
+                text = row[cols[c]].strip()
+                try:
+                    float(text)
+                except ValueError:
+                    raise ParameterError(f"{p}: row {r + 2}, column {c}: {text!r} is not "
+                                         "a number") from None
+        raise
+    return np.asarray(values.reshape(len(body), len(wanted)))
