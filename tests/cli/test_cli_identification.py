@@ -45,7 +45,7 @@ def test_identify_writes_a_config_that_reproduces_the_base_parameters(excite_csv
     assert main(["identify", str(excite_csv), "--config", CONFIG, "--validate",
                  str(excite_csv), "--out", str(out)]) == 0
     text = capsys.readouterr().out
-    assert "identified 11 base parameters" in text
+    assert "identified: 11 base parameters" in text
     assert {p.name for p in out.iterdir()} == {"identified.toml", "parameters.csv",
                                                "summary.json", "fit.png", "report.html"}
     s = json.loads((out / "summary.json").read_text())
@@ -54,7 +54,7 @@ def test_identify_writes_a_config_that_reproduces_the_base_parameters(excite_csv
         assert key in s
     assert s["status"] == "identified" and s["n_samples"] == 10001
     head, *_ = (out / "parameters.csv").read_text().splitlines()
-    assert head == "name,meaning,value,std,rel_std_percent,unit"
+    assert head == "name,meaning,value,std,rel_std_percent,unit,poorly_determined"
     # the identified config loads and its model has exactly the identified base parameters
     model = load_scenario(out / "identified.toml").si_model
     base = base_parameters(model)
@@ -95,3 +95,73 @@ def test_bad_options_exit_2(excite_csv, tmp_path, capsys):
     assert "--harmonics 1 must be an integer from 2 to 20" in capsys.readouterr().err
     assert main(["excite", CONFIG, "--out", str(tmp_path / "e.txt")]) == 2
     assert "must end in .csv" in capsys.readouterr().err
+
+
+def test_a_poor_fit_is_exit_1_with_its_files_and_causes(excite_csv, tmp_path, capsys):
+    """The pick-and-place robot's data (gravity, a gripper) identified as the default DexTAR
+    without gravity: computed, written, exit 1, the likely causes named (measured fit quality
+    97.8 % / 92.6 % against the 20 % limit)."""
+    out = tmp_path / "id"
+    assert main(["identify", str(excite_csv), "--out", str(out), "--quiet"]) == 1
+    err = capsys.readouterr().err
+    assert "no --config: the robot is assumed to be the DexTAR" in err
+    assert "poor fit: the model leaves" in err and "gravity left out" in err
+    s = json.loads((out / "summary.json").read_text())
+    assert s["status"] == "poor fit" and min(s["fit_quality"]) > 0.5
+    assert (out / "identified.toml").exists() and (out / "report.html").exists()
+    # the right config fits: exit 0, a fit quality far below the limit
+    assert main(["identify", str(excite_csv), "--config", CONFIG, "--out",
+                 str(tmp_path / "ok"), "--quiet"]) == 0
+    s = json.loads((tmp_path / "ok" / "summary.json").read_text())
+    assert s["status"] == "identified" and max(s["fit_quality"]) < 0.01
+    assert {"rel_std", "poorly_determined"} <= set(s["base_parameters"][0])
+    head = (tmp_path / "ok" / "parameters.csv").read_text().splitlines()[0]
+    assert head.endswith(",poorly_determined")
+
+
+def test_validation_reports_the_excited_region(excite_csv, tmp_path, capsys):
+    """The paper's semicircle on the same robot is outside what the excitation visited: the
+    validation says what fraction is inside and warns that the prediction extrapolates."""
+    sc = load_scenario(CONFIG)
+    doc = dict(sc.doc)
+    doc.update({"law": {"type": "optimal", "duration": 1.0}, "output": {"units": "si"}})
+    from dextar.config import scenario_from_dict
+    from dextar.dynamics import inverse_dynamics
+
+    tr = scenario_from_dict({k: v for k, v in doc.items() if k != "move"}).trajectory(
+        samples=2001)
+    tau = inverse_dynamics(sc.si_model, tr.q, tr.dq, tr.ddq)
+    semi = tmp_path / "semi.csv"
+    np.savetxt(semi, np.column_stack([tr.t, tr.q, tau]), delimiter=",", comments="",
+               header="t_s,phi_rad,psi_rad,tau1_Nm,tau2_Nm")
+    out = tmp_path / "v"
+    assert main(["identify", str(excite_csv), "--config", CONFIG, "--validate", str(semi),
+                 "--out", str(out), "--quiet"]) == 0
+    s = json.loads((out / "summary.json").read_text())
+    assert 0.0 <= s["validation_inside_fraction"] < 1.0
+    assert "the prediction extrapolates there" in capsys.readouterr().err
+
+
+def test_excite_covers_a_task_with_the_motors_headroom(tmp_path, capsys):
+    assert main(["excite", CONFIG, "--task", CONFIG, "--out", str(tmp_path / "e.csv"),
+                 "--duration", "5", "--json"]) == 0
+    p = json.loads(capsys.readouterr().out)
+    assert min(p["headroom"]) > 0.5  # the old design used 4-7 % of the torque
+    assert 0.0 < p["task_coverage"] <= 1.0 and len(p["task_speed_ratio"]) == 2
+
+
+def test_every_config_command_takes_a_model_file(excite_csv, tmp_path):
+    """--model identified.toml: the identified robot, inertia, friction and gravity, the
+    task's other tables kept."""
+    out = tmp_path / "id"
+    assert main(["identify", str(excite_csv), "--config", CONFIG, "--out", str(out),
+                 "--quiet"]) == 0
+    model = out / "identified.toml"
+    ident = load_scenario(model).si_model.inertia
+    assert load_scenario(CONFIG, model=model).si_model.inertia == ident
+    assert main(["program", CONFIG, "--model", str(model), "--out", str(tmp_path / "p"),
+                 "--quiet"]) == 0
+    assert main(["plan", "--model", str(model), "--out", str(tmp_path / "q.csv")]) == 0
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[motors]\npeak_torque = 1.0\n")
+    assert main(["plan", "--model", str(bad), "--out", str(tmp_path / "r.csv")]) == 2

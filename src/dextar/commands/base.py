@@ -79,11 +79,21 @@ def into_directory(sp: argparse.ArgumentParser, force: str = "write into an exis
 
 def config_argument(sp: argparse.ArgumentParser, *, required: bool = False,
                     help: str = "TOML config (default: the paper's example)") -> None:
-    """The config file of a command (positional, optional unless ``required``)."""
+    """The config file of a command (positional, optional unless ``required``) and
+    ``--model`` (see :func:`model_argument`)."""
     if required:
         sp.add_argument("config", help=help)
     else:
         sp.add_argument("config", nargs="?", help=help)
+    model_argument(sp)
+
+
+def model_argument(sp: argparse.ArgumentParser) -> None:
+    """``--model FILE.toml``: the robot, inertia, friction and gravity of a model file
+    (``identified.toml``, ``best.toml``) instead of the config's; its other tables kept."""
+    sp.add_argument("--model", metavar="MODEL.toml",
+                    help="take [robot], [inertia], [friction] and [gravity] from this file "
+                    "(identified.toml, best.toml); the config's other tables are kept")
 
 
 def json_flag(sp: argparse.ArgumentParser) -> None:

@@ -62,7 +62,7 @@ def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
     from ..output.files import OutputDir
 
     require_dask()
-    sc = load_scenario(args.config)
+    sc = load_scenario(args.config, model=args.model)
     task, space = sc.design_task(samples=args.samples, seed=args.seed)
     designs = space.designs()
     n = len(designs)

@@ -5,8 +5,13 @@ rate with the torques the config's model predicts."""
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
 
 from .base import Result, config_argument, json_flag, out_file, write_or_hand_back
+
+if TYPE_CHECKING:
+    from ..config import Scenario
+    from ..identification.coverage import JointRegion
 
 NAME = "excite"
 HELP = ("an exciting trajectory for identification (a Fourier series per motor, regressor "
@@ -25,6 +30,9 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
     sp.add_argument("--base-hz", type=float, default=0.2,
                     help="base frequency, Hz (default 0.2: a 5 s period)")
     sp.add_argument("--seed", type=int, default=0, help="seed of the optimiser's starts")
+    sp.add_argument("--task", metavar="TASK.toml",
+                    help="a program or run config whose joint region and speeds to cover "
+                    "(its robot must be the config's)")
     sp.add_argument("--quiet", action="store_true", help="no summary output")
 
 
@@ -36,10 +44,12 @@ def run(args: argparse.Namespace) -> Result:
     from ..output.tables import csv_text
 
     target = out_file(args.out, ".csv")
-    sc = load_scenario(args.config)
+    sc = load_scenario(args.config, model=args.model)
     model = sc.si_model
+    region = None if args.task is None else task_region(args.task, sc)
     res = design_excitation(model, sc.mode, harmonics=args.harmonics, base_hz=args.base_hz,
-                            duration=args.duration, motors=sc.si_motors, seed=args.seed)
+                            duration=args.duration, motors=sc.si_motors, seed=args.seed,
+                            region=region)
     rate = sc.output.servo_rate_hz
     cols = excitation_columns(model, res, rate)
     where, data = write_or_hand_back(target, csv_text(cols))
@@ -53,4 +63,31 @@ def run(args: argparse.Namespace) -> Result:
             f"{res.min_type2_distance:.3g}; wrote {where} ({payload['samples']} samples at "
             f"{rate:g} Hz)")
     warnings = [] if res.status == 0 else [f"dextar excite: warning: {res.message}"]
+    if region is not None:
+        text += (f"; covers {res.region_coverage:.1%} of the task's poses, at "
+                 f"{res.region_speed_ratio[0]:.2f} and {res.region_speed_ratio[1]:.2f} of its "
+                 "peak speeds")
+        if res.region_coverage < 1.0 or (res.region_speed_ratio < 1.0).any():
+            warnings.append(f"dextar excite: warning: the motion covers "
+                            f"{res.region_coverage:.1%} of the task's poses and reaches "
+                            f"{res.region_speed_ratio.min():.2f} of its peak speed: an "
+                            "identification from it extrapolates on the rest")
     return Result(payload, text, warnings, data=data)
+
+
+def task_region(path: str, sc: Scenario) -> JointRegion:
+    """The joint region a task visits, with its speeds: its program planned, or its run
+    sampled (SI), on the config's robot."""
+    from ..config import load_scenario
+    from ..errors import ConfigError
+    from ..identification.coverage import JointRegion
+
+    task = load_scenario(path)
+    if task.robot_mm != sc.robot_mm:
+        raise ConfigError(f"--task {path!r} is for another robot ({task.robot_mm.as_dict()} "
+                          f"mm) than the config's ({sc.robot_mm.as_dict()} mm)")
+    if task.moves:
+        res = task.program_request().plan()
+        return JointRegion.from_samples(res.q, res.dq)
+    tr = task.in_units("si").trajectory()
+    return JointRegion.from_samples(tr.q, tr.dq)

@@ -25,7 +25,7 @@ def run(args: argparse.Namespace) -> Result:
     from ..config import load_scenario
     from ..output.mjcf import to_mjcf
 
-    sc = load_scenario(args.config)
+    sc = load_scenario(args.config, model=args.model)
     path = out_file(args.out, ".xml")
     tr = sc.trajectory(samples=2)
     where, data = write_or_hand_back(path, to_mjcf(sc.model(tr.assembly),

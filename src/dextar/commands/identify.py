@@ -5,16 +5,18 @@ from __future__ import annotations
 
 import argparse
 
-from .base import Result, into_directory, shown
+from .base import Result, into_directory, model_argument, shown
 
 NAME = "identify"
-HELP = "identify the base parameters from measured motion and write a config with them"
+HELP = ("identify the base parameters from measured motion and write a config with them "
+        "(exit 1 for a poor fit)")
 
 
 def add_arguments(sp: argparse.ArgumentParser) -> None:
     """``data``, ``--config``, ``--validate``, ``--cutoff-hz``, ``--out``, ``--force``."""
     sp.add_argument("data", help="CSV with t_s, phi_rad, psi_rad, tau1_Nm, tau2_Nm (SI)")
     sp.add_argument("--config", help="TOML config: the robot and the prior masses")
+    model_argument(sp)
     sp.add_argument("--validate", metavar="DATA2.csv",
                     help="data not used in the fit: predicted against measured torques")
     sp.add_argument("--cutoff-hz", type=float, default=None,
@@ -35,7 +37,7 @@ def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
     cutoff = args.cutoff_hz
     if cutoff is not None and not (np.isfinite(cutoff) and cutoff > 0):
         raise ConfigError(f"--cutoff-hz {cutoff!r} must be a positive number")
-    sc = load_scenario(args.config)
+    sc = load_scenario(args.config, model=args.model)
     model = sc.si_model
     data = read_motion_csv(args.data)
     vdata = read_motion_csv(args.validate) if args.validate else None
@@ -52,11 +54,13 @@ def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
     lines = rep.lines()
     lines.append(f"wrote {shown(args.out, 'identified.toml')}, parameters.csv, summary.json"
                  + (", fit.png, report.html" if figures else ""))
-    warnings = [f"dextar identify: warning: {w}" for w in res.warnings]
-    if args.config is None:
+    poor = res.message if res.status == 3 else None  # computed, but it does not explain
+    warnings = [f"dextar identify: {w}" if w == poor else f"dextar identify: warning: {w}"
+                for w in rep.summary["warnings"]]  # the poor fit's message names itself
+    if args.config is None and args.model is None:
         g = sc.robot_mm
         warnings.insert(0, f"dextar identify: note: no --config: the robot is assumed to be "
                         f"the DexTAR (l1 = {g.l1:g}, l2 = {g.l2:g}, L1 = {g.L1:g}, L2 = "
                         f"{g.L2:g}, d = {g.d:g} mm, working mode {sc.mode}) without gravity; "
                         "give the robot's config with --config")
-    return Result(rep.summary, "\n".join(lines), warnings)
+    return Result(rep.summary, "\n".join(lines), warnings, code=1 if res.status == 3 else 0)

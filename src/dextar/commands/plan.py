@@ -38,7 +38,7 @@ def run(args: argparse.Namespace) -> Result:
     from ..output.tables import csv_text, trajectory_columns
 
     path = out_file(args.out, ".csv")
-    sc = load_scenario(args.config).in_units(args.units)
+    sc = load_scenario(args.config, model=args.model).in_units(args.units)
     law = sc.law()
     tr = sc.trajectory(law)
     where, data = write_or_hand_back(path, csv_text(trajectory_columns(tr, sc.units)))

@@ -25,7 +25,7 @@ def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
     from ..output.program import ProgramSummary, write_program
     from ..program import sizing
 
-    sc = load_scenario(args.config)
+    sc = load_scenario(args.config, model=args.model)
     res = sc.program_request().plan()
     summary = ProgramSummary(args.config, res.cycle_time_s, sc.output.servo_rate_hz,
                              tuple(res.timeline()), sizing(res))

@@ -28,7 +28,7 @@ def run(args: argparse.Namespace) -> Result:
     from ..output.files import OutputDir
     from ..output.run import RUN_FILES, Progress, staged, write_run
 
-    sc = load_scenario(args.config)
+    sc = load_scenario(args.config, model=args.model)
     prog = Progress(enabled=not args.quiet and sys.stderr.isatty())
     stage = staged(prog)
     inputs = sc.inputs()

@@ -25,7 +25,7 @@ def run(args: argparse.Namespace) -> Result:
     from ..output.simulation import TRACKING_FILES, write_tracking
     from ..simulation import simulate_computed_torque
 
-    sc = load_scenario(args.config)
+    sc = load_scenario(args.config, model=args.model)
     tr = sc.trajectory()
     c = sc.control
     plant_inertia = sc.inertia.scaled_masses(1.0 + c["mass_error"])

@@ -42,7 +42,7 @@ def run(args: argparse.Namespace) -> Result:
     from ..output.tables import csv_text, torque_columns
 
     path = out_file(args.out, ".csv")
-    sc = load_scenario(args.config).in_units(args.units)
+    sc = load_scenario(args.config, model=args.model).in_units(args.units)
     an = analyze(sc.inputs(), sc.law())
     where, data = write_or_hand_back(path, csv_text(torque_columns(an)))
     peak = np.abs(an.tau).max(axis=0)

@@ -346,13 +346,33 @@ def scenario_from_dict(doc: Mapping[str, Any], *, source: str | None = None,
     return sc
 
 
-def load_scenario(path: str | FilePath | None = None) -> Scenario:
+#: The tables a model file (``identified.toml``, ``best.toml``, ``calibrated.toml``) gives to
+#: another config (``--model``).
+MODEL_TABLES = ("robot", "inertia", "friction", "gravity")
+
+
+def load_scenario(path: str | FilePath | None = None, *,
+                  model: str | FilePath | None = None) -> Scenario:
     """Read a config file (or none: the paper's example) into a :class:`Scenario`; the file
-    is read once."""
-    if path is None:
+    is read once. ``model``: a model file whose robot, inertia, friction and gravity replace
+    the config's (its other tables kept): what ``--model identified.toml`` does."""
+    doc, text = ({}, b"") if path is None else read_config(path)
+    source = None if path is None else str(path)
+    if model is not None:
+        mdoc, mtext = read_config(model)
+        missing = [t for t in ("robot", "inertia") if t not in mdoc]
+        if missing:
+            raise ConfigError(f"--model {str(model)!r} has no [{missing[0]}] table: a model "
+                              "file (identified.toml, best.toml) gives [robot], [inertia], "
+                              "[friction] and [gravity]")
+        check_tables({k: v for k, v in mdoc.items() if k != "move"}, set(TABLES) | {"move"})
+        doc = {**{k: v for k, v in doc.items() if k not in MODEL_TABLES},
+               **{k: mdoc[k] for k in MODEL_TABLES if k in mdoc}}
+        text = text + b"\n# --model\n" + mtext
+        source = f"{source or 'the defaults'} with the model of {model}"
+    if path is None and model is None:
         return scenario_from_dict({})
-    doc, text = read_config(path)
-    return scenario_from_dict(doc, source=str(path), text=text)
+    return scenario_from_dict(doc, source=source, text=text)
 
 
 def load_robot_table(path: str | FilePath | None) -> RobotTable:

@@ -16,10 +16,11 @@ from matplotlib.figure import Figure
 
 from .._arrays import Array
 from ..dynamics import Model, inverse_dynamics
-from ..dynamics.regressor import NAMES, standard_parameters
+from ..dynamics.regressor import NAMES
 from ..identification.data import MotionData
 from ..identification.excite import ExcitationResult
-from ..identification.fit import IdentificationResult, check_working_mode, condition
+from ..identification.fit import IdentificationResult, Validation
+from ..identification.fit import validate as validate_fit
 from .config_file import toml_number as _num
 from .files import OutputDir
 from .html_page import figures, page
@@ -47,7 +48,12 @@ def excitation_payload(res: ExcitationResult, harmonics: int, base_hz: float, sa
             "min_type2_distance": res.min_type2_distance,
             "peak_torque_Nm": [float(v) for v in res.peak_torque],
             "peak_speed_rad_s": [float(v) for v in res.peak_speed],
-            "status": res.status, "message": res.message, "out": out}
+            "status": res.status, "message": res.message, "out": out,
+            "headroom": [float(v) for v in res.headroom],
+            "headroom_note": "each motor's peak use of its torque (at its speed) and speed",
+            **({} if math.isnan(res.region_coverage) else {
+                "task_coverage": res.region_coverage,
+                "task_speed_ratio": [float(v) for v in res.region_speed_ratio]})}
 
 
 def _rms(x: Array) -> list[float]:
@@ -62,6 +68,7 @@ class IdentificationReport:
     summary: dict[str, Any]
     result: IdentificationResult
     panels: tuple[tuple[str, Array, Array, Array], ...]
+    validation: Validation | None = None
 
     @classmethod
     def of(cls, res: IdentificationResult, data: MotionData, model: Model, mode: str,
@@ -72,48 +79,63 @@ class IdentificationReport:
         if c is None:
             raise ValueError("an identification result without its conditioned data")
         summary: dict[str, Any] = {
-            "status": ("identified" if res.status == 0 else "poorly conditioned"
-                       if res.status == 1 else "not physically consistent"),
+            "status": res.status_text, "status_code": res.status,
             "message": res.message, "method": res.method, "data": data_path,
             "config": config or "defaults", "n_samples": res.n_samples, "n_used": res.n_used,
+            "rows_used": [int(v) for v in res.rows_used],
             "sample_rate_hz": data.rate_hz, "cutoff_hz": res.cutoff_hz,
+            "parallel_cutoff_hz": res.parallel_hz,
             "condition_number": res.condition_number,
             "rms_residual_Nm": [float(v) for v in res.rms_residual],
+            "fit_quality": [float(v) for v in res.fit_quality],
+            "fit_quality_note": "RMS residual / RMS torque per motor (motor A, motor D)",
+            "torque_scale": [float(v) for v in res.torque_scale],
+            "poorly_determined": list(res.poorly_determined),
             "base_parameters": [{"name": n, "meaning": m, "unit": u, "value": float(v),
-                                 "std": float(s)}
-                                for n, m, u, v, s in zip(res.base.names, res.base.meanings,
-                                                         res.base.units, res.beta, res.std,
-                                                         strict=True)],
+                                 "std": float(s), "rel_std": float(r),
+                                 "poorly_determined": n in res.poorly_determined}
+                                for n, m, u, v, s, r in zip(res.base.names, res.base.meanings,
+                                                            res.base.units, res.beta, res.std,
+                                                            res.rel_std, strict=True)],
             "unidentifiable": [NAMES[j] for j in res.base.unidentifiable],
             "physically_consistent": res.consistent, "warnings": list(res.warnings),
             "units": "SI: s, rad, N m; base parameters in the unit of their column"}
         panels = [("identification data", c.t, c.tau, res.base.columns(c.Y) @ res.beta)]
+        v = None
         if vdata is not None:
-            check_working_mode(vdata, model, mode)
-            vc = condition(vdata, model, cutoff_hz=res.cutoff_hz)
-            pred = vc.Y @ res.theta
-            prior = vc.Y @ standard_parameters(model.inertia)
+            v = validate_fit(res, vdata, model, mode=mode)
+            cov = v.coverage
             summary["validation_data"] = validate
-            summary["validation_rms_error_Nm"] = _rms(pred - vc.tau)
-            summary["validation_rms_error_prior_Nm"] = _rms(prior - vc.tau)
-            summary["validation_rms_torque_Nm"] = _rms(vc.tau)
-            panels.append(("validation data", vc.t, vc.tau, pred))
-        return cls(summary, res, tuple(panels))
+            summary["validation_rms_error_Nm"] = [float(x) for x in v.rms_error]
+            summary["validation_rms_error_prior_Nm"] = [float(x) for x in v.rms_error_prior]
+            summary["validation_rms_torque_Nm"] = [float(x) for x in v.rms_torque]
+            summary["validation_error"] = [float(x) for x in v.error]
+            summary["validation_error_prior"] = [float(x) for x in v.error_prior]
+            summary["validation_inside_fraction"] = cov.fraction
+            summary["validation_outside_rows"] = len(cov.rows)
+            summary["warnings"] = [*summary["warnings"], *v.warnings]
+            vc = v.conditioned
+            panels.append(("validation data", vc.t, vc.tau, vc.Y @ res.theta))
+        return cls(summary, res, tuple(panels), v)
 
     def lines(self) -> list[str]:
         """The identification in words (without the files)."""
         res, s = self.result, self.summary
-        lines = [f"identified {res.base.size} base parameters from {res.n_samples} samples "
-                 f"({res.n_used} used after filtering at {res.cutoff_hz:.3g} Hz): "
-                 f"{res.method}, condition number {res.condition_number:.4g}, RMS residual "
-                 f"{res.rms_residual[0]:.4g}, {res.rms_residual[1]:.4g} N m",
+        lines = [f"{res.status_text}: {res.base.size} base parameters from {res.n_samples} "
+                 f"samples ({res.n_used} used after filtering at {res.cutoff_hz:.3g} Hz, "
+                 f"parallel filter {res.parallel_hz:.3g} Hz): {res.method}, condition number "
+                 f"{res.condition_number:.4g}, RMS residual {res.rms_residual[0]:.4g}, "
+                 f"{res.rms_residual[1]:.4g} N m, fit quality {res.fit_quality[0]:.2%}, "
+                 f"{res.fit_quality[1]:.2%} of the RMS torques",
                  *(f"  {n:<7} = {v: .6g} +- {sd:.2g} {u}  ({m})" for n, m, u, v, sd in
                    zip(res.base.names, res.base.meanings, res.base.units, res.beta, res.std,
                        strict=True))]
         if "validation_rms_error_Nm" in s:
             e, ep = s["validation_rms_error_Nm"], s["validation_rms_error_prior_Nm"]
             lines.append(f"validation on {s['validation_data']}: RMS error {e[0]:.4g}, "
-                         f"{e[1]:.4g} N m (prior model {ep[0]:.4g}, {ep[1]:.4g} N m)")
+                         f"{e[1]:.4g} N m (prior model {ep[0]:.4g}, {ep[1]:.4g} N m); "
+                         f"{s['validation_inside_fraction']:.1%} of its samples inside the "
+                         "excited region")
         return lines
 
 
@@ -140,14 +162,15 @@ def write_identification(out: str, rep: IdentificationReport, model_toml: str, *
 
 
 def parameters_csv(res: IdentificationResult) -> str:
-    """``name, meaning, value, std, rel_std_percent, unit``: one row per base parameter
-    (SI values)."""
-    out = ["name,meaning,value,std,rel_std_percent,unit"]
+    """``name, meaning, value, std, rel_std_percent, unit, poorly_determined`` (relative std
+    above 50 %): one row per base parameter (SI values)."""
+    out = ["name,meaning,value,std,rel_std_percent,unit,poorly_determined"]
     for name, meaning, unit, v, s in zip(res.base.names, res.base.meanings, res.base.units,
                                          res.beta, res.std, strict=True):
         rel = 100.0 * s / abs(v) if v != 0 else math.inf
+        flag = "true" if name in res.poorly_determined else "false"
         out.append(f'{name},"{meaning}",{_num(v)},{_num(s)},'
-                   f"{_num(rel) if math.isfinite(rel) else 'inf'},{unit}")
+                   f"{_num(rel) if math.isfinite(rel) else 'inf'},{unit},{flag}")
     return "\n".join(out) + "\n"
 
 
@@ -183,22 +206,30 @@ def identification_report(summary: Mapping[str, Any], pngs: dict[str, bytes]) ->
     for p in summary["base_parameters"]:
         v, s = p["value"], p["std"]
         rel = f"{100.0 * s / abs(v):.3g}" if v != 0 else "inf"
+        flag = (" <b>poorly determined</b>" if p.get("poorly_determined") else "")
         rows.append(f"<tr><td>{esc(p['name'])}</td><td>{esc(p['meaning'])}</td>"
                     f"<td>{esc(p['unit'])}</td><td>{v:.6g}</td><td>{s:.3g}</td>"
-                    f"<td>{rel}</td></tr>")
+                    f"<td>{rel}{flag}</td></tr>")
     facts = [("status", summary["status"]), ("message", summary["message"]),
              ("method", summary["method"]), ("samples read / used",
                                              f"{summary['n_samples']} / {summary['n_used']}"),
-             ("cut-off [Hz]", f"{summary['cutoff_hz']:.4g}"),
+             ("state / parallel filter cut-off [Hz]",
+              f"{summary['cutoff_hz']:.4g} / {summary['parallel_cutoff_hz']:.4g}"),
              ("condition number", f"{summary['condition_number']:.4g}"),
-             ("RMS residual [N m]", ", ".join(f"{v:.4g}" for v in summary["rms_residual_Nm"]))]
+             ("RMS residual [N m]", ", ".join(f"{v:.4g}" for v in summary["rms_residual_Nm"])),
+             ("fit quality: RMS residual / RMS torque",
+              ", ".join(f"{v:.3%}" for v in summary["fit_quality"])),
+             ("parameters with a relative std above 50 %",
+              ", ".join(summary["poorly_determined"]) or "none")]
     if "validation_rms_error_Nm" in summary:
         facts += [("validation RMS error, identified [N m]",
                    ", ".join(f"{v:.4g}" for v in summary["validation_rms_error_Nm"])),
                   ("validation RMS error, prior [N m]",
                    ", ".join(f"{v:.4g}" for v in summary["validation_rms_error_prior_Nm"])),
                   ("validation RMS torque [N m]",
-                   ", ".join(f"{v:.4g}" for v in summary["validation_rms_torque_Nm"]))]
+                   ", ".join(f"{v:.4g}" for v in summary["validation_rms_torque_Nm"])),
+                  ("validation samples inside the excited region",
+                   f"{summary['validation_inside_fraction']:.1%}")]
     fact_rows = "".join(f"<tr><td>{esc(k)}</td><td>{esc(str(v))}</td></tr>" for k, v in facts)
     warn = "".join(f"<li>{esc(w)}</li>" for w in summary["warnings"]) or "<li>none</li>"
     return page(
