@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import json
 import math
 import re
 import signal
@@ -86,6 +87,17 @@ def _finite_csv(text: str) -> bool:
     return True
 
 
+def _complete(out: Path) -> bool:
+    """A CSV with finite numbers, or a JSON summary that reads back."""
+    if out.suffix == ".json":
+        try:
+            json.loads(out.read_text(), parse_constant=lambda c: float("nan"))
+        except ValueError:
+            return False
+        return "NaN" not in out.read_text()
+    return _finite_csv(out.read_text())
+
+
 def run_case(argv: list[str], workdir: Path, out: Path | None,
              bound: float = TIME_BOUND, allow_exceeds: bool = False) -> tuple[str, str]:
     """Run one command line; returns ``(outcome, detail)`` (see the module doc)."""
@@ -121,8 +133,8 @@ def run_case(argv: list[str], workdir: Path, out: Path | None,
             return "partial", f"output written on a refusal: {msg.strip()}"
         return "refused", msg.strip()
     if code == 1 and allow_exceeds:
-        if out is None or not out.exists() or not _finite_csv(out.read_text()):
-            return "partial", "exit 1 without complete setpoints"
+        if out is None or not out.exists() or not _complete(out):
+            return "partial", "exit 1 without its complete files"
         return "exceeds", msg.strip()[:200]
     if code != 0:
         return "bad-exit", f"exit {code}: {msg.strip()}"
