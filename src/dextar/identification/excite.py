@@ -318,160 +318,17 @@ def design_excitation(model: Model, mode: str, *, harmonics: int = 5, base_hz: f
         Bad options, or no feasible motion (the rest pose too close to a singularity, the
         motors too weak to hold it).
     """
-    if not (isinstance(harmonics, int) and 2 <= harmonics <= 20):
-        raise ParameterError(f"--harmonics {harmonics!r} must be an integer from 2 to 20")
-    if not (math.isfinite(base_hz) and 0 < base_hz <= 10):
-        raise ParameterError(f"--base-hz {base_hz!r} must be in (0, 10] Hz")
-    if not (math.isfinite(duration) and 0 < duration <= 3600):
-        raise ParameterError(f"--duration {duration!r} must be in (0, 3600] s")
-    if not (math.isfinite(safety) and 0 < safety <= 1):
-        raise ParameterError(f"safety factor {safety!r} must be in (0, 1]")
+    _check_options(harmonics, base_hz, duration, safety)
     base = base or base_parameters(model)
     if q0 is None and region is not None:
         q0 = region_rest_pose(model, region)
     q0 = rest_pose(model, mode) if q0 is None else np.asarray(q0, float)
-    n = harmonics
-    m = GRID_PER_HARMONIC * n
-    t = np.arange(m) / (m * base_hz)
-    t_fine = np.arange(4 * m) / (4 * m * base_hz)
-    nfine = 2 * WINDOWS
-    vmax = None if motors is None else np.asarray(motors.max_speed, float)
-    safe_speed = (np.full(2, np.inf) if vmax is None else safety * vmax)
-    cache: dict[bytes, tuple[float, Array]] = {}
-
-    nlim = 0 if motors is None else 2 * WINDOWS
-
-    seen: list[tuple[float, Array]] = []  # the best feasible point evaluated
-
-    def evaluate(x: Array) -> tuple[float, Array]:
-        """Cost and the constraint values (>= 0 when feasible) of ``x``."""
-        key = x.tobytes()
-        if key not in cache:
-            cache[key] = _score(FourierTrajectory.from_free(q0, x, n, base_hz))
-            cost, cons = cache[key]
-            if (cons >= 0).all() and (not seen or cost < seen[0][0]):
-                seen[:] = [(cost, np.array(x))]
-        return cache[key]
-
-    def _score(tr: FourierTrajectory) -> tuple[float, Array]:
-        # the margins on a grid 4x finer than the regressor's (a leg can fold between
-        # samples of the coarse one)
-        qf, dqf, _ = tr.evaluate(t_fine)
-        f = _feasibility(model, qf)
-        if f is None:  # the rods cannot meet somewhere
-            return 1e3, -np.ones(nfine + nlim)
-        cons = [_windows(f[0]) - MARGIN, _windows(f[1]) - MARGIN]
-        if f[1].min() < 0.1 * MARGIN:  # too near a parallel singularity for the dynamics
-            return 1e3, np.concatenate(cons + [-np.ones(nlim)])
-        q, dq, ddq = tr.evaluate(t)
-        Yb = base.columns(regressor(model, q, dq, ddq)).reshape(-1, base.size)
-        norms = np.linalg.norm(Yb, axis=0)
-        cost = 1e3
-        if (norms > 0).all():
-            sv = np.linalg.svd(Yb / norms, compute_uv=False)
-            cost = float(np.log(sv[0] / max(sv[-1], 1e-300)))
-        if motors is not None:
-            use = _use(model, motors, q, dq, ddq)
-            cons.append(np.minimum(safety - np.concatenate([-_windows(-use[:, 0]), -_windows(-use[:, 1])]), 1.0))
-            short = np.maximum(1.0 - use.max(axis=0) / (HEADROOM_TARGET * safety), 0.0)
-            cost += HEADROOM_WEIGHT * float((short ** 2).sum())
-        if region is not None:
-            cost += REGION_WEIGHT * _region_cost(region, qf, np.abs(dqf).max(axis=0),
-                                                 safe_speed)
-        return cost, np.concatenate(cons)
-
-    rng = np.random.default_rng(seed)
-    best: tuple[float, Array, bool] | None = None
-    converged = False  # some start converged (the best point found is at least as good)
-    for _ in range(max(starts, 1)):
-        x = rng.normal(size=4 * (n - 1))
-        # shrink the start until it is feasible, then grow it to the largest feasible size
-        # (a start at the limits uses the headroom the cost asks for)
-        for _k in range(60):
-            if (evaluate(x)[1] > 0).all():
-                break
-            x = 0.7 * x
-        else:
-            continue
-        lo, hi = 1.0, 1.0 / 0.7 if _k else 8.0
-        while hi / lo > 1.02:
-            mid = math.sqrt(lo * hi)
-            if (evaluate(mid * x)[1] > 0).all():
-                lo = mid
-            else:
-                hi = mid
-        x = lo * x
-        seen.clear()
-        evaluate(x)
-        for _restart in range(RESTARTS + 1):
-            # derivative-free (the cost has corners: minima over samples, the rods that
-            # cannot meet); a run stopped by its budget restarts from the best feasible point
-            r = optimize.minimize(lambda x: evaluate(x)[0], x, method="COBYLA",
-                                  constraints=[{"type": "ineq",
-                                                "fun": lambda x: evaluate(x)[1]}],
-                                  options={"maxiter": MAX_EVALUATIONS,
-                                           "rhobeg": 0.1 * float(np.abs(x).max()),
-                                           "tol": 1e-3})
-            if r.success and (evaluate(r.x)[1] >= 0).all():
-                converged = True
-                break
-            if np.array_equal(seen[0][1], x):  # no feasible progress: a restart repeats it
-                break
-            x = seen[0][1]
-        cost, xs = seen[0] if seen else (evaluate(x)[0], x)
-        if best is None or cost < best[0]:
-            best = (cost, xs, converged)
-    if best is None:
-        raise ParameterError("no feasible exciting trajectory: the rest pose is too close to a "
-                             "singularity or the motors are too weak to hold it")
-    # the optimiser saw a coarse grid: check a fine one, shrinking the motion about the rest
-    # pose until every sample is within the margins and the motors
-    tt = np.linspace(0.0, 1.0 / base_hz, 40 * m, endpoint=False)
-
-    def fine(x: Array) -> tuple[FourierTrajectory, Array, Array, Array,
-                                tuple[Array, Array, Array] | None, bool]:
-        tr = FourierTrajectory.from_free(q0, x, n, base_hz)
-        q, dq, ddq = tr.evaluate(tt)
-        f = _feasibility(model, q)
-        ok = f is not None and min(f[0].min(), f[1].min()) >= MARGIN and (
-            motors is None or _within(model, motors, q, dq, ddq, safety))
-        return tr, q, dq, ddq, f, ok
-
-    def fine_cond(q: Array, dq: Array, ddq: Array) -> float:
-        Yb = base.columns(regressor(model, q, dq, ddq)).reshape(-1, base.size)
-        s = np.linalg.svd(Yb / np.linalg.norm(Yb, axis=0), compute_uv=False)
-        return float(s[0] / s[-1])
-
-    x = best[1]
-    for _ in range(200):
-        tr, q, dq, ddq, f, ok = fine(x)
-        if ok:
-            break
-        x = 0.98 * x
-    else:  # pragma: no cover - the rest pose itself is feasible
-        raise ParameterError("no exciting trajectory stays within the margins and motors")
-    cond = fine_cond(q, dq, ddq)
-    if motors is not None:
-        # where the optimiser stopped short of the motors' headroom (its line search can
-        # fail), grow the motion about the rest pose while it stays feasible and its
-        # condition number within GROW_COND of the optimum's
-        head = _use(model, motors, q, dq, ddq).max(axis=0)
-        grow = x
-        while head.min() < HEADROOM_TARGET * safety:
-            g = fine(1.02 * grow)
-            if not g[5]:
-                break
-            gc = fine_cond(g[1], g[2], g[3])
-            if gc > GROW_COND * cond:
-                break
-            grow = 1.02 * grow
-            tr, q, dq, ddq, f = g[:5]
-            head = _use(model, motors, q, dq, ddq).max(axis=0)
-        cond = fine_cond(q, dq, ddq)
+    problem = _Problem(model, base, np.asarray(q0, float), harmonics, base_hz, motors, safety,
+                       region)
+    best, converged = _optimise(problem, seed, starts)
+    tr, q, dq, ddq, f, cond = _finalise(problem, best)
     tau = inverse_dynamics(model, q, dq, ddq)
     periods = max(1, int(math.ceil(duration * base_hz - 1e-9)))
-    ok = converged
-    assert f is not None
     headroom = (np.full(2, np.nan) if motors is None
                 else _use(model, motors, q, dq, ddq).max(axis=0))
     covered, speed_ratio = math.nan, np.full(2, np.nan)
@@ -483,7 +340,208 @@ def design_excitation(model: Model, mode: str, *, harmonics: int = 5, base_hz: f
                                    np.inf)
     return ExcitationResult(tr, cond, periods, float(f[0].min()),
                             float(f[1].min()), np.abs(tau).max(axis=0),
-                            np.abs(dq).max(axis=0), 0 if ok else 1,
-                            "optimised" if ok else "no start of the optimiser converged; the "
-                            "best feasible trajectory met is kept", headroom, covered,
-                            speed_ratio)
+                            np.abs(dq).max(axis=0), 0 if converged else 1,
+                            "optimised" if converged else "no start of the optimiser "
+                            "converged; the best feasible trajectory met is kept", headroom,
+                            covered, speed_ratio)
+
+
+def _check_options(harmonics: int, base_hz: float, duration: float, safety: float) -> None:
+    if not (isinstance(harmonics, int) and 2 <= harmonics <= 20):
+        raise ParameterError(f"--harmonics {harmonics!r} must be an integer from 2 to 20")
+    if not (math.isfinite(base_hz) and 0 < base_hz <= 10):
+        raise ParameterError(f"--base-hz {base_hz!r} must be in (0, 10] Hz")
+    if not (math.isfinite(duration) and 0 < duration <= 3600):
+        raise ParameterError(f"--duration {duration!r} must be in (0, 3600] s")
+    if not (math.isfinite(safety) and 0 < safety <= 1):
+        raise ParameterError(f"safety factor {safety!r} must be in (0, 1]")
+
+
+class _Problem:
+    """The optimisation of an exciting trajectory: its cost and constraints on the free
+    coefficients, remembered, and the best feasible point evaluated since :meth:`restart`."""
+
+    def __init__(self, model: Model, base: BaseParameters, q0: Array, harmonics: int,
+                 base_hz: float, motors: MotorLimits | None, safety: float,
+                 region: JointRegion | None) -> None:
+        self.model, self.base, self.q0, self.n, self.base_hz = model, base, q0, harmonics, base_hz
+        self.motors, self.safety, self.region = motors, safety, region
+        m = GRID_PER_HARMONIC * harmonics
+        self.m = m
+        self.t = np.arange(m) / (m * base_hz)
+        self.t_fine = np.arange(4 * m) / (4 * m * base_hz)
+        vmax = None if motors is None else np.asarray(motors.max_speed, float)
+        self.safe_speed = np.full(2, np.inf) if vmax is None else safety * vmax
+        self.nlim = 0 if motors is None else 2 * WINDOWS
+        self.cache: dict[bytes, tuple[float, Array]] = {}
+        self.seen: list[tuple[float, Array]] = []  # the best feasible point evaluated
+
+    def trajectory(self, x: Array) -> FourierTrajectory:
+        """The trajectory of the free coefficients ``x``."""
+        return FourierTrajectory.from_free(self.q0, x, self.n, self.base_hz)
+
+    def restart(self) -> None:
+        """Forget the best feasible point (a new start)."""
+        self.seen.clear()
+
+    def evaluate(self, x: Array) -> tuple[float, Array]:
+        """Cost and the constraint values (>= 0 when feasible) of ``x``."""
+        key = x.tobytes()
+        if key not in self.cache:
+            self.cache[key] = self._score(self.trajectory(x))
+            cost, cons = self.cache[key]
+            if (cons >= 0).all() and (not self.seen or cost < self.seen[0][0]):
+                self.seen[:] = [(cost, np.array(x))]
+        return self.cache[key]
+
+    def feasible(self, x: Array) -> bool:
+        """Every constraint strictly met at ``x``."""
+        return bool((self.evaluate(x)[1] > 0).all())
+
+    def _score(self, tr: FourierTrajectory) -> tuple[float, Array]:
+        model, motors, nlim = self.model, self.motors, self.nlim
+        # the margins on a grid 4x finer than the regressor's (a leg can fold between
+        # samples of the coarse one)
+        qf, dqf, _ = tr.evaluate(self.t_fine)
+        f = _feasibility(model, qf)
+        if f is None:  # the rods cannot meet somewhere
+            return 1e3, -np.ones(2 * WINDOWS + nlim)
+        cons = [_windows(f[0]) - MARGIN, _windows(f[1]) - MARGIN]
+        if f[1].min() < 0.1 * MARGIN:  # too near a parallel singularity for the dynamics
+            return 1e3, np.concatenate(cons + [-np.ones(nlim)])
+        q, dq, ddq = tr.evaluate(self.t)
+        cost = _log_condition(model, self.base, q, dq, ddq)
+        if motors is not None:
+            use = _use(model, motors, q, dq, ddq)
+            cons.append(np.minimum(self.safety - np.concatenate(
+                [-_windows(-use[:, 0]), -_windows(-use[:, 1])]), 1.0))
+            short = np.maximum(1.0 - use.max(axis=0) / (HEADROOM_TARGET * self.safety), 0.0)
+            cost += HEADROOM_WEIGHT * float((short ** 2).sum())
+        if self.region is not None:
+            cost += REGION_WEIGHT * _region_cost(self.region, qf, np.abs(dqf).max(axis=0),
+                                                 self.safe_speed)
+        return cost, np.concatenate(cons)
+
+
+def _singular_values(model: Model, base: BaseParameters, q: Array, dq: Array,
+                     ddq: Array) -> Array | None:
+    """Singular values of the unit-norm base regressor of the motion (None when a column is
+    zero)."""
+    Yb = base.columns(regressor(model, q, dq, ddq)).reshape(-1, base.size)
+    norms = np.linalg.norm(Yb, axis=0)
+    if not (norms > 0).all():
+        return None
+    return np.asarray(np.linalg.svd(Yb / norms, compute_uv=False))
+
+
+def _log_condition(model: Model, base: BaseParameters, q: Array, dq: Array,
+                   ddq: Array) -> float:
+    """Log of the condition number of the unit-norm base regressor (1e3 when a column is
+    zero): the optimiser's cost."""
+    sv = _singular_values(model, base, q, dq, ddq)
+    return 1e3 if sv is None else float(np.log(sv[0] / max(sv[-1], 1e-300)))
+
+
+def _optimise(pb: _Problem, seed: int, starts: int) -> tuple[Array, bool]:
+    """The best feasible free coefficients over ``starts`` random starts, and whether a start
+    converged (the best point found is at least as good)."""
+    rng = np.random.default_rng(seed)
+    best: tuple[float, Array] | None = None
+    converged = False
+    for _ in range(max(starts, 1)):
+        x = _feasible_start(pb, rng.normal(size=4 * (pb.n - 1)))
+        if x is None:
+            continue
+        pb.restart()
+        pb.evaluate(x)
+        for _restart in range(RESTARTS + 1):
+            # derivative-free (the cost has corners: minima over samples, the rods that
+            # cannot meet); a run stopped by its budget restarts from the best feasible point
+            r = optimize.minimize(lambda x: pb.evaluate(x)[0], x, method="COBYLA",
+                                  constraints=[{"type": "ineq",
+                                                "fun": lambda x: pb.evaluate(x)[1]}],
+                                  options={"maxiter": MAX_EVALUATIONS,
+                                           "rhobeg": 0.1 * float(np.abs(x).max()),
+                                           "tol": 1e-3})
+            if r.success and (pb.evaluate(r.x)[1] >= 0).all():
+                converged = True
+                break
+            if np.array_equal(pb.seen[0][1], x):  # no feasible progress: a restart repeats it
+                break
+            x = pb.seen[0][1]
+        cost, xs = pb.seen[0] if pb.seen else (pb.evaluate(x)[0], x)
+        if best is None or cost < best[0]:
+            best = (cost, xs)
+    if best is None:
+        raise ParameterError("no feasible exciting trajectory: the rest pose is too close to a "
+                             "singularity or the motors are too weak to hold it")
+    return best[1], converged
+
+
+def _feasible_start(pb: _Problem, x: Array) -> Array | None:
+    """A random start shrunk until it is feasible, then grown to the largest feasible size
+    (a start at the limits uses the headroom the cost asks for); None when even a small one
+    is not feasible."""
+    for _k in range(60):
+        if pb.feasible(x):
+            break
+        x = 0.7 * x
+    else:
+        return None
+    lo, hi = 1.0, 1.0 / 0.7 if _k else 8.0
+    while hi / lo > 1.02:
+        mid = math.sqrt(lo * hi)
+        if pb.feasible(mid * x):
+            lo = mid
+        else:
+            hi = mid
+    return lo * x
+
+
+_Fine = tuple[FourierTrajectory, Array, Array, Array, tuple[Array, Array, Array]]
+
+
+def _finalise(pb: _Problem, x: Array) -> tuple[FourierTrajectory, Array, Array, Array,
+                                                 tuple[Array, Array, Array], float]:
+    """The optimiser saw a coarse grid: check a fine one, shrinking the motion about the rest
+    pose until every sample is within the margins and the motors; then, where the optimiser
+    stopped short of the motors' headroom (its line search can fail), grow it while it stays
+    feasible and its condition number within :data:`GROW_COND` of the optimum's. Returns the
+    trajectory, its fine samples, their distances to the singularities and the condition
+    number."""
+    model, motors, safety = pb.model, pb.motors, pb.safety
+    tt = np.linspace(0.0, 1.0 / pb.base_hz, 40 * pb.m, endpoint=False)
+
+    def fine(x: Array) -> _Fine | None:
+        tr = pb.trajectory(x)
+        q, dq, ddq = tr.evaluate(tt)
+        f = _feasibility(model, q)
+        ok = f is not None and min(f[0].min(), f[1].min()) >= MARGIN and (
+            motors is None or _within(model, motors, q, dq, ddq, safety))
+        return (tr, q, dq, ddq, f) if ok and f is not None else None
+
+    def cond_of(g: _Fine) -> float:
+        sv = _singular_values(model, pb.base, g[1], g[2], g[3])
+        return math.inf if sv is None else float(sv[0] / sv[-1])
+
+    for _ in range(200):
+        got = fine(x)
+        if got is not None:
+            break
+        x = 0.98 * x
+    else:  # pragma: no cover - the rest pose itself is feasible
+        raise ParameterError("no exciting trajectory stays within the margins and motors")
+    cond = cond_of(got)
+    if motors is not None:
+        head = _use(model, motors, *got[1:4]).max(axis=0)
+        grow = x
+        while head.min() < HEADROOM_TARGET * safety:
+            g = fine(1.02 * grow)
+            if g is None or cond_of(g) > GROW_COND * cond:
+                break
+            grow = 1.02 * grow
+            got = g
+            head = _use(model, motors, *got[1:4]).max(axis=0)
+        cond = cond_of(got)
+    tr, q, dq, ddq, f = got
+    return tr, q, dq, ddq, f, cond

@@ -258,18 +258,7 @@ def identify(data: MotionData, model: Model, *, mode: str, cutoff_hz: float | No
             f"({len(data.t)} read), fewer than {need} ({SAMPLES_PER_PARAMETER} per base "
             f"parameter, {base.size} of them): record longer, or move more")
     Yb = base.columns(c.Y)
-    A, b = _stack(Yb, c.tau, np.ones(2), keep)
-    _rank_check(A, base, data.source)
-    beta0, *_ = np.linalg.lstsq(A, b, rcond=None)
-    r0 = (Yb @ beta0) - c.tau
-    sigma = np.array([np.sqrt((r0[keep[:, k], k] ** 2).sum()
-                              / max(sizes[k] - base.size / 2.0, 1.0)) for k in range(2)])
-    if not (sigma > 0).all():  # an exact fit of a motor: weigh both alike
-        sigma = np.ones(2)
-    Aw, bw = _stack(Yb, c.tau, sigma, keep)
-    cond = _rank_check(Aw, base, data.source)
-    beta, *_ = np.linalg.lstsq(Aw, bw, rcond=None)
-    std = _hac_std(Aw, Aw @ beta - bw, sizes)
+    beta, std, sigma, cond, Aw, bw = _weighted_fit(Yb, c.tau, keep, sizes, base, data.source)
     prior = standard_parameters(model.inertia)
     method = "weighted least squares"
     theta, ok = physical_set(beta, base, prior, model.inertia)
@@ -283,16 +272,54 @@ def identify(data: MotionData, model: Model, *, mode: str, cutoff_hz: float | No
     consistent = bool(np.all(np.abs(back - beta) <= 1e-9 * np.maximum(np.abs(beta), 1e-12)
                              + 1e-12 * np.abs(beta).max()))
     pred = Yb @ beta
-    res = pred - c.tau
-    rms = np.array([_rms(res[keep[:, k], k]) for k in range(2)])
-    rms_tau = np.array([_rms(c.tau[keep[:, k], k]) for k in range(2)])
-    quality = np.where(rms_tau > 0, rms / np.where(rms_tau > 0, rms_tau, 1.0), math.inf)
-    prior_rms = np.array([_rms(c.Y[keep[:, k], k] @ prior) for k in range(2)])
-    pred_rms = np.array([_rms(pred[keep[:, k], k]) for k in range(2)])
-    scale = np.where(prior_rms > 0, pred_rms / np.where(prior_rms > 0, prior_rms, 1.0), math.inf)
+    rms, quality, scale = _fit_figures(pred, c.tau, c.Y @ prior, keep)
     with np.errstate(divide="ignore"):
         rel = np.where(beta != 0, std / np.abs(beta), math.inf)
     flagged = tuple(n for n, r in zip(base.names, rel, strict=True) if r > REL_STD_FLAG)
+    status, message, warnings = _status(cond, consistent, method, flagged, quality, scale)
+    return IdentificationResult(base, beta, std, theta, inertia, method, cond, rms, sigma,
+                                len(data.t), len(c.t), c.cutoff_hz, consistent, status, message,
+                                warnings, c, quality, rel, flagged, scale, c.parallel_hz,
+                                np.array(sizes))
+
+
+def _weighted_fit(Yb: Array, tau: Array, keep: Array, sizes: tuple[int, int],
+                  base: BaseParameters, source: str
+                  ) -> tuple[Array, Array, Array, float, Array, Array]:
+    """Ordinary least squares, each motor's residual standard deviation, then the rows of
+    each motor weighted by its inverse: the estimates, their standard deviations, the
+    weights, the condition number and the weighted system ``(Aw, bw)``."""
+    A, b = _stack(Yb, tau, np.ones(2), keep)
+    _rank_check(A, base, source)
+    beta0, *_ = np.linalg.lstsq(A, b, rcond=None)
+    r0 = (Yb @ beta0) - tau
+    sigma = np.array([np.sqrt((r0[keep[:, k], k] ** 2).sum()
+                              / max(sizes[k] - base.size / 2.0, 1.0)) for k in range(2)])
+    if not (sigma > 0).all():  # an exact fit of a motor: weigh both alike
+        sigma = np.ones(2)
+    Aw, bw = _stack(Yb, tau, sigma, keep)
+    cond = _rank_check(Aw, base, source)
+    beta, *_ = np.linalg.lstsq(Aw, bw, rcond=None)
+    return beta, _hac_std(Aw, Aw @ beta - bw, sizes), sigma, cond, Aw, bw
+
+
+def _fit_figures(pred: Array, tau: Array, prior_pred: Array, keep: Array
+                 ) -> tuple[Array, Array, Array]:
+    """Per motor over the rows used: the RMS residual, the fit quality (RMS residual / RMS
+    torque) and the identified torques' scale against the prior's."""
+    res = pred - tau
+    rms = np.array([_rms(res[keep[:, k], k]) for k in range(2)])
+    rms_tau = np.array([_rms(tau[keep[:, k], k]) for k in range(2)])
+    quality = np.where(rms_tau > 0, rms / np.where(rms_tau > 0, rms_tau, 1.0), math.inf)
+    prior_rms = np.array([_rms(prior_pred[keep[:, k], k]) for k in range(2)])
+    pred_rms = np.array([_rms(pred[keep[:, k], k]) for k in range(2)])
+    scale = np.where(prior_rms > 0, pred_rms / np.where(prior_rms > 0, prior_rms, 1.0), math.inf)
+    return rms, quality, scale
+
+
+def _status(cond: float, consistent: bool, method: str, flagged: tuple[str, ...],
+            quality: Array, scale: Array) -> tuple[int, str, list[str]]:
+    """The result's status, message and warnings (the worst finding last)."""
     warnings = []
     status, message = 0, "identified"
     if cond > COND_WARNING:
@@ -316,10 +343,7 @@ def identify(data: MotionData, model: Model, *, mode: str, cutoff_hz: float | No
     if poor:
         status, message = 3, poor
         warnings.append(poor)
-    return IdentificationResult(base, beta, std, theta, inertia, method, cond, rms, sigma,
-                                len(data.t), len(c.t), c.cutoff_hz, consistent, status, message,
-                                warnings, c, quality, rel, flagged, scale, c.parallel_hz,
-                                np.array(sizes))
+    return status, message, warnings
 
 
 @dataclass(frozen=True)
