@@ -105,6 +105,15 @@ class MotorLimits:
         """Largest ``|qdot| / max speed`` over samples (n, 2)."""
         return float((np.abs(dq) / np.asarray(self.max_speed, float)).max())
 
+    def motion_ratio(self, ddq: Array | None = None, jerk: Array | None = None) -> float:
+        """Largest ``|qddot| / max_acceleration`` and ``|qdddot| / max_jerk`` over samples
+        (n, 2) (0 for a limit not set or samples not given)."""
+        out = 0.0
+        for v, lim in ((ddq, self.max_acceleration), (jerk, self.max_jerk)):
+            if v is not None and lim is not None and np.size(v):
+                out = max(out, float((np.abs(v) / np.asarray(lim, float)).max()))
+        return out
+
     def ratios(self, tau: Array, dq: Array) -> tuple[float, float]:
         """Largest ``|tau| / available torque`` and ``|qdot| / max speed`` over samples (n, 2)."""
         return self.torque_ratio(tau, dq), self.speed_ratio(dq)

@@ -175,8 +175,8 @@ class _Table:
         return out, f(self.d3q), f(self.da), f(self.db), f(self.dg)
 
 
-def _table(dynamics: PathDynamics, n: int) -> _Table:
-    co = dynamics.coefficients(np.linspace(0.0, float(dynamics.length), n + 1))
+def _table(dynamics: PathDynamics, s: Array) -> _Table:
+    co = dynamics.coefficients(s)
 
     def d(v: Array) -> Array:
         return np.asarray(np.gradient(v, co.s, axis=0))
@@ -358,7 +358,8 @@ def _states(t: Array, jerk: Array) -> tuple[Array, Array, Array]:
 
 def solve_jerk_limited_law(dynamics: PathDynamics, *, motors: MotorLimits | None = None,
                            constraints: Sequence[Constraint] | None = None,
-                           segments: int = SEGMENTS, grid: int = 400, tol: float = 1e-3,
+                           segments: int = SEGMENTS, grid: int | Array = 400,
+                           tol: float = 1e-3,
                            rate_tol: float = RATE_TOL,
                            units: Units | None = None) -> JerkLimitedLaw:
     """The fastest rest-to-rest law along a path, with zero acceleration at both ends, within
@@ -375,8 +376,9 @@ def solve_jerk_limited_law(dynamics: PathDynamics, *, motors: MotorLimits | None
         torques.
     segments : int
         Intervals of constant jerk (at least 16).
-    grid : int
-        Points of the coefficient table along the path (its segments).
+    grid : int or ndarray, shape (N + 1,)
+        The coefficient table along the path: a number of equal segments or its arc lengths
+        (from 0 to the length; the second-order start law takes every few of them).
     tol, rate_tol : float
         Allowed relative excess of a torque, speed or acceleration (``tol``) and of a jerk
         or torque rate (``rate_tol``) over its limit on the check samples.
@@ -405,11 +407,16 @@ def solve_jerk_limited_law(dynamics: PathDynamics, *, motors: MotorLimits | None
         raise ParameterError(f"tolerances {tol!r}, {rate_tol!r} must be in (0, 1)")
     second = [c for c in cons if c.order == 2]
     third = [c for c in cons if c.order == 3]
-    base = solve_time_optimal_law(dynamics, constraints=second, grid=min(grid, START_GRID),
-                                  tol=tol, units=units)
     length = float(dynamics.length)
+    pts = (np.linspace(0.0, length, int(grid) + 1) if np.ndim(grid) == 0
+           else np.asarray(grid, float))
+    step = max(1, int(np.ceil((len(pts) - 1) / START_GRID)))
+    coarse = np.unique(np.concatenate([pts[::step], pts[-1:]]))
+    base = solve_time_optimal_law(dynamics, constraints=second,
+                                  grid=coarse if len(coarse) > 11 else pts, tol=tol,
+                                  units=units)
     T2 = float(base.duration)
-    table = _table(dynamics, grid)
+    table = _table(dynamics, pts)
     # how long a ramp of the second-order law's acceleration takes at the jerk limits
     co_b = table.at(np.asarray(base.knots_s, float))[0]
     qd = np.abs(co_b.dq_ds).max(axis=0) + 1e-300

@@ -203,6 +203,13 @@ def program_report(summary: ProgramSummary, pngs: dict[str, bytes]) -> str:
             ("peak_torque_ratio", "peak torque / available torque"),
             ("rms_torque_ratio", "RMS torque / rating"),
             ("peak_speed_ratio", "peak speed / maximum speed")]
+    if any("peak_jerk_rad_s3" in m.as_dict() for m in summary.sizing.motors):
+        keys += [("peak_acceleration_rad_s2", "peak acceleration [rad/s^2]"),
+                 ("peak_jerk_rad_s3", "peak jerk [rad/s^3]"),
+                 ("peak_torque_rate_Nm_s", "peak torque rate [N m/s]"),
+                 ("peak_acceleration_ratio", "peak acceleration / limit"),
+                 ("peak_jerk_ratio", "peak jerk / limit"),
+                 ("peak_torque_rate_ratio", "peak torque rate / limit")]
     motors = [m.as_dict() for m in summary.sizing.motors]
     sizing = grid(("", "motor A", "motor D"),
                   [(label, *(m.get(k, "-") for m in motors)) for k, label in keys])
