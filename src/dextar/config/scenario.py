@@ -260,7 +260,8 @@ class Scenario:
         return ProgramRequest(m.robot, m.inertia, self.moves, self.program_start,
                               self.program_mode, self.assembly, self.si_motors,
                               self.motors_table.rms_torque, self.output.servo_rate_hz,
-                              self.program_table.grid, self.tolerances)
+                              self.program_table.grid, self.tolerances,
+                              self.program_table.cycle)
 
     def design_task(self, *, samples: int | None = None, seed: int | None = None
                     ) -> tuple[Task, DesignSpace]:

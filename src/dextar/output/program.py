@@ -17,7 +17,7 @@ from matplotlib.figure import Figure
 from .._arrays import Array
 from ..geometry import FiveBar
 from ..kinematics import workspace_map
-from ..program import MoveTiming, ProgramResult, Sizing
+from ..program import MoveTiming, ProgramResult, RmsFit, Sizing
 from .figures import plot_workspace, png_bytes, svg_bytes
 from .files import OutputDir
 from .html_page import figures, grid, page
@@ -51,6 +51,8 @@ class ProgramSummary:
     servo_rate_hz: float
     moves: tuple[MoveTiming, ...]
     sizing: Sizing
+    rms_fit: RmsFit | None = None
+    drive: dict[str, Any] | None = None
 
     @property
     def status(self) -> str:
@@ -59,11 +61,16 @@ class ProgramSummary:
 
     def as_json(self) -> dict[str, Any]:
         """``summary.json``."""
-        return {"status": self.status, "cycle_time_s": self.cycle_time_s,
-                "servo_rate_hz": self.servo_rate_hz, "config": self.config,
-                "moves": [asdict(m) for m in self.moves],
-                "motors": [m.as_dict() for m in self.sizing.motors],
-                "violations": [v.as_dict() for v in self.sizing.violations], "units": UNITS}
+        out = {"status": self.status, "cycle_time_s": self.cycle_time_s,
+               "servo_rate_hz": self.servo_rate_hz, "config": self.config,
+               "moves": [asdict(m) for m in self.moves],
+               "motors": [m.as_dict() for m in self.sizing.motors],
+               "violations": [v.as_dict() for v in self.sizing.violations], "units": UNITS}
+        if self.rms_fit is not None:
+            out["rms_fit"] = self.rms_fit.as_dict()
+        if self.drive is not None:
+            out["drive"] = self.drive
+        return out
 
     def lines(self, out: str, samples: int) -> list[str]:
         """The summary in words."""
@@ -75,6 +82,11 @@ class ProgramSummary:
               for m in self.moves),
             *(f"  motor {m.motor}: peak {m.peak_torque_Nm:.4g} N m, RMS {m.rms_torque_Nm:.4g} "
               f"N m, peak speed {m.peak_speed_rad_s:.4g} rad/s" for m in self.sizing.motors),
+            *([] if self.rms_fit is None else [
+                f"  cycle fitted within the RMS ratings: bound by the {self.rms_fit.bound_by} "
+                f"(peak torques planned at {self.rms_fit.peak_scale:.4g} of the motors'; RMS "
+                f"ratios {self.rms_fit.rms_ratio[0]:.4f}, {self.rms_fit.rms_ratio[1]:.4f}; "
+                f"{self.rms_fit.plans} plans)"]),
             f"wrote {Path(out) / 'setpoints.csv'} ({samples} setpoints at "
             f"{self.servo_rate_hz:g} Hz) and {Path(out) / 'summary.json'}"]
 
