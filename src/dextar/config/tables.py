@@ -471,6 +471,43 @@ class MotorsTable(Table):
                            opt(self.max_torque_rate, units.torque(1.0) * ts))
 
 
+@dataclass(frozen=True)
+class DriveTable(Table):
+    """``[drive]`` (optional): the drives behind the joints (motor at A first; a number means
+    both): the gearbox, the encoders, the rated torque (for the torque feedforward in
+    per-mille, CiA 402) and the period of the PVT points. With it ``dextar program`` also
+    writes ``csp.csv`` and ``pvt.csv``. ``encoder_offset_deg`` is the joint angle at which
+    each encoder reads zero (the calibration's ``[robot].encoder_offset_deg``, on another
+    branch, is the same angle, identified: when both exist they must agree)."""
+
+    NAME: ClassVar[str] = "drive"
+    PARAMS: ClassVar[dict[str, Param]] = {
+        "gear_ratio": _pair("", "motor turns per joint turn", 1.0, positive=True),
+        "encoder_counts": _pair("", "counts per motor turn", 4096.0, positive=True),
+        "rated_torque_Nm": _pair("", "motor-side rated torque, N m (0x6076)", None,
+                                 positive=True),
+        "encoder_offset_deg": _pair("", "joint angle at each encoder's zero, deg", 0.0),
+        "pvt_period_ms": Param("number", "", 10.0, "period of the PVT points, ms",
+                               positive=True, maximum=1000.0),
+    }
+
+    gear_ratio: tuple[float, float] = (1.0, 1.0)
+    encoder_counts: tuple[float, float] = (4096.0, 4096.0)
+    rated_torque_Nm: tuple[float, float] | None = None
+    encoder_offset_deg: tuple[float, float] = (0.0, 0.0)
+    pvt_period_ms: float = 10.0
+    given: bool = False
+
+    @classmethod
+    def from_toml(cls, raw: Mapping[str, object]) -> DriveTable:
+        """Read ``[drive]``; encoder counts are whole numbers."""
+        t = cls(**read_params(cls.NAME, raw, cls.PARAMS), given=bool(raw))
+        if any(c != int(c) for c in t.encoder_counts):
+            raise ConfigError(f"config key [drive].encoder_counts {list(t.encoder_counts)} "
+                              "must be whole numbers")
+        return t
+
+
 for _cls in (RobotTable, PathTable, LawTable, InertiaTable, FrictionTable, GravityTable,
-             ControlTable, PaperTable, OutputTable, TolerancesTable, MotorsTable):
+             ControlTable, PaperTable, OutputTable, TolerancesTable, MotorsTable, DriveTable):
     register_table(_cls)

@@ -18,13 +18,14 @@ from .._arrays import Array
 from ..geometry import FiveBar
 from ..kinematics import workspace_map
 from ..program import MoveTiming, ProgramResult, RmsFit, Sizing
+from ..program.drive import DriveUnits, PvtPoints
 from .figures import plot_workspace, png_bytes, svg_bytes
 from .files import OutputDir
 from .html_page import figures, grid, page
 from .tables import csv_text
 
-#: Every file a program may write.
-PROGRAM_FILES = ("setpoints.csv", "summary.json", "report.html",
+#: Every file a program may write (``csp.csv`` and ``pvt.csv`` with a ``[drive]`` table).
+PROGRAM_FILES = ("setpoints.csv", "summary.json", "report.html", "csp.csv", "pvt.csv",
                  *(f"{n}.{e}" for n in ("moves", "motion", "operating_points")
                    for e in ("png", "svg")))
 #: What the units of a program's outputs are.
@@ -87,8 +88,15 @@ class ProgramSummary:
                 f"(peak torques planned at {self.rms_fit.peak_scale:.4g} of the motors'; RMS "
                 f"ratios {self.rms_fit.rms_ratio[0]:.4f}, {self.rms_fit.rms_ratio[1]:.4f}; "
                 f"{self.rms_fit.plans} plans)"]),
+            *([] if self.drive is None else [
+                f"  drive: PVT points every {1e3 * float(self.drive['pvt_period_s']):g} ms "
+                f"within {float(self.drive['pvt_max_error_counts']):.3g} counts of the plan; "
+                + "; ".join(f"motor {m['motor']} peak {m['peak_speed_rpm']:.4g} rpm, "
+                            f"{m['peak_torque_Nm']:.4g} N m" for m in self.drive["motors"])]),
             f"wrote {Path(out) / 'setpoints.csv'} ({samples} setpoints at "
-            f"{self.servo_rate_hz:g} Hz) and {Path(out) / 'summary.json'}"]
+            f"{self.servo_rate_hz:g} Hz)"
+            + (f", {Path(out) / 'csp.csv'}, {Path(out) / 'pvt.csv'}" if self.drive else "")
+            + f" and {Path(out) / 'summary.json'}"]
 
 
 def setpoint_columns(res: ProgramResult) -> dict[str, Array]:
@@ -101,11 +109,18 @@ def setpoint_columns(res: ProgramResult) -> dict[str, Array]:
 
 
 def write_program(out: str, res: ProgramResult, summary: ProgramSummary, robot_mm: FiveBar,
-                  mode: str, *, force: bool = False, with_figures: bool = True) -> None:
+                  mode: str, *, force: bool = False, with_figures: bool = True,
+                  drive: DriveUnits | None = None, pvt: PvtPoints | None = None) -> None:
     """Write ``setpoints.csv``, the figures (PNG and SVG), ``report.html`` and
-    ``summary.json`` into ``out``."""
+    ``summary.json`` into ``out``, and with ``drive`` ``csp.csv`` and ``pvt.csv`` (the PVT
+    points ``pvt``, computed from the drive when not given)."""
+    from ..program.drive import csp_columns, pvt_points
+
     with OutputDir(out, force=force, produces=PROGRAM_FILES) as od:
         od.write_text("setpoints.csv", csv_text(setpoint_columns(res)))
+        if drive is not None:
+            od.write_text("csp.csv", _counts_csv(csp_columns(res, drive)))
+            od.write_text("pvt.csv", _counts_csv((pvt or pvt_points(res, drive)).columns()))
         if with_figures:
             pngs: dict[str, bytes] = {}
             for name, fig in (("moves", moves_figure(res, robot_mm, mode)),
@@ -118,6 +133,18 @@ def write_program(out: str, res: ProgramResult, summary: ProgramSummary, robot_m
             od.write_text("report.html", program_report(summary, pngs))
         od.write_text("summary.json", json.dumps(summary.as_json(), indent=2,
                                                  allow_nan=False) + "\n")
+
+
+def _counts_csv(columns: dict[str, Array]) -> str:
+    """CSV of the drive files: positions in counts and torques in per-mille as whole numbers,
+    the other columns as :func:`csv_text` writes them."""
+    text = csv_text(columns).splitlines()
+    names = list(columns)
+    whole = [n.startswith(("pos", "torque")) for n in names]
+    rows = [",".join(str(int(float(v))) if w else v for v, w in zip(r.split(","), whole,
+                                                                       strict=True))
+            for r in text[1:]]
+    return "\n".join([text[0], *rows]) + "\n"
 
 
 def moves_figure(res: ProgramResult, robot_mm: FiveBar, mode: str) -> Figure:
