@@ -126,8 +126,9 @@ def test_fit_rms_plans_at_the_rating_and_stronger_motors_never_lose(tmp_path):
     """With 4 N m peaks the task as planned exceeds its 1 N m RMS rating; fitted, it is
     within it, bound by a rating, and faster than with 2 N m motors (which fit as
     planned); a cycle 1 % shorter (the moves planned at higher peaks) exceeds the rating."""
-    from dextar.config import scenario_from_dict
     import tomllib
+
+    from dextar.config import scenario_from_dict
     from dextar.program.plan import rms_ratios
 
     def req(peak, cycle):

@@ -84,7 +84,7 @@ DURATION_TOL = 2e-4
 ACTIVE = 0.5
 #: Check samples per interval.
 CHECK_PER_INTERVAL = 8
-DEBUG = False
+DEBUG = False  # print the search (development)
 #: Tolerance of the third-order ratios (finite differences) on the check samples.
 RATE_TOL = 1e-2
 
@@ -200,7 +200,9 @@ def _fractions(base: Law, segments: int, ramp: float) -> Array:
     if ramp >= 1.0 / segments:  # the ramps span intervals: uniform knots
         return np.linspace(0.0, 1.0, segments + 1)
     width = float(max(ramp, 2e-3))
-    density = 1.0 + sum(6.0 * np.exp(-0.5 * ((tau - c) / width) ** 2) for c in centres)
+    density = np.ones_like(tau)
+    for c in centres:
+        density += 6.0 * np.exp(-0.5 * ((tau - c) / width) ** 2)
     cdf = np.concatenate([[0.0], np.cumsum(0.5 * (density[1:] + density[:-1]) * np.diff(tau))])
     f = np.interp(np.linspace(0.0, cdf[-1], segments + 1), cdf, tau)
     f[0], f[-1] = 0.0, 1.0

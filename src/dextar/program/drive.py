@@ -63,8 +63,8 @@ class DriveUnits:
     @property
     def counts_per_rad(self) -> Array:
         """Encoder counts per joint radian (2,)."""
-        return np.asarray(self.gear_ratio, float) * np.asarray(self.encoder_counts,
-                                                                float) / (2 * np.pi)
+        return np.asarray(np.asarray(self.gear_ratio, float)
+                          * np.asarray(self.encoder_counts, float) / (2 * np.pi))
 
     def counts(self, q: Array) -> Array:
         """Joint angles (n, 2) to encoder counts from the encoders' zero (unrounded)."""
