@@ -2,9 +2,11 @@
 
 One object, :class:`MotorLimits`, says what the motors can give: a peak torque, a maximum
 speed and, optionally, a torque-speed envelope (full torque up to a knee speed, then linearly
-down to zero at the maximum speed). The time-optimal law plans within it (as constraint
-objects, :mod:`dextar.laws.constraints`), programs are sized against it, exciting
-trajectories stay within it.
+down to zero at the maximum speed), and what the drives may be asked: a joint acceleration,
+a joint jerk and a torque rate (each optional). The time-optimal law plans within it (as
+constraint objects, :mod:`dextar.laws.constraints`; with a jerk or torque-rate limit it is
+third order, :mod:`dextar.laws.smooth`), programs are sized against it, exciting trajectories
+stay within it.
 """
 
 from __future__ import annotations
@@ -32,11 +34,21 @@ class MotorLimits:
         ``inf`` for none.
     knee_speed : (float, float), optional
         Below ``max_speed``; None for no envelope.
+    max_acceleration : (float, float), optional
+        Joint accelerations (rad per run time unit squared); None for none.
+    max_jerk : (float, float), optional
+        Joint jerks (rad per run time unit cubed); None for none.
+    max_torque_rate : (float, float), optional
+        Rates of change of the motor torques (run torque unit per run time unit); None for
+        none.
     """
 
     peak_torque: tuple[float, float]
     max_speed: tuple[float, float] = (math.inf, math.inf)
     knee_speed: tuple[float, float] | None = None
+    max_acceleration: tuple[float, float] | None = None
+    max_jerk: tuple[float, float] | None = None
+    max_torque_rate: tuple[float, float] | None = None
 
     def __post_init__(self) -> None:
         t, w = np.asarray(self.peak_torque, float), np.asarray(self.max_speed, float)
@@ -50,6 +62,18 @@ class MotorLimits:
             if k.shape != (2,) or not np.all((k > 0) & (k < w)):
                 raise ParameterError(f"knee speeds {self.knee_speed!r} must be positive and below "
                                      f"the maximum speeds {self.max_speed!r}")
+        for name in ("max_acceleration", "max_jerk", "max_torque_rate"):
+            v = getattr(self, name)
+            if v is not None:
+                a = np.asarray(v, float)
+                if a.shape != (2,) or not np.all(np.isfinite(a) & (a > 0)):
+                    raise ParameterError(f"{name.replace('_', ' ')} limits {v!r} must be two "
+                                         "positive finite numbers")
+
+    @property
+    def third_order(self) -> bool:
+        """True when a jerk or torque-rate limit makes a time-optimal law third order."""
+        return self.max_jerk is not None or self.max_torque_rate is not None
 
     @classmethod
     def of(cls, torque_limit: object, speed_limit: object = None) -> MotorLimits:
@@ -80,6 +104,15 @@ class MotorLimits:
     def speed_ratio(self, dq: Array) -> float:
         """Largest ``|qdot| / max speed`` over samples (n, 2)."""
         return float((np.abs(dq) / np.asarray(self.max_speed, float)).max())
+
+    def motion_ratio(self, ddq: Array | None = None, jerk: Array | None = None) -> float:
+        """Largest ``|qddot| / max_acceleration`` and ``|qdddot| / max_jerk`` over samples
+        (n, 2) (0 for a limit not set or samples not given)."""
+        out = 0.0
+        for v, lim in ((ddq, self.max_acceleration), (jerk, self.max_jerk)):
+            if v is not None and lim is not None and np.size(v):
+                out = max(out, float((np.abs(v) / np.asarray(lim, float)).max()))
+        return out
 
     def ratios(self, tau: Array, dq: Array) -> tuple[float, float]:
         """Largest ``|tau| / available torque`` and ``|qdot| / max speed`` over samples (n, 2)."""

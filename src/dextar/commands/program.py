@@ -24,13 +24,20 @@ def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
     from ..config import load_scenario
     from ..output.program import ProgramSummary, write_program
     from ..program import sizing
+    from ..program.drive import drive_report, pvt_points
 
     sc = load_scenario(args.config, model=args.model)
+    drive = sc.drive()
     res = sc.program_request().plan()
+    pvt = None if drive is None else pvt_points(res, drive)
+    report = None
+    if drive is not None and pvt is not None:
+        report = {**drive_report(res, drive, sc.si_model.inertia.rotor),
+                  "pvt_max_error_counts": pvt.max_error_counts}
     summary = ProgramSummary(args.config, res.cycle_time_s, sc.output.servo_rate_hz,
-                             tuple(res.timeline()), sizing(res))
+                             tuple(res.timeline()), sizing(res), res.rms_fit, report)
     write_program(args.out, res, summary, sc.robot_mm, sc.program_mode, force=args.force,
-                  with_figures=figures)
+                  with_figures=figures, drive=drive, pvt=pvt)
     warnings = [f"dextar program: {v.text()}" for v in summary.sizing.violations]
     return Result(summary.as_json(), "\n".join(summary.lines(args.out, res.t.size)), warnings,
                   code=0 if summary.sizing.fits else 1)

@@ -31,6 +31,9 @@ class ProgramTable(Table):
         "grid": Param("integer", "", 400, "time-optimal segments per motion (blended moves "
                       "are one motion; a blend gets at least 20)", minimum=10,
                       maximum=100_000),
+        "cycle": Param("choice", "", "as-planned", "as-planned (each move's own law) or "
+                       "fit-rms (the shortest cycle within [motors].rms_torque: the moves "
+                       "planned within lower peak torques)", choices=("as-planned", "fit-rms")),
     }
 
     start: tuple[float, float] | None = None
@@ -38,6 +41,7 @@ class ProgramTable(Table):
     law: str = "time-optimal"
     blend: float = 0.0
     grid: int = 400
+    cycle: str = "as-planned"
 
     @classmethod
     def from_toml(cls, raw: Mapping[str, object]) -> ProgramTable:

@@ -31,9 +31,11 @@ from .program import ProgramTable, read_moves
 if TYPE_CHECKING:
     from ..design.evaluate import Task
     from ..design.space import DesignSpace
+    from ..program.drive import DriveUnits
 from .tables import (
     TABLES,
     ControlTable,
+    DriveTable,
     FrictionTable,
     GravityTable,
     InertiaTable,
@@ -126,6 +128,28 @@ class Scenario:
     def motors_table(self) -> MotorsTable:
         """``[motors]``."""
         return self._get(MotorsTable)
+
+    @property
+    def drive_table(self) -> DriveTable:
+        """``[drive]``."""
+        return self._get(DriveTable)
+
+    def drive(self) -> DriveUnits | None:
+        """The drives in SI (``[drive]``), or None without the table."""
+        import math
+
+        from ..program.drive import DriveUnits
+
+        t = self.drive_table
+        if not t.given:
+            return None
+        try:
+            return DriveUnits(t.gear_ratio, (int(t.encoder_counts[0]), int(t.encoder_counts[1])),
+                              t.rated_torque_Nm, (math.radians(t.encoder_offset_deg[0]),
+                                                  math.radians(t.encoder_offset_deg[1])),
+                              t.pvt_period_ms * 1e-3)
+        except DextarError as exc:
+            raise ConfigError(f"config table [drive]: {exc}") from None
 
     @property
     def program_table(self) -> ProgramTable:
@@ -270,7 +294,8 @@ class Scenario:
         return ProgramRequest(m.robot, m.inertia, self.moves, self.program_start,
                               self.program_mode, self.assembly, self.si_motors,
                               self.motors_table.rms_torque, self.output.servo_rate_hz,
-                              self.program_table.grid, self.tolerances)
+                              self.program_table.grid, self.tolerances,
+                              self.program_table.cycle)
 
     def design_task(self, *, samples: int | None = None, seed: int | None = None
                     ) -> tuple[Task, DesignSpace]:

@@ -407,7 +407,9 @@ class TolerancesTable(Table):
 class MotorsTable(Table):
     """``[motors]``: the motors at the joints (motor at A first; a number means both):
     peak torque, continuous (RMS) rating, maximum speed and the knee of the torque-speed
-    envelope (full torque up to the knee, then linear to zero at the maximum speed)."""
+    envelope (full torque up to the knee, then linear to zero at the maximum speed), and the
+    limits a drive sets on the motion: joint acceleration, joint jerk and torque rate (a jerk
+    or torque-rate limit makes the time-optimal law third order)."""
 
     NAME: ClassVar[str] = "motors"
     PARAMS: ClassVar[dict[str, Param]] = {
@@ -416,12 +418,19 @@ class MotorsTable(Table):
         "max_speed_rpm": _pair("", "maximum speeds, rpm", None, positive=True),
         "knee_speed_rpm": _pair("", "end of full torque, rpm (< max_speed_rpm)", None,
                                 positive=True),
+        "max_acceleration": _pair("", "joint accelerations, rad/s^2", None, positive=True),
+        "max_jerk": _pair("", "joint jerks, rad/s^3", None, positive=True),
+        "max_torque_rate": _pair("", "rates of change of the torques, N m/s", None,
+                                 positive=True),
     }
 
     peak_torque: tuple[float, float] | None = None
     rms_torque: tuple[float, float] | None = None
     max_speed_rpm: tuple[float, float] | None = None
     knee_speed_rpm: tuple[float, float] | None = None
+    max_acceleration: tuple[float, float] | None = None
+    max_jerk: tuple[float, float] | None = None
+    max_torque_rate: tuple[float, float] | None = None
 
     @classmethod
     def from_toml(cls, raw: Mapping[str, object]) -> MotorsTable:
@@ -429,6 +438,11 @@ class MotorsTable(Table):
         needs a maximum speed above it."""
         t = cls(**read_params(cls.NAME, raw, cls.PARAMS))
         if raw and t.peak_torque is None:
+            given = [k for k in ("max_jerk", "max_torque_rate", "max_acceleration") if k in raw]
+            if given:
+                raise ConfigError(f"config key [motors].{given[0]} needs peak_torque: a "
+                                  "time-optimal law plans within the torques too (config key "
+                                  "[motors].peak_torque is required)")
             raise ConfigError("config key [motors].peak_torque is required")
         if t.knee_speed_rpm is not None:
             if t.max_speed_rpm is None:
@@ -447,11 +461,53 @@ class MotorsTable(Table):
         def pair(v: tuple[float, float] | None, scale: float) -> tuple[float, float]:
             return (math.inf, math.inf) if v is None else (v[0] * scale, v[1] * scale)
 
+        def opt(v: tuple[float, float] | None, scale: float) -> tuple[float, float] | None:
+            return None if v is None else (v[0] * scale, v[1] * scale)
+
+        ts = units.time_s
         return MotorLimits((units.torque(self.peak_torque[0]), units.torque(self.peak_torque[1])),
-                           pair(self.max_speed_rpm, rad),
-                           None if self.knee_speed_rpm is None else pair(self.knee_speed_rpm, rad))
+                           pair(self.max_speed_rpm, rad), opt(self.knee_speed_rpm, rad),
+                           opt(self.max_acceleration, ts**2), opt(self.max_jerk, ts**3),
+                           opt(self.max_torque_rate, units.torque(1.0) * ts))
+
+
+@dataclass(frozen=True)
+class DriveTable(Table):
+    """``[drive]`` (optional): the drives behind the joints (motor at A first; a number means
+    both): the gearbox, the encoders, the rated torque (for the torque feedforward in
+    per-mille, CiA 402) and the period of the PVT points. With it ``dextar program`` also
+    writes ``csp.csv`` and ``pvt.csv``. ``encoder_offset_deg`` is the joint angle at which
+    each encoder reads zero (the calibration's ``[robot].encoder_offset_deg``, on another
+    branch, is the same angle, identified: when both exist they must agree)."""
+
+    NAME: ClassVar[str] = "drive"
+    PARAMS: ClassVar[dict[str, Param]] = {
+        "gear_ratio": _pair("", "motor turns per joint turn", 1.0, positive=True),
+        "encoder_counts": _pair("", "counts per motor turn", 4096.0, positive=True),
+        "rated_torque_Nm": _pair("", "motor-side rated torque, N m (0x6076)", None,
+                                 positive=True),
+        "encoder_offset_deg": _pair("", "joint angle at each encoder's zero, deg", 0.0),
+        "pvt_period_ms": Param("number", "", 10.0, "period of the PVT points, ms",
+                               positive=True, maximum=1000.0),
+    }
+
+    gear_ratio: tuple[float, float] = (1.0, 1.0)
+    encoder_counts: tuple[float, float] = (4096.0, 4096.0)
+    rated_torque_Nm: tuple[float, float] | None = None
+    encoder_offset_deg: tuple[float, float] = (0.0, 0.0)
+    pvt_period_ms: float = 10.0
+    given: bool = False
+
+    @classmethod
+    def from_toml(cls, raw: Mapping[str, object]) -> DriveTable:
+        """Read ``[drive]``; encoder counts are whole numbers."""
+        t = cls(**read_params(cls.NAME, raw, cls.PARAMS), given=bool(raw))
+        if any(c != int(c) for c in t.encoder_counts):
+            raise ConfigError(f"config key [drive].encoder_counts {list(t.encoder_counts)} "
+                              "must be whole numbers")
+        return t
 
 
 for _cls in (RobotTable, PathTable, LawTable, InertiaTable, FrictionTable, GravityTable,
-             ControlTable, PaperTable, OutputTable, TolerancesTable, MotorsTable):
+             ControlTable, PaperTable, OutputTable, TolerancesTable, MotorsTable, DriveTable):
     register_table(_cls)

@@ -54,7 +54,7 @@ class RobotAlongPath:
         ine = self.model.inertia
         a, b, g = path_dynamics(self._model(jp.assembly), jp.q, jp.dq, jp.ddq)
         return PathCoefficients(jp.t, jp.P, a, b, g, jp.dq, np.array(ine.coulomb, float),
-                                np.array(ine.viscous, float))
+                                np.array(ine.viscous, float), jp.ddq, ine.coulomb_speed)
 
     def _model(self, assembly: str) -> Model:
         """The model in the assembly mode the path's poses are in (its own tolerance)."""
@@ -66,7 +66,7 @@ class RobotAlongPath:
         tr = sample_trajectory(self.model.robot, self.path, law, mode=self.mode, times=times,
                                checked=False)  # the path was checked by coefficients()
         tau = inverse_dynamics(self._model(tr.assembly), tr.q, tr.dq, tr.ddq)
-        return JointSamples(tau, tr.dq)
+        return JointSamples(tau, tr.dq, tr.ddq, np.asarray(times, float))
 
 
 def time_optimal_law(model: Model, path: Path, *,
@@ -105,14 +105,16 @@ class RobotAlongJointLine:
         a, b, g = path_dynamics(self._free, q, u, np.zeros_like(u))
         P = direct_kinematics(robot, q, self.model.assembly)
         return PathCoefficients(s, P, a, b, g, u, np.array(ine.coulomb, float),
-                                np.array(ine.viscous, float))
+                                np.array(ine.viscous, float), np.zeros_like(u),
+                                ine.coulomb_speed)
 
     def samples(self, law: Law, times: Array) -> JointSamples:
         """``law`` at ``times`` through the exact model."""
         s, ds, dds, _ = law.evaluate(times)
         u = self.line.direction
         q, dq, ddq = self.line.at(s), ds[:, None] * u, dds[:, None] * u
-        return JointSamples(inverse_dynamics(self._free, q, dq, ddq), dq)
+        return JointSamples(inverse_dynamics(self._free, q, dq, ddq), dq, ddq,
+                            np.asarray(times, float))
 
     @property
     def _free(self) -> Model:

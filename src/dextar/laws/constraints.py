@@ -24,6 +24,13 @@ solver (:mod:`dextar.laws.time_optimal`) takes any sequence of them. The kinds:
   at the maximum speed: ``|tau| + sigma |q'| sqrt(x) <= T + sigma knee``
   (``sigma = T / (max_speed - knee)``), ``sqrt(x)`` bounded above by its tangent at
   ``max(x0, x_knee)``: conservative, and exact at the tangent point.
+* :class:`AccelerationLimit`: ``|qddot_i| = |q'_i u + q''_i x| <= max_acceleration_i``, linear
+  in ``(u, x)`` like the torque rows.
+* :class:`JerkLimit` and :class:`TorqueRateLimit`: third order, ``|qdddot_i|`` and
+  ``|d tau_i / dt|`` bounded. They have no rows in ``(u, x)`` (the jerk involves ``sdddot``):
+  the jerk-limited law (:mod:`dextar.laws.smooth`) linearises them in its own variables, and
+  they measure their ratio by finite differences of the sampled accelerations or torques
+  (samples in increasing time, e.g. at a servo rate).
 
 Each constraint has a ``kind`` (the quantity it limits: ``"torque"``, ``"speed"``); when the
 check finds an excess of a kind, the solver tightens every constraint of that kind by it
@@ -61,6 +68,10 @@ class PathCoefficients:
         ``q'``, the joint rates per unit arc length.
     coulomb, viscous : ndarray, shape (2,)
         The motors' friction coefficients.
+    d2q_ds2 : ndarray, shape (N + 1, 2), optional
+        ``q''`` (for the joint accelerations; None: zero, a straight line in joint space).
+    coulomb_speed : float
+        The regularisation speed of the Coulomb friction (``tanh(qdot / coulomb_speed)``).
     """
 
     s: Array
@@ -71,6 +82,13 @@ class PathCoefficients:
     dq_ds: Array
     coulomb: Array
     viscous: Array
+    d2q_ds2: Array | None = None
+    coulomb_speed: float = 1.0
+
+    @property
+    def ddq_ds(self) -> Array:
+        """``q''`` (N + 1, 2), zeros when not given."""
+        return np.zeros_like(self.dq_ds) if self.d2q_ds2 is None else self.d2q_ds2
 
     @cached_property
     def friction_sides(self) -> tuple[Array, Array]:
@@ -88,15 +106,21 @@ class PathCoefficients:
 
 @dataclass(frozen=True)
 class JointSamples:
-    """A law's motion sampled through the exact model: the torques and the joint rates.
+    """A law's motion sampled through the exact model: the torques and the joint rates (and
+    the joint accelerations and the times, for the limits on them and on their rates).
 
     Attributes
     ----------
     tau, dq : ndarray, shape (n, 2)
+    ddq : ndarray, shape (n, 2), optional
+    t : ndarray, shape (n,), optional
+        The sample times.
     """
 
     tau: Array
     dq: Array
+    ddq: Array | None = None
+    t: Array | None = None
 
 
 class PathDynamics(Protocol):
@@ -173,6 +197,10 @@ class Constraint(ABC):
     @abstractmethod
     def scaled(self, scales: Mapping[str, float]) -> Constraint:
         """The constraint with its limits multiplied by ``scales[kind]`` (tightened)."""
+
+    #: 2 for a limit on the state and the acceleration (rows in ``(u, x)``), 3 for a limit on
+    #: the jerk or the torque rate.
+    order: int = 2
 
     @property
     def torque_limit(self) -> tuple[float, float] | None:
@@ -305,14 +333,97 @@ class TorqueSpeedEnvelope(Constraint):
         return self.peak
 
 
+@dataclass(frozen=True)
+class AccelerationLimit(Constraint):
+    """``|qddot_i| = |q'_i u + q''_i x| <= max_acceleration_i``: rows linear in ``(u, x)``."""
+
+    max_acceleration: tuple[float, float]
+    kind: str = "acceleration"
+
+    def rows(self, tangent: Tangent) -> PointRows:
+        """``+-(q' u + q'' x) <= max_acceleration`` at every point."""
+        co = tangent.co
+        amax = np.broadcast_to(np.asarray(self.max_acceleration, float), co.dq_ds.shape)
+        d1, d2 = co.dq_ds, co.ddq_ds
+        return PointRows(np.concatenate([d1, -d1], axis=1), np.concatenate([d2, -d2], axis=1),
+                         np.concatenate([amax, amax], axis=1))
+
+    def ratio(self, js: JointSamples) -> float:
+        """Largest ``|qddot_i| / max_acceleration_i`` (0 without accelerations)."""
+        if js.ddq is None:
+            return 0.0
+        return float((np.abs(js.ddq) / np.asarray(self.max_acceleration, float)).max())
+
+    def scaled(self, scales: Mapping[str, float]) -> AccelerationLimit:
+        """The accelerations tightened by ``scales["acceleration"]``."""
+        return replace(self, max_acceleration=_pair(np.asarray(self.max_acceleration, float)
+                                                    * scales.get("acceleration", 1.0)))
+
+
+def _rate(values: Array | None, t: Array | None) -> Array | None:
+    """Finite differences ``d values / dt`` between consecutive samples (n - 1, 2)."""
+    if values is None or t is None or len(t) < 2:
+        return None
+    dt = np.diff(t)
+    return np.asarray(np.diff(values, axis=0) / np.where(dt > 0, dt, np.inf)[:, None])
+
+
+@dataclass(frozen=True)
+class JerkLimit(Constraint):
+    """``|qdddot_i| <= max_jerk_i`` (third order); its ratio is measured by finite differences
+    of the sampled joint accelerations (samples in increasing time)."""
+
+    max_jerk: tuple[float, float]
+    kind: str = "jerk"
+    order: int = 3
+
+    def ratio(self, js: JointSamples) -> float:
+        """Largest ``|d qddot_i / dt| / max_jerk_i`` between consecutive samples."""
+        r = _rate(js.ddq, js.t)
+        return 0.0 if r is None else float((np.abs(r) / np.asarray(self.max_jerk, float)).max())
+
+    def scaled(self, scales: Mapping[str, float]) -> JerkLimit:
+        """The jerks tightened by ``scales["jerk"]``."""
+        return replace(self, max_jerk=_pair(np.asarray(self.max_jerk, float)
+                                            * scales.get("jerk", 1.0)))
+
+
+@dataclass(frozen=True)
+class TorqueRateLimit(Constraint):
+    """``|d tau_i / dt| <= max_torque_rate_i`` (third order); its ratio is measured by finite
+    differences of the sampled torques (samples in increasing time)."""
+
+    max_torque_rate: tuple[float, float]
+    kind: str = "torque_rate"
+    order: int = 3
+
+    def ratio(self, js: JointSamples) -> float:
+        """Largest ``|d tau_i / dt| / max_torque_rate_i`` between consecutive samples."""
+        r = _rate(js.tau, js.t)
+        return 0.0 if r is None else float((np.abs(r) / np.asarray(self.max_torque_rate,
+                                                                     float)).max())
+
+    def scaled(self, scales: Mapping[str, float]) -> TorqueRateLimit:
+        """The rates tightened by ``scales["torque_rate"]``."""
+        return replace(self, max_torque_rate=_pair(np.asarray(self.max_torque_rate, float)
+                                                   * scales.get("torque_rate", 1.0)))
+
+
 def motor_constraints(motors: MotorLimits) -> tuple[Constraint, ...]:
-    """The motors' limits as constraints: the peak torque, the speed limit (when finite) and
-    the torque-speed envelope (when it has a knee)."""
+    """The motors' limits as constraints: the peak torque, the speed limit (when finite), the
+    torque-speed envelope (when it has a knee), and the acceleration, jerk and torque-rate
+    limits (when given)."""
     out: list[Constraint] = [TorqueLimit(motors.peak_torque)]
     if np.isfinite(np.asarray(motors.max_speed, float)).any():
         out.append(SpeedLimit(motors.max_speed))
     if motors.knee_speed is not None:
         out.append(TorqueSpeedEnvelope(motors.peak_torque, motors.max_speed, motors.knee_speed))
+    if motors.max_acceleration is not None:
+        out.append(AccelerationLimit(motors.max_acceleration))
+    if motors.max_jerk is not None:
+        out.append(JerkLimit(motors.max_jerk))
+    if motors.max_torque_rate is not None:
+        out.append(TorqueRateLimit(motors.max_torque_rate))
     return tuple(out)
 
 

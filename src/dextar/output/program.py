@@ -17,14 +17,15 @@ from matplotlib.figure import Figure
 from .._arrays import Array
 from ..geometry import FiveBar
 from ..kinematics import workspace_map
-from ..program import MoveTiming, ProgramResult, Sizing
+from ..program import MoveTiming, ProgramResult, RmsFit, Sizing
+from ..program.drive import DriveUnits, PvtPoints
 from .figures import plot_workspace, png_bytes, svg_bytes
 from .files import OutputDir
 from .html_page import figures, grid, page
 from .tables import csv_text
 
-#: Every file a program may write.
-PROGRAM_FILES = ("setpoints.csv", "summary.json", "report.html",
+#: Every file a program may write (``csp.csv`` and ``pvt.csv`` with a ``[drive]`` table).
+PROGRAM_FILES = ("setpoints.csv", "summary.json", "report.html", "csp.csv", "pvt.csv",
                  *(f"{n}.{e}" for n in ("moves", "motion", "operating_points")
                    for e in ("png", "svg")))
 #: What the units of a program's outputs are.
@@ -51,6 +52,8 @@ class ProgramSummary:
     servo_rate_hz: float
     moves: tuple[MoveTiming, ...]
     sizing: Sizing
+    rms_fit: RmsFit | None = None
+    drive: dict[str, Any] | None = None
 
     @property
     def status(self) -> str:
@@ -59,11 +62,16 @@ class ProgramSummary:
 
     def as_json(self) -> dict[str, Any]:
         """``summary.json``."""
-        return {"status": self.status, "cycle_time_s": self.cycle_time_s,
-                "servo_rate_hz": self.servo_rate_hz, "config": self.config,
-                "moves": [asdict(m) for m in self.moves],
-                "motors": [m.as_dict() for m in self.sizing.motors],
-                "violations": [v.as_dict() for v in self.sizing.violations], "units": UNITS}
+        out = {"status": self.status, "cycle_time_s": self.cycle_time_s,
+               "servo_rate_hz": self.servo_rate_hz, "config": self.config,
+               "moves": [asdict(m) for m in self.moves],
+               "motors": [m.as_dict() for m in self.sizing.motors],
+               "violations": [v.as_dict() for v in self.sizing.violations], "units": UNITS}
+        if self.rms_fit is not None:
+            out["rms_fit"] = self.rms_fit.as_dict()
+        if self.drive is not None:
+            out["drive"] = self.drive
+        return out
 
     def lines(self, out: str, samples: int) -> list[str]:
         """The summary in words."""
@@ -75,8 +83,20 @@ class ProgramSummary:
               for m in self.moves),
             *(f"  motor {m.motor}: peak {m.peak_torque_Nm:.4g} N m, RMS {m.rms_torque_Nm:.4g} "
               f"N m, peak speed {m.peak_speed_rad_s:.4g} rad/s" for m in self.sizing.motors),
+            *([] if self.rms_fit is None else [
+                f"  cycle fitted within the RMS ratings: bound by the {self.rms_fit.bound_by} "
+                f"(peak torques planned at {self.rms_fit.peak_scale:.4g} of the motors'; RMS "
+                f"ratios {self.rms_fit.rms_ratio[0]:.4f}, {self.rms_fit.rms_ratio[1]:.4f}; "
+                f"{self.rms_fit.plans} plans)"]),
+            *([] if self.drive is None else [
+                f"  drive: PVT points every {1e3 * float(self.drive['pvt_period_s']):g} ms "
+                f"within {float(self.drive['pvt_max_error_counts']):.3g} counts of the plan; "
+                + "; ".join(f"motor {m['motor']} peak {m['peak_speed_rpm']:.4g} rpm, "
+                            f"{m['peak_torque_Nm']:.4g} N m" for m in self.drive["motors"])]),
             f"wrote {Path(out) / 'setpoints.csv'} ({samples} setpoints at "
-            f"{self.servo_rate_hz:g} Hz) and {Path(out) / 'summary.json'}"]
+            f"{self.servo_rate_hz:g} Hz)"
+            + (f", {Path(out) / 'csp.csv'}, {Path(out) / 'pvt.csv'}" if self.drive else "")
+            + f" and {Path(out) / 'summary.json'}"]
 
 
 def setpoint_columns(res: ProgramResult) -> dict[str, Array]:
@@ -89,11 +109,18 @@ def setpoint_columns(res: ProgramResult) -> dict[str, Array]:
 
 
 def write_program(out: str, res: ProgramResult, summary: ProgramSummary, robot_mm: FiveBar,
-                  mode: str, *, force: bool = False, with_figures: bool = True) -> None:
+                  mode: str, *, force: bool = False, with_figures: bool = True,
+                  drive: DriveUnits | None = None, pvt: PvtPoints | None = None) -> None:
     """Write ``setpoints.csv``, the figures (PNG and SVG), ``report.html`` and
-    ``summary.json`` into ``out``."""
+    ``summary.json`` into ``out``, and with ``drive`` ``csp.csv`` and ``pvt.csv`` (the PVT
+    points ``pvt``, computed from the drive when not given)."""
+    from ..program.drive import csp_columns, pvt_points
+
     with OutputDir(out, force=force, produces=PROGRAM_FILES) as od:
         od.write_text("setpoints.csv", csv_text(setpoint_columns(res)))
+        if drive is not None:
+            od.write_text("csp.csv", _counts_csv(csp_columns(res, drive)))
+            od.write_text("pvt.csv", _counts_csv((pvt or pvt_points(res, drive)).columns()))
         if with_figures:
             pngs: dict[str, bytes] = {}
             for name, fig in (("moves", moves_figure(res, robot_mm, mode)),
@@ -106,6 +133,18 @@ def write_program(out: str, res: ProgramResult, summary: ProgramSummary, robot_m
             od.write_text("report.html", program_report(summary, pngs))
         od.write_text("summary.json", json.dumps(summary.as_json(), indent=2,
                                                  allow_nan=False) + "\n")
+
+
+def _counts_csv(columns: dict[str, Array]) -> str:
+    """CSV of the drive files: positions in counts and torques in per-mille as whole numbers,
+    the other columns as :func:`csv_text` writes them."""
+    text = csv_text(columns).splitlines()
+    names = list(columns)
+    whole = [n.startswith(("pos", "torque")) for n in names]
+    rows = [",".join(str(int(float(v))) if w else v for v, w in zip(r.split(","), whole,
+                                                                       strict=True))
+            for r in text[1:]]
+    return "\n".join([text[0], *rows]) + "\n"
 
 
 def moves_figure(res: ProgramResult, robot_mm: FiveBar, mode: str) -> Figure:
@@ -216,6 +255,13 @@ def program_report(summary: ProgramSummary, pngs: dict[str, bytes]) -> str:
             ("peak_torque_ratio", "peak torque / available torque"),
             ("rms_torque_ratio", "RMS torque / rating"),
             ("peak_speed_ratio", "peak speed / maximum speed")]
+    if any("peak_jerk_rad_s3" in m.as_dict() for m in summary.sizing.motors):
+        keys += [("peak_acceleration_rad_s2", "peak acceleration [rad/s^2]"),
+                 ("peak_jerk_rad_s3", "peak jerk [rad/s^3]"),
+                 ("peak_torque_rate_Nm_s", "peak torque rate [N m/s]"),
+                 ("peak_acceleration_ratio", "peak acceleration / limit"),
+                 ("peak_jerk_ratio", "peak jerk / limit"),
+                 ("peak_torque_rate_ratio", "peak torque rate / limit")]
     motors = [m.as_dict() for m in summary.sizing.motors]
     sizing = grid(("", "motor A", "motor D"),
                   [(label, *(m.get(k, "-") for m in motors)) for k, label in keys])

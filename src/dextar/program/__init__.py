@@ -10,10 +10,13 @@ from .plan import (
     PlanState,
     ProgramRequest,
     ProgramResult,
+    RmsFit,
+    fit_rms,
     plan_program,
 )
 from .sizing import MotorSizing, Sizing, Violation, sizing
 
 __all__ = ["MOVE_TYPES", "MotorSizing", "Move", "MovePlan", "MoveTiming", "MoveType",
-           "PlanContext", "PlanState", "PlannedMove", "ProgramRequest", "ProgramResult", "Sizing", "Violation",
-           "move_type", "plan_program", "register_move", "sizing"]
+           "PlanContext", "PlanState", "PlannedMove", "ProgramRequest", "ProgramResult", "RmsFit",
+           "Sizing", "Violation", "fit_rms", "move_type", "plan_program", "register_move",
+           "sizing"]

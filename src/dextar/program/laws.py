@@ -1,7 +1,7 @@
 """A move's law: any registered law built from the move's keys (SI), planned on the robot's
 dynamics when the law needs them, or a fixed-shape law with its duration in seconds or
-``"fit"``: the shortest duration for which the law stays within the motors (regula falsi on a
-bracket)."""
+``"fit"``: the shortest duration for which the law stays within the motors (torque, speed,
+and the joint acceleration and jerk when set; regula falsi on a bracket)."""
 
 from __future__ import annotations
 
@@ -88,7 +88,7 @@ def move_law(mv: Move, path: Path, dynamics: PathDynamics, motors: MotorLimits |
             law = family(T)
             tr_ = traj(law, check_times(law) if law.breakpoints().size else None)
             tr, sp = limits.ratios(inverse_dynamics(model, tr_.q, tr_.dq, tr_.ddq), tr_.dq)
-            return max(tr, sp)
+            return max(tr, sp, limits.motion_ratio(tr_.ddq, _jerk(tr_)))
 
         ratio = stretched_ratio(family, traj, model, limits) or sampled
         return max(t_min, shortest_within(ratio))
@@ -158,13 +158,20 @@ def stretched_ratio(build: Callable[[float], Law], traj: Sampling, model: Model,
     inertial = inverse_dynamics(Model(model.robot, ine.frictionless(), model.assembly,
                                       tol=model.tol), q, dq, ddq)
     g = gravity_torques(model, q)
+    jerk = _jerk(tr)
 
     def ratio(T: float) -> float:
         dqT = dq / T
         tr, sp = motors.ratios(inertial / (T * T) + g + ine.friction_torques(dqT), dqT)
-        return max(tr, sp)
+        return max(tr, sp, motors.motion_ratio(ddq / (T * T), jerk / T**3))
 
     return ratio
+
+
+def _jerk(tr: Trajectory) -> Array:
+    """The joint jerks (n - 1, 2) between consecutive samples (finite differences)."""
+    dt = np.diff(tr.t)
+    return np.asarray(np.diff(tr.ddq, axis=0) / np.where(dt > 0, dt, np.inf)[:, None])
 
 
 @dataclass(frozen=True)

@@ -24,7 +24,7 @@ from __future__ import annotations
 import functools
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 
 import numpy as np
@@ -216,6 +216,8 @@ class ProgramResult:
         The motors' continuous ratings (N m).
     move_types : tuple of str
         Every move's type, in program order.
+    rms_fit : RmsFit, optional
+        How the cycle was fitted within the RMS ratings (``cycle = "fit-rms"``).
     """
 
     moves: list[PlannedMove]
@@ -230,6 +232,7 @@ class ProgramResult:
     motors: MotorLimits | None
     rms_limit: tuple[float, float] | None = None
     move_types: tuple[str, ...] = ()
+    rms_fit: RmsFit | None = None
 
     def timeline(self) -> list[MoveTiming]:
         """Every move of the program in order, each move of a blended chain on its own."""
@@ -248,6 +251,42 @@ class ProgramResult:
 
 
 @dataclass(frozen=True)
+class RmsFit:
+    """A cycle planned within the motors' RMS ratings (``cycle = "fit-rms"``): the moves
+    planned within lower peak torques, ``peak_scale`` times the motors', the largest scale
+    (to ``1e-3`` of the cycle time) whose cycle keeps every motor's RMS torque over the
+    repeated cycle within its rating.
+
+    Attributes
+    ----------
+    peak_scale : float
+        1 when the motors' own peaks already keep the RMS within the ratings.
+    bound_by : str
+        What bounds the cycle: ``"peak torque"`` (scale 1) or ``"RMS rating of motor A"``
+        (or D).
+    rms_ratio : (float, float)
+        Each motor's RMS torque over its rating at the planned cycle.
+    plans : int
+        Programs planned by the search.
+    """
+
+    peak_scale: float
+    bound_by: str
+    rms_ratio: tuple[float, float]
+    plans: int
+
+    def as_dict(self) -> dict[str, object]:
+        """JSON-ready."""
+        return {"peak_scale": self.peak_scale, "bound_by": self.bound_by,
+                "rms_ratio": list(self.rms_ratio), "plans": self.plans}
+
+
+#: The cycles a program can be planned for: the moves' own laws, or the shortest cycle within
+#: the RMS ratings.
+CYCLES = ("as-planned", "fit-rms")
+
+
+@dataclass(frozen=True)
 class ProgramRequest:
     """Everything a program is planned from (SI; see :func:`plan_program`), as the config
     layer builds it once."""
@@ -263,14 +302,108 @@ class ProgramRequest:
     servo_rate_hz: float = 1000.0
     grid: int = 400
     tolerances: Tolerances = DEFAULT_TOLERANCES
+    cycle: str = "as-planned"
 
     def plan(self) -> ProgramResult:
-        """The program planned (:func:`plan_program`)."""
-        return plan_program(self.robot, self.inertia, self.moves, start=self.start,
-                            working_mode=self.working_mode, assembly=self.assembly,
-                            motors=self.motors, rms_limit=self.rms_limit,
-                            servo_rate_hz=self.servo_rate_hz, grid=self.grid,
-                            tolerances=self.tolerances)
+        """The program planned (:func:`plan_program`), or with ``cycle = "fit-rms"`` the
+        shortest cycle within the RMS ratings (:func:`fit_rms`)."""
+        if self.cycle == "fit-rms":
+            return fit_rms(self)
+        if self.cycle != "as-planned":
+            raise ParameterError(f"cycle {self.cycle!r} must be one of {', '.join(CYCLES)}")
+        return self.plan_with(self.motors)
+
+    def plan_with(self, motors: MotorLimits | None) -> ProgramResult:
+        """The program planned within ``motors`` (sized against this request's motors)."""
+        res = plan_program(self.robot, self.inertia, self.moves, start=self.start,
+                           working_mode=self.working_mode, assembly=self.assembly,
+                           motors=motors, rms_limit=self.rms_limit,
+                           servo_rate_hz=self.servo_rate_hz, grid=self.grid,
+                           tolerances=self.tolerances)
+        return res if motors is self.motors else replace(res, motors=self.motors)
+
+
+def rms_ratios(res: ProgramResult) -> tuple[float, float]:
+    """Each motor's RMS torque over the cycle (trapezoidal, over the setpoints' times) over
+    its rating."""
+    assert res.rms_limit is not None
+    t, tau = res.t, res.tau
+    dt = np.diff(t)
+    rms = np.sqrt(np.sum(0.5 * (tau[1:] ** 2 + tau[:-1] ** 2) * dt[:, None], axis=0)
+                  / max(float(t[-1]), 1e-300))
+    return float(rms[0] / res.rms_limit[0]), float(rms[1] / res.rms_limit[1])
+
+
+def fit_rms(req: ProgramRequest, *, rtol: float = 1e-3) -> ProgramResult:
+    """The shortest cycle whose RMS torques over the repeated cycle are within the ratings:
+    the moves planned within the motors' peak torques times a scale (the time-optimal and
+    fitted moves slow down with it), the largest scale in ``(0, 1]`` that keeps both RMS
+    ratios at most 1, by bisection on the scale until the cycle times of the bracket differ
+    by less than ``rtol``. The result's ``rms_fit`` says what bounds the cycle.
+
+    Raises
+    ------
+    ParameterError
+        No motors or no ratings, or no scale down to the torques that hold the robot keeps
+        the RMS within the ratings (named: the motor and its RMS at the lowest scale tried).
+    """
+    if req.motors is None or req.rms_limit is None:
+        raise ParameterError("cycle = \"fit-rms\" needs the motors' peak_torque and "
+                             "rms_torque")
+    base = req.motors
+    plans = 0
+
+    def plan(scale: float) -> ProgramResult:
+        nonlocal plans
+        plans += 1
+        if scale == 1.0:
+            return req.plan_with(base)
+        m = replace(base, peak_torque=(base.peak_torque[0] * scale,
+                                       base.peak_torque[1] * scale))
+        return req.plan_with(m)
+
+    full = plan(1.0)
+    r = rms_ratios(full)
+    if max(r) <= 1.0:
+        return replace(full, rms_fit=RmsFit(1.0, "peak torque", r, plans))
+    hi, res_hi = 1.0, full  # exceeds
+    lo, res_lo = 0.5, None
+    while res_lo is None:
+        try:
+            cand = plan(lo)
+        except DextarError as exc:
+            rr = rms_ratios(res_hi)
+            i = int(np.argmax(rr))
+            raise ParameterError(
+                f"no cycle keeps the RMS torques within the ratings: motor {'AD'[i]} has "
+                f"{rr[i] * req.rms_limit[i]:.4g} N m RMS against its rating "
+                f"{req.rms_limit[i]:.4g} N m with the peak torques scaled by {hi:.3g}, and "
+                f"scaled by {lo:.3g} the program cannot be planned ({exc})") from None
+        if max(rms_ratios(cand)) <= 1.0:
+            res_lo = cand
+            break
+        hi, res_hi = lo, cand
+        lo *= 0.5
+        if lo < 1e-3:
+            rr = rms_ratios(res_hi)
+            i = int(np.argmax(rr))
+            raise ParameterError(
+                f"no cycle keeps the RMS torques within the ratings: motor {'AD'[i]} still "
+                f"has {rr[i] * req.rms_limit[i]:.4g} N m RMS against its rating "
+                f"{req.rms_limit[i]:.4g} N m with the peak torques scaled by {2 * lo:.3g}")
+    for _ in range(40):
+        if res_lo.cycle_time_s - res_hi.cycle_time_s <= rtol * res_lo.cycle_time_s:
+            break
+        mid = 0.5 * (lo + hi)
+        cand = plan(mid)
+        if max(rms_ratios(cand)) <= 1.0:
+            lo, res_lo = mid, cand
+        else:
+            hi, res_hi = mid, cand
+    r = rms_ratios(res_lo)
+    return replace(res_lo, rms_fit=RmsFit(lo, f"RMS rating of motor {'AD'[int(np.argmax(r))]}",
+                                          r, plans))
+
 
 
 def move_name(index: int, mv: Move) -> str:

@@ -1,5 +1,6 @@
 """Motor sizing of a planned program: per motor the peak and RMS torque, the peak speed and
-power, the energy delivered, their ratios to the motors' limits, and the violations."""
+power, the energy delivered, the peak acceleration, jerk and torque rate (finite differences
+at the servo rate), their ratios to the motors' limits, and the violations."""
 
 from __future__ import annotations
 
@@ -13,6 +14,8 @@ from .plan import ProgramResult
 
 #: Relative excess over a limit that counts as a violation.
 SIZING_TOL = 1e-3
+#: ... for the rates measured by finite differences at the servo rate (jerk, torque rate).
+SIZING_TOL_RATES = {"jerk": 1e-2, "torque_rate": 1e-2}
 
 
 @dataclass(frozen=True)
@@ -30,6 +33,10 @@ class MotorSizing:
         (None without motors).
     rms_torque_ratio : float, optional
         Against the continuous rating (None without one).
+    peak_acceleration_rad_s2, peak_jerk_rad_s3, peak_torque_rate_Nm_s : float, optional
+        The jerk and the torque rate by finite differences of the setpoints at the servo rate.
+    peak_acceleration_ratio, peak_jerk_ratio, peak_torque_rate_ratio : float, optional
+        Against ``[motors]``' limits (None without one).
     """
 
     motor: str
@@ -41,6 +48,12 @@ class MotorSizing:
     peak_torque_ratio: float | None = None
     peak_speed_ratio: float | None = None
     rms_torque_ratio: float | None = None
+    peak_acceleration_rad_s2: float | None = None
+    peak_jerk_rad_s3: float | None = None
+    peak_torque_rate_Nm_s: float | None = None
+    peak_acceleration_ratio: float | None = None
+    peak_jerk_ratio: float | None = None
+    peak_torque_rate_ratio: float | None = None
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready, the ratios that do not apply left out."""
@@ -90,6 +103,14 @@ def sizing(res: ProgramResult) -> Sizing:
     t, tau, dq = res.t, res.tau, res.dq
     power = tau * dq
     dt = np.diff(t)
+    step = np.where(dt > 0, dt, np.inf)[:, None]
+    jerk = np.diff(res.ddq, axis=0) / step
+    rate = np.diff(tau, axis=0) / step
+    mo = res.motors
+    # the motion's rates are reported when the motors limit one of them (outputs without
+    # those limits stay as they were)
+    drive_limits = mo is not None and any(
+        v is not None for v in (mo.max_acceleration, mo.max_jerk, mo.max_torque_rate))
     motors_out: list[MotorSizing] = []
     violations: list[Violation] = []
     for i, name in enumerate(("A", "D")):
@@ -113,6 +134,20 @@ def sizing(res: ProgramResult) -> Sizing:
                 violations.append(Violation(name, "speed", float(abs(dq[k, i])),
                                             float(m.max_speed[i]), int(res.move_index[k]),
                                             float(t[k])))
+        motion = {"acceleration": np.abs(res.ddq[:, i]), "jerk": np.abs(jerk[:, i]),
+                  "torque_rate": np.abs(rate[:, i])}
+        if res.motors is not None:
+            m = res.motors
+            for key, lim in (("acceleration", m.max_acceleration), ("jerk", m.max_jerk),
+                             ("torque_rate", m.max_torque_rate)):
+                if lim is None:
+                    continue
+                v = motion[key]
+                k = int(np.argmax(v))
+                ratios[f"peak_{key}_ratio"] = float(v[k] / lim[i])
+                if v[k] > lim[i] * (1 + SIZING_TOL_RATES.get(key, SIZING_TOL)):
+                    violations.append(Violation(name, key, float(v[k]), float(lim[i]),
+                                                int(res.move_index[k]), float(t[k])))
         if res.rms_limit is not None:
             ratios["rms_torque_ratio"] = rms / res.rms_limit[i]
             if rms > res.rms_limit[i] * (1 + SIZING_TOL):
@@ -121,5 +156,10 @@ def sizing(res: ProgramResult) -> Sizing:
         motors_out.append(MotorSizing(
             name, float(np.abs(tau[:, i]).max()), rms, float(np.abs(dq[:, i]).max()),
             float(np.abs(power[:, i]).max()), float(np.sum(0.5 * (pos[1:] + pos[:-1]) * dt)),
+            **({} if not drive_limits else {
+                "peak_acceleration_rad_s2": float(motion["acceleration"].max()),
+                "peak_jerk_rad_s3": float(motion["jerk"].max()) if len(jerk) else 0.0,
+                "peak_torque_rate_Nm_s": float(motion["torque_rate"].max()) if len(rate)
+                else 0.0}),
             **ratios))
     return Sizing((motors_out[0], motors_out[1]), tuple(violations))

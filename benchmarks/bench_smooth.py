@@ -1,0 +1,97 @@
+"""The jerk-limited time-optimal law: against Ruckig on joint moves, its convergence to the
+second-order law as the jerk limit grows, and its planning time per pick-and-place move
+against today's (second-order) time-optimal law, in one process.
+
+Run: taskset -c 0 python benchmarks/bench_smooth.py   (ruckig: pip install -e '.[bench]')
+
+Floors: joint moves within 1 % of Ruckig's duration and never below; within 1 % of the
+second-order duration at 100 times the binding jerk; a pick-and-place move within 3x the
+second-order law's planning time (best of 5, spread shown).
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+
+from dextar.config import load_scenario
+from dextar.dynamics import Model, RobotAlongJointLine, RobotAlongPath
+from dextar.laws import solve_jerk_limited_law, solve_time_optimal_law
+from dextar.motors import MotorLimits
+from dextar.paths import Line
+from dextar.trajectory import JointLine
+
+EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "pick_place.toml"
+JOINT_MOVES = [((2.2, 0.9), (1.6, 0.5), (3.0, 2.5), (40.0, 30.0), (800.0, 600.0)),
+               ((2.2, 0.9), (1.2, 1.4), (3.0, 3.0), (20.0, 30.0), (100.0, 600.0)),
+               ((2.0, 0.7), (2.05, 0.72), (3.0, 3.0), (40.0, 40.0), (400.0, 400.0)),
+               ((1.0, 1.5), (2.5, 0.2), (2.0, 4.0), (10.0, 50.0), (200.0, 300.0))]
+
+
+def best(fn, repeat: int = 5) -> tuple[float, float, object]:
+    times, out = [], None
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        out = fn()
+        times.append(time.perf_counter() - t0)
+    return min(times), max(times), out
+
+
+def ruckig_duration(q0, q1, V, A, J) -> float:
+    import ruckig
+
+    inp = ruckig.InputParameter(2)
+    inp.current_position, inp.target_position = list(q0), list(q1)
+    inp.current_velocity = inp.current_acceleration = [0.0, 0.0]
+    inp.target_velocity = inp.target_acceleration = [0.0, 0.0]
+    inp.max_velocity, inp.max_acceleration, inp.max_jerk = list(V), list(A), list(J)
+    inp.synchronization = ruckig.Synchronization.Phase
+    traj = ruckig.Trajectory(2)
+    ruckig.Ruckig(2).calculate(inp, traj)
+    return float(traj.duration)
+
+
+def main() -> None:
+    sc = load_scenario(EXAMPLE)
+    m = sc.si_model
+    model = Model(m.robot, m.inertia, "up")
+    print("joint moves against Ruckig (phase-synchronised, rest to rest, same limits):")
+    for q0, q1, V, A, J in JOINT_MOVES:
+        law = solve_jerk_limited_law(RobotAlongJointLine(model, JointLine(q0, q1)),
+                                     motors=MotorLimits((50.0, 50.0), V, None, A, J))
+        try:
+            ref = ruckig_duration(q0, q1, V, A, J)
+        except ImportError:
+            print(f"  {q0} -> {q1}: ours {law.duration:.6f} s; ruckig not installed")
+            continue
+        print(f"  {q0} -> {q1}: ours {law.duration:.6f} s, Ruckig {ref:.6f} s, "
+              f"{law.duration / ref - 1:+.2e} relative ({law.solves} programmes)")
+    path = Line((-0.04, 0.09), (0.04, 0.12))
+    along = RobotAlongPath(model, path, "+-")
+    second = solve_time_optimal_law(along, torque_limit=(0.3, 0.3))
+    tr = along.samples(second, np.linspace(0, second.duration, 2001))
+    J0 = 4 * np.abs(tr.ddq).max() / second.duration
+    print(f"convergence on a torque-limited line (second-order {second.duration:.6f} s, "
+          f"binding jerk J0 = 4 a / T = {J0:.4g} rad/s^3):")
+    for k in (1, 3, 10, 30, 100, 300):
+        law = solve_jerk_limited_law(along, motors=MotorLimits((0.3, 0.3),
+                                                               max_jerk=(k * J0, k * J0)))
+        print(f"  {k:4d} J0: {law.duration:.6f} s, {law.duration / second.duration - 1:+.3%}")
+    print("planning time per pick-and-place move (the law alone, best of 5 [worst]):")
+    limits = sc.si_motors
+    assert limits is not None
+    jerky = MotorLimits(limits.peak_torque, limits.max_speed, limits.knee_speed,
+                        (60.0, 60.0), (3000.0, 3000.0))
+    for a, b in (((-0.04, 0.11), (-0.04, 0.09)), ((0.04, 0.09), (0.04, 0.11))):
+        mv = RobotAlongPath(sc.si_model, Line(a, b), sc.mode)
+        t2, w2, l2 = best(lambda mv=mv: solve_time_optimal_law(mv, motors=limits, grid=400))
+        t3, w3, l3 = best(lambda mv=mv: solve_jerk_limited_law(mv, motors=jerky, grid=400))
+        print(f"  line {a} -> {b} mm*1e-3: second order {t2 * 1e3:.1f} ms [{w2 * 1e3:.1f}] "
+              f"({l2.duration:.4f} s), jerk-limited {t3 * 1e3:.1f} ms [{w3 * 1e3:.1f}] "
+              f"({l3.duration:.4f} s, {l3.solves} programmes): {t3 / t2:.1f}x (floor 3x)")
+
+
+if __name__ == "__main__":
+    main()

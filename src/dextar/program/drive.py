@@ -1,0 +1,191 @@
+"""A program in the drives' own units: the motor side of a gearbox, encoder counts and the
+torque feedforward in per-mille of the rated torque (CiA 402), per servo tick (cyclic
+synchronous position, ``csp.csv``) and as position-velocity-time points at a coarser period
+whose cubic interpolation follows the planned motion (``pvt.csv``).
+
+Conventions: motor at A first; ``counts = (q - encoder_offset) * gear_ratio * encoder_counts /
+(2 pi)`` (from the encoders' zero, ``encoder_offset`` the joint angle at which an encoder
+reads zero), the motor-side speed ``gear_ratio * qdot`` and torque ``tau / gear_ratio`` (an
+ideal gearbox: no loss), the torque feedforward ``round(1000 tau_motor / rated_torque)``
+(object 0x60B2, torque offset, in per-mille of the rated torque 0x6076).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._arrays import Array
+from ..errors import ParameterError
+from .plan import ProgramResult
+
+
+@dataclass(frozen=True)
+class DriveUnits:
+    """The drives (SI).
+
+    Attributes
+    ----------
+    gear_ratio : (float, float)
+        Motor turns per joint turn.
+    encoder_counts : (int, int)
+        Counts per motor turn.
+    rated_torque : (float, float), optional
+        Motor-side rated torque (N m); the torque feedforward needs it.
+    encoder_offset : (float, float)
+        The joint angle (rad) at which each encoder reads zero.
+    pvt_period : float
+        The period of the PVT points (s).
+    """
+
+    gear_ratio: tuple[float, float] = (1.0, 1.0)
+    encoder_counts: tuple[int, int] = (4096, 4096)
+    rated_torque: tuple[float, float] | None = None
+    encoder_offset: tuple[float, float] = (0.0, 0.0)
+    pvt_period: float = 0.01
+
+    def __post_init__(self) -> None:
+        for name in ("gear_ratio", "encoder_counts"):
+            v = np.asarray(getattr(self, name), float)
+            if v.shape != (2,) or not np.all(np.isfinite(v) & (v > 0)):
+                raise ParameterError(f"{name.replace('_', ' ')} {getattr(self, name)!r} must "
+                                     "be two positive numbers")
+        if self.rated_torque is not None:
+            v = np.asarray(self.rated_torque, float)
+            if v.shape != (2,) or not np.all(np.isfinite(v) & (v > 0)):
+                raise ParameterError(f"rated torque {self.rated_torque!r} must be two positive "
+                                     "numbers")
+        if not (math.isfinite(self.pvt_period) and self.pvt_period > 0):
+            raise ParameterError(f"PVT period {self.pvt_period!r} must be positive")
+
+    @property
+    def counts_per_rad(self) -> Array:
+        """Encoder counts per joint radian (2,)."""
+        return np.asarray(np.asarray(self.gear_ratio, float)
+                          * np.asarray(self.encoder_counts, float) / (2 * np.pi))
+
+    def counts(self, q: Array) -> Array:
+        """Joint angles (n, 2) to encoder counts from the encoders' zero (unrounded)."""
+        return np.asarray((q - np.asarray(self.encoder_offset, float)) * self.counts_per_rad)
+
+    def angles(self, counts: Array) -> Array:
+        """Encoder counts (n, 2) back to joint angles (rad)."""
+        return np.asarray(np.asarray(counts, float) / self.counts_per_rad
+                          + np.asarray(self.encoder_offset, float))
+
+    def motor_torque(self, tau: Array) -> Array:
+        """Joint torques (n, 2) to motor-side torques (N m)."""
+        return np.asarray(tau / np.asarray(self.gear_ratio, float))
+
+    def permille(self, tau: Array) -> Array:
+        """Joint torques (n, 2) to the torque feedforward in per-mille of the rated torque
+        (rounded); needs the rated torque."""
+        if self.rated_torque is None:
+            raise ParameterError("the torque feedforward needs [drive].rated_torque_Nm")
+        return np.asarray(np.round(1000.0 * self.motor_torque(tau)
+                                   / np.asarray(self.rated_torque, float)))
+
+
+def csp_columns(res: ProgramResult, drive: DriveUnits) -> dict[str, Array]:
+    """``csp.csv``: per servo tick the target positions (counts, rounded), the velocities
+    (counts/s) and the torque feedforward (per-mille of the rated torque, rounded; columns
+    left out without a rated torque)."""
+    pos = np.round(drive.counts(res.q))
+    vel = res.dq * drive.counts_per_rad
+    out = {"t_s": res.t, "pos1_counts": pos[:, 0], "pos2_counts": pos[:, 1],
+           "vel1_counts_s": vel[:, 0], "vel2_counts_s": vel[:, 1]}
+    if drive.rated_torque is not None:
+        pm = drive.permille(res.tau)
+        out |= {"torque1_permille": pm[:, 0], "torque2_permille": pm[:, 1]}
+    return out
+
+
+@dataclass(frozen=True)
+class PvtPoints:
+    """Position-velocity-time points and how closely their cubic follows the plan.
+
+    Attributes
+    ----------
+    t : ndarray, shape (m,)
+        Every ``pvt_period`` (at the servo tick nearest each multiple) and the last tick.
+    pos, vel : ndarray, shape (m, 2)
+        Counts (rounded) and counts/s.
+    max_error_counts : float
+        Largest distance, in counts, between the cubic Hermite interpolation of the points
+        and the planned motion at every servo tick.
+    """
+
+    t: Array
+    pos: Array
+    vel: Array
+    max_error_counts: float
+
+    def columns(self) -> dict[str, Array]:
+        """``pvt.csv``."""
+        return {"t_s": self.t, "pos1_counts": self.pos[:, 0], "pos2_counts": self.pos[:, 1],
+                "vel1_counts_s": self.vel[:, 0], "vel2_counts_s": self.vel[:, 1]}
+
+
+def hermite(t: Array, tk: Array, pk: Array, vk: Array) -> Array:
+    """The cubic Hermite interpolation of points ``(tk, pk, vk)`` (m,), (m, 2) at ``t`` (n,),
+    (n, 2): what a drive's PVT mode runs between its points."""
+    k = np.clip(np.searchsorted(tk, t, side="right") - 1, 0, len(tk) - 2)
+    h = (tk[k + 1] - tk[k])[:, None]
+    u = ((t - tk[k])[:, None]) / h
+    h00, h10 = 2 * u**3 - 3 * u**2 + 1, u**3 - 2 * u**2 + u
+    h01, h11 = -2 * u**3 + 3 * u**2, u**3 - u**2
+    return np.asarray(h00 * pk[k] + h10 * h * vk[k] + h01 * pk[k + 1] + h11 * h * vk[k + 1])
+
+
+def pvt_points(res: ProgramResult, drive: DriveUnits) -> PvtPoints:
+    """The PVT points every ``drive.pvt_period`` from the setpoints, and the largest error of
+    their cubic against the planned motion (in counts, over every servo tick)."""
+    t = res.t
+    rate = 1.0 / float(np.median(np.diff(t))) if len(t) > 1 else 1.0
+    step = max(1, int(round(drive.pvt_period * rate)))
+    idx = np.arange(0, len(t), step)
+    if idx[-1] != len(t) - 1:
+        idx = np.append(idx, len(t) - 1)
+    pos = np.round(drive.counts(res.q[idx]))
+    vel = res.dq[idx] * drive.counts_per_rad
+    planned = drive.counts(res.q)
+    err = float(np.abs(hermite(t, t[idx], pos, vel) - planned).max()) if len(idx) > 1 else 0.0
+    return PvtPoints(t[idx], pos, vel, err)
+
+
+def drive_report(res: ProgramResult, drive: DriveUnits, rotor_inertia: tuple[float, float]
+                 ) -> dict[str, object]:
+    """The motor side of the program: per motor the peak speed (rpm) and the peak and RMS
+    torques (N m, and against the rated torque), and the reflected rotor inertia's share of
+    the torques (its RMS torque ``I_r qddot`` over the RMS torque; ``rotor_inertia`` the
+    joint-side rotor inertias, kg m^2, as the model has them)."""
+    g = np.asarray(drive.gear_ratio, float)
+    w = np.abs(res.dq).max(axis=0) * g * 60.0 / (2 * np.pi)
+    tm = drive.motor_torque(res.tau)
+    t = res.t
+    dt = np.diff(t)
+
+    def rms(x: Array) -> Array:
+        return np.asarray(np.sqrt(np.sum(0.5 * (x[1:] ** 2 + x[:-1] ** 2) * dt[:, None], axis=0)
+                                  / max(float(t[-1]), 1e-300)))
+
+    rotor = res.ddq * np.asarray(rotor_inertia, float)
+    share = rms(rotor) / np.maximum(rms(res.tau), 1e-300)
+    motors = []
+    for i, name in enumerate(("A", "D")):
+        m: dict[str, object] = {
+            "motor": name, "peak_speed_rpm": float(w[i]),
+            "peak_torque_Nm": float(np.abs(tm[:, i]).max()),
+            "rms_torque_Nm": float(rms(tm)[i]),
+            "reflected_rotor_inertia_kg_m2": float(rotor_inertia[i]),
+            "motor_rotor_inertia_kg_m2": float(rotor_inertia[i] / g[i] ** 2),
+            "rotor_torque_share_rms": float(share[i])}
+        if drive.rated_torque is not None:
+            m["peak_torque_permille"] = float(1000 * np.abs(tm[:, i]).max()
+                                              / drive.rated_torque[i])
+        motors.append(m)
+    return {"gear_ratio": list(drive.gear_ratio), "encoder_counts": list(drive.encoder_counts),
+            "encoder_offset_deg": [math.degrees(v) for v in drive.encoder_offset],
+            "pvt_period_s": drive.pvt_period, "motors": motors}
