@@ -28,7 +28,8 @@ def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
     sc = load_scenario(args.config)
     res = sc.program_request().plan()
     summary = ProgramSummary(args.config, res.cycle_time_s, sc.output.servo_rate_hz,
-                             tuple(res.timeline()), sizing(res))
+                             tuple(res.timeline()), sizing(res),
+                             sc.robot_table.encoder_offset_deg)
     write_program(args.out, res, summary, sc.robot_mm, sc.program_mode, force=args.force,
                   with_figures=figures)
     warnings = [f"dextar program: {v.text()}" for v in summary.sizing.violations]
