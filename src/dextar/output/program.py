@@ -30,7 +30,7 @@ PROGRAM_FILES = ("setpoints.csv", "summary.json", "report.html",
 #: What the units of a program's outputs are.
 UNITS = "SI: s, rad, N m, W, J; positions in mm in setpoints.csv"
 #: What the joint angles of ``setpoints.csv`` are.
-ANGLES = ("phi_rad, psi_rad and their rates in setpoints.csv are encoder readings: geometric "
+ANGLES = ("phi_rad, psi_rad in setpoints.csv are encoder readings: geometric "
           "angle - [robot].encoder_offset_deg")
 
 
