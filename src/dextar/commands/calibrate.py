@@ -35,7 +35,7 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
     sp.add_argument("--robust", metavar="LOSS", default=None,
                     help="robust loss: soft_l1, huber, cauchy or arctan (outliers rejected "
                     "and listed)")
-    sp.add_argument("--outlier-factor", type=float, default=None,
+    sp.add_argument("--outlier-factor", type=float, default=None, metavar="F",
                     help="a row farther from its prediction than this many residual scales "
                     "is an outlier (default 5)")
     into_directory(sp)
@@ -51,7 +51,12 @@ def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
     from ..calibration.data import rows_text
     from ..calibration.fit import OUTLIER_FACTOR, encoder_std
     from ..config import load_scenario
-    from ..output.calibration import CALIBRATION_FILES, STATUS_WORDS, calibration_files
+    from ..output.calibration import (
+        CALIBRATION_FILES,
+        OUTLIERS,
+        STATUS_WORDS,
+        calibration_files,
+    )
     from ..output.files import OutputDir
 
     od = OutputDir(args.out, force=args.force, produces=CALIBRATION_FILES)  # checked now
@@ -92,7 +97,7 @@ def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
                 od.write_text(name, content)
     written = [n for n in CALIBRATION_FILES if n in files]
     e = res.errors
-    lines = [f"{STATUS_WORDS[3]}: {problem}" if outliers else res.message,
+    lines = [f"{STATUS_WORDS[OUTLIERS]}: {problem}" if outliers else res.message,
              f"  {len(e.rows)} poses: RMS error {1e3 * e.rms_before:.4g} -> "
              f"{1e3 * e.rms_after:.4g} mm, max {1e3 * e.max_before:.4g} -> "
              f"{1e3 * e.max_after:.4g} mm (nominal robot -> calibrated)"]
