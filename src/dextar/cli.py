@@ -144,7 +144,8 @@ def _terminate_as_interrupt() -> None:
 def _protect_negatives(argv: list[str]) -> list[str]:
     """Let values that look like options through argparse: ``dextar ik -10 120`` (a negative
     number gets a leading space, which argparse reads as a value) and the working modes
-    ``--mode --``, ``--mode=-+`` (rewritten to their aliases: argparse would drop ``--``)."""
+    ``--mode --``, ``--mode=-+`` (rewritten to their aliases: argparse would drop ``--``),
+    ``--modes --,-+`` (joined as ``--modes=--,-+``)."""
     out: list[str] = []
     for a in argv:
         if a.startswith("--mode=") and a[7:] in _ALIAS_OF:
@@ -152,6 +153,9 @@ def _protect_negatives(argv: list[str]) -> list[str]:
             continue
         if out and out[-1] == "--mode" and a in _ALIAS_OF:
             out[-1] = "--mode=" + _ALIAS_OF[a]
+            continue
+        if out and out[-1] == "--modes" and a.startswith("-"):  # --modes --,+-
+            out[-1] = "--modes=" + a
             continue
         try:
             float(a)

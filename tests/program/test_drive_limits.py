@@ -15,7 +15,9 @@ from .test_program import EXAMPLES
 
 LIMITS = "max_acceleration = 60.0\nmax_jerk = 3000.0\n"
 DRIVE = ('[drive]\ngear_ratio = 353.5\nencoder_counts = 4096\nrated_torque_Nm = 0.0115\n'
-         'encoder_offset_deg = [90.0, 0.0]\npvt_period_ms = 10\n')
+         'pvt_period_ms = 10\n')
+#: The encoders' zeros (the joint angles at which they read 0), as calibration writes them.
+OFFSET = 'encoder_offset_deg = [90.0, 0.0]\n'
 
 
 def columns(path):
@@ -28,6 +30,8 @@ def columns(path):
 def task(extra_motors="", tables="", program="", moves=None):
     text = (EXAMPLES / "pick_place.toml").read_text()
     text = text.replace("knee_speed_rpm = 1 ", extra_motors + "knee_speed_rpm = 1 ")
+    if "[drive]" in tables:
+        text = text.replace('working_mode = "+-"\n', 'working_mode = "+-"\n' + OFFSET, 1)
     head, sep, rest = text.partition("[[move]]")
     if moves is not None:
         rest = moves
@@ -92,8 +96,10 @@ def test_csp_and_pvt_reconstruct_the_setpoints(smooth):
     sp, csp, pvt = (columns(smooth / f"{n}.csv") for n in ("setpoints", "csp", "pvt"))
     s = json.loads((smooth / "summary.json").read_text())
     per_rad = 353.5 * 4096 / (2 * np.pi)
-    offset = np.radians([90.0, 0.0])
+    # the setpoints' angles are encoder readings (geometric angle - [robot].encoder_offset_deg)
     q = np.stack([sp["phi_rad"], sp["psi_rad"]], -1)
+    assert s["encoder_offset_deg"] == [90.0, 0.0]
+    offset = 0.0
     counts = np.stack([csp["pos1_counts"], csp["pos2_counts"]], -1)
     assert np.all(counts == np.round(counts))
     # counts back to radians within one count

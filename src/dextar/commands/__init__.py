@@ -6,4 +6,4 @@ name in :data:`COMMANDS`.
 
 #: The command modules, in the order ``dextar --help`` lists them.
 COMMANDS = ("ik", "fk", "workspace", "plan", "torques", "simulate", "export", "program",
-            "excite", "identify", "design", "run")
+            "excite", "identify", "poses", "calibrate", "design", "run")

@@ -3,6 +3,10 @@
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from ..config.tables import InstrumentTable
 
 MODE_HELP = "working mode: ++, +-, -+ or -- (aliases pp, pm, mp, mm)"
 
@@ -26,3 +30,21 @@ def mode_argument(sp: argparse.ArgumentParser) -> None:
 def robot_argument(sp: argparse.ArgumentParser) -> None:
     """``--robot FILE.toml``: the robot of a config file."""
     sp.add_argument("--robot", metavar="FILE.toml", help="TOML file with a [robot] table")
+
+
+def frame_argument(sp: argparse.ArgumentParser, what: str) -> None:
+    """``--frame robot|instrument``: the robot frame (default) or the measuring instrument's
+    (``[instrument]`` of ``--robot``)."""
+    sp.add_argument("--frame", choices=["robot", "instrument"], default="robot",
+                    help=f"{what}: the robot frame (default) or the measuring instrument's "
+                    "([instrument] of --robot)")
+
+
+def instrument_of(table: InstrumentTable | None, path: str | None) -> InstrumentTable:
+    """The ``[instrument]`` table, or a one-line error when the file has none."""
+    from ..errors import ConfigError
+
+    if table is None:
+        raise ConfigError("--frame instrument needs an [instrument] table in --robot FILE.toml"
+                          + ("" if path is None else f" ({path} has none)"))
+    return table

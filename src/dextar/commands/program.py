@@ -35,7 +35,8 @@ def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
         report = {**drive_report(res, drive, sc.si_model.inertia.rotor),
                   "pvt_max_error_counts": pvt.max_error_counts}
     summary = ProgramSummary(args.config, res.cycle_time_s, sc.output.servo_rate_hz,
-                             tuple(res.timeline()), sizing(res), res.rms_fit, report)
+                             tuple(res.timeline()), sizing(res), res.rms_fit, report,
+                             sc.robot_table.encoder_offset_deg)
     write_program(args.out, res, summary, sc.robot_mm, sc.program_mode, force=args.force,
                   with_figures=figures, drive=drive, pvt=pvt)
     warnings = [f"dextar program: {v.text()}" for v in summary.sizing.violations]

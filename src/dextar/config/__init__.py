@@ -7,6 +7,8 @@ and one :func:`register_table` line.
 from .scenario import (
     Scenario,
     default_scenario,
+    kinematic_model,
+    load_kinematics,
     load_robot_table,
     load_scenario,
     scenario_from_dict,
@@ -18,6 +20,7 @@ from .tables import (
     FrictionTable,
     GravityTable,
     InertiaTable,
+    InstrumentTable,
     LawTable,
     MotorsTable,
     OutputTable,
@@ -31,7 +34,8 @@ from .tables import (
 from .toml import check_tables, load_toml
 
 __all__ = ["FIGURES", "TABLES", "ControlTable", "FrictionTable", "GravityTable",
-           "InertiaTable", "LawTable", "MotorsTable", "OutputTable", "PaperTable", "PathTable", "RobotTable",
-           "Scenario", "Table", "TolerancesTable", "check_tables", "default_scenario",
-           "load_robot_table",
-           "load_scenario", "load_toml", "register_table", "scenario_from_dict"]
+           "InertiaTable", "InstrumentTable", "LawTable", "MotorsTable", "OutputTable",
+           "PaperTable", "PathTable", "RobotTable", "Scenario", "Table", "TolerancesTable",
+           "check_tables", "default_scenario", "kinematic_model", "load_kinematics",
+           "load_robot_table", "load_scenario", "load_toml", "register_table",
+           "scenario_from_dict"]

@@ -4,8 +4,9 @@ key checked against the move type's declaration and named as ``[[move]] 2 (arc).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, ClassVar
 
 from ..errors import ConfigError, DextarError
@@ -62,13 +63,24 @@ register_table(ProgramTable)
 BLEND_PARAM = Param("number", "", None, "corner blend radius, mm", minimum=0.0)
 
 
-def read_moves(raw: object, program: ProgramTable) -> list[Move]:
-    """The ``[[move]]`` tables as moves (SI), in order; errors name the move and the key."""
+def read_moves(raw: object, program: ProgramTable,
+               encoder_offset_deg: tuple[float, float] = (0.0, 0.0)) -> list[Move]:
+    """The ``[[move]]`` tables as moves (SI), in order; errors name the move and the key.
+
+    A task file speaks encoder readings: a joint move's ``to_deg`` becomes the geometric
+    angles ``to_q = reading + offset`` (rad) of the domain, ``encoder_offset_deg`` the
+    ``[robot]`` offsets."""
     if raw is None:
         return []
     if not isinstance(raw, list) or not all(isinstance(m, dict) for m in raw):
         raise ConfigError("config key 'move' must be an array of tables [[move]]")
-    return [_read_move(i, m, program) for i, m in enumerate(raw)]
+    moves = [_read_move(i, m, program) for i, m in enumerate(raw)]
+    if encoder_offset_deg != (0.0, 0.0):
+        off = tuple(math.radians(v) for v in encoder_offset_deg)
+        moves = [replace(m, values={**m.values, "to_q": (m.values["to_q"][0] + off[0],
+                                                          m.values["to_q"][1] + off[1])})
+                 if m.values.get("to_q") is not None else m for m in moves]
+    return moves
 
 
 def _move_kind(label: str, raw: Mapping[str, Any]) -> MoveType:

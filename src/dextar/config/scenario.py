@@ -29,6 +29,7 @@ from .design import DesignTable
 from .program import ProgramTable, read_moves
 
 if TYPE_CHECKING:
+    from ..calibration import KinematicModel
     from ..design.evaluate import Task
     from ..design.space import DesignSpace
     from ..program.drive import DriveUnits
@@ -39,6 +40,7 @@ from .tables import (
     FrictionTable,
     GravityTable,
     InertiaTable,
+    InstrumentTable,
     LawTable,
     MotorsTable,
     OutputTable,
@@ -140,13 +142,12 @@ class Scenario:
 
         from ..program.drive import DriveUnits
 
-        t = self.drive_table
+        t, off = self.drive_table, self.robot_table.encoder_offset_deg
         if not t.given:
             return None
         try:
             return DriveUnits(t.gear_ratio, (int(t.encoder_counts[0]), int(t.encoder_counts[1])),
-                              t.rated_torque_Nm, (math.radians(t.encoder_offset_deg[0]),
-                                                  math.radians(t.encoder_offset_deg[1])),
+                              t.rated_torque_Nm, (math.radians(off[0]), math.radians(off[1])),
                               t.pvt_period_ms * 1e-3)
         except DextarError as exc:
             raise ConfigError(f"config table [drive]: {exc}") from None
@@ -185,6 +186,17 @@ class Scenario:
             raise ConfigError(f"--units {system!r} must be si or paper")
         tables = {**self.tables, "output": replace(self.output, units=system)}
         return Scenario(tables, self.source, self.moves, self.doc, self.text)
+
+    @property
+    def instrument_table(self) -> InstrumentTable:
+        """``[instrument]`` (the measuring instrument's frame and noise)."""
+        return self._get(InstrumentTable)
+
+    @property
+    def kinematic_model(self) -> KinematicModel:
+        """The robot (SI), its encoder offsets (``[robot].encoder_offset_deg``) and the
+        instrument frame (``[instrument]``) as a calibration model."""
+        return kinematic_model(self.robot_table, self.instrument_table)
 
     def raw(self, *names: str) -> dict[str, Mapping[str, Any]]:
         """The tables ``names`` as the file writes them (those it has)."""
@@ -358,8 +370,11 @@ def scenario_from_dict(doc: Mapping[str, Any], *, source: str | None = None,
     program = tables["program"]
     if not isinstance(program, ProgramTable):
         raise TypeError("table [program] is not a ProgramTable")
-    sc = Scenario(tables, moves=tuple(read_moves(doc.get("move"), program)), doc=dict(doc),
-                  text=text)
+    robot = tables["robot"]
+    if not isinstance(robot, RobotTable):
+        raise TypeError("table [robot] is not a RobotTable")
+    moves = read_moves(doc.get("move"), program, robot.encoder_offset_deg)
+    sc = Scenario(tables, moves=tuple(moves), doc=dict(doc), text=text)
     if source is not None:
         sc = Scenario(sc.tables, source, sc.moves, sc.doc, text)
     try:  # build the run's objects now: a bad value fails here, named by its table
@@ -403,11 +418,31 @@ def load_scenario(path: str | FilePath | None = None, *,
 def load_robot_table(path: str | FilePath | None) -> RobotTable:
     """``[robot]`` of a config file (every table's name checked; the DexTAR without a
     file)."""
+    return load_kinematics(path)[0]
+
+
+def load_kinematics(path: str | FilePath | None
+                    ) -> tuple[RobotTable, InstrumentTable | None]:
+    """``[robot]`` and ``[instrument]`` (None when the file has none) of a config file, the
+    file read once, every table's name checked; the DexTAR without a file."""
     if path is None:
-        return RobotTable()
+        return RobotTable(), None
     doc, _ = read_config(path)
     check_tables({k: v for k, v in doc.items() if k != "move"}, set(TABLES) | {"move"})
-    return RobotTable.from_toml(doc.get("robot", {}))
+    inst = doc.get("instrument")
+    return (RobotTable.from_toml(doc.get("robot", {})),
+            None if inst is None else InstrumentTable.from_toml(inst))
+
+
+def kinematic_model(robot: RobotTable, instrument: InstrumentTable | None = None
+                    ) -> KinematicModel:
+    """The calibration model (SI) of config tables: the geometry, the encoder offsets and
+    the instrument frame."""
+    from ..calibration import KinematicModel
+
+    return KinematicModel.from_config_units(
+        robot.geometry_mm, encoder_offset_deg=robot.encoder_offset_deg,
+        instrument=(instrument or InstrumentTable()).frame)
 
 
 def default_scenario() -> Scenario:

@@ -67,15 +67,28 @@ class RobotTable(Table):
            for k in ("l1", "l2", "L1", "L2", "d")},
         "working_mode": Param("text", "", "+-", "++, +-, -+ or -- (aliases pp, pm, mp, mm)"),
         "assembly_mode": Param("choice", "", "up", "up or down", choices=("up", "down")),
+        "encoder_offset_deg": Param("pair", "deg", (0.0, 0.0), "encoder offsets [phi, psi]: "
+                                    "geometric angle = reading + offset", minimum=-180.0,
+                                    maximum=180.0),
+        "encoder_counts": Param("number", "", None, "encoder counts per turn of a joint",
+                                positive=True, maximum=1e12),
     }
 
     geometry_mm: FiveBar = DEXTAR_MM
     working_mode: str = "+-"
     assembly_mode: str = "up"
+    #: ``(phi, psi)`` offsets in degrees: geometric angle = encoder reading + offset.
+    encoder_offset_deg: tuple[float, float] = (0.0, 0.0)
+    encoder_counts: float | None = None
 
     @classmethod
     def from_toml(cls, raw: Mapping[str, object]) -> RobotTable:
-        """Read ``[robot]``: without a preset, all five lengths are required."""
+        """Read ``[robot]``: without a preset, all five lengths are required;
+        ``encoder_offset_deg`` is a pair ``[phi, psi]`` (degrees)."""
+        off = raw.get("encoder_offset_deg")
+        if off is not None and not (isinstance(off, list) and len(off) == 2):
+            raise ConfigError("config key [robot].encoder_offset_deg must be a pair [phi, psi] "
+                              f"in degrees, got {type(off).__name__} {off!r}")
         t = read_params(cls.NAME, raw, cls.PARAMS)
         lengths: dict[str, float] = {k: t[k] for k in ("l1", "l2", "L1", "L2", "d") if k in t}
         try:
@@ -96,7 +109,55 @@ class RobotTable(Table):
             raise
         except DextarError as exc:
             raise ConfigError(f"config table [robot]: {exc}") from None
-        return cls(geom, mode, t["assembly_mode"])
+        return cls(geom, mode, t["assembly_mode"], t["encoder_offset_deg"],
+                   t.get("encoder_counts"))
+
+    def geometric_deg(self, readings_deg: tuple[float, float]) -> tuple[float, float]:
+        """Geometric angles (deg) of encoder readings (deg): reading + offset."""
+        a, b = self.encoder_offset_deg
+        return (readings_deg[0] + a, readings_deg[1] + b)
+
+
+@dataclass(frozen=True)
+class InstrumentTable(Table):
+    """``[instrument]``: the measuring instrument (a laser tracker, a camera, a CMM) that
+    sees the robot: the pose of the robot frame in the instrument's frame (a point ``P`` of
+    the robot frame is measured at ``R(theta0) P + (x0, y0)``) and the instrument's noise.
+    It converts measured points only; every command works in the robot frame."""
+
+    NAME: ClassVar[str] = "instrument"
+    PARAMS: ClassVar[dict[str, Param]] = {
+        "x0_mm": Param("number", "mm", 0.0, "origin of the robot frame, instrument x",
+                       minimum=-1e6, maximum=1e6),
+        "y0_mm": Param("number", "mm", 0.0, "origin of the robot frame, instrument y",
+                       minimum=-1e6, maximum=1e6),
+        "theta0_deg": Param("number", "deg", 0.0, "angle of the robot frame's x axis in the "
+                            "instrument's frame", minimum=-360.0, maximum=360.0),
+        "sigma_mm": Param("number", "mm", None, "standard deviation of a measured point per "
+                          "axis (rows without sigma_mm)", positive=True, maximum=1e3),
+    }
+
+    x0_mm: float = 0.0
+    y0_mm: float = 0.0
+    theta0_deg: float = 0.0
+    sigma_mm: float | None = None
+
+    @property
+    def frame(self) -> tuple[float, float, float]:
+        """``(x0_mm, y0_mm, theta0_deg)``."""
+        return (self.x0_mm, self.y0_mm, self.theta0_deg)
+
+    def to_robot_mm(self, point_mm: tuple[float, float]) -> tuple[float, float]:
+        """A point measured in the instrument's frame (mm) in the robot frame (mm)."""
+        c, s = math.cos(math.radians(self.theta0_deg)), math.sin(math.radians(self.theta0_deg))
+        x, y = point_mm[0] - self.x0_mm, point_mm[1] - self.y0_mm
+        return (c * x + s * y, -s * x + c * y)
+
+    def to_instrument_mm(self, point_mm: tuple[float, float]) -> tuple[float, float]:
+        """A point of the robot frame (mm) in the instrument's frame (mm)."""
+        c, s = math.cos(math.radians(self.theta0_deg)), math.sin(math.radians(self.theta0_deg))
+        x, y = point_mm
+        return (c * x - s * y + self.x0_mm, s * x + c * y + self.y0_mm)
 
 
 @dataclass(frozen=True)
@@ -476,9 +537,9 @@ class DriveTable(Table):
     """``[drive]`` (optional): the drives behind the joints (motor at A first; a number means
     both): the gearbox, the encoders, the rated torque (for the torque feedforward in
     per-mille, CiA 402) and the period of the PVT points. With it ``dextar program`` also
-    writes ``csp.csv`` and ``pvt.csv``. ``encoder_offset_deg`` is the joint angle at which
-    each encoder reads zero (the calibration's ``[robot].encoder_offset_deg``, on another
-    branch, is the same angle, identified: when both exist they must agree)."""
+    writes ``csp.csv`` and ``pvt.csv``, whose counts start at the encoders' zero: the joint
+    angle ``[robot].encoder_offset_deg`` (which ``dextar calibrate`` identifies; one key for
+    one angle)."""
 
     NAME: ClassVar[str] = "drive"
     PARAMS: ClassVar[dict[str, Param]] = {
@@ -486,7 +547,6 @@ class DriveTable(Table):
         "encoder_counts": _pair("", "counts per motor turn", 4096.0, positive=True),
         "rated_torque_Nm": _pair("", "motor-side rated torque, N m (0x6076)", None,
                                  positive=True),
-        "encoder_offset_deg": _pair("", "joint angle at each encoder's zero, deg", 0.0),
         "pvt_period_ms": Param("number", "", 10.0, "period of the PVT points, ms",
                                positive=True, maximum=1000.0),
     }
@@ -494,13 +554,16 @@ class DriveTable(Table):
     gear_ratio: tuple[float, float] = (1.0, 1.0)
     encoder_counts: tuple[float, float] = (4096.0, 4096.0)
     rated_torque_Nm: tuple[float, float] | None = None
-    encoder_offset_deg: tuple[float, float] = (0.0, 0.0)
     pvt_period_ms: float = 10.0
     given: bool = False
 
     @classmethod
     def from_toml(cls, raw: Mapping[str, object]) -> DriveTable:
         """Read ``[drive]``; encoder counts are whole numbers."""
+        if "encoder_offset_deg" in raw:
+            raise ConfigError("config key [drive].encoder_offset_deg is not known: the "
+                              "encoders' offsets are [robot].encoder_offset_deg (the joint "
+                              "angle at each encoder's zero, as dextar calibrate writes it)")
         t = cls(**read_params(cls.NAME, raw, cls.PARAMS), given=bool(raw))
         if any(c != int(c) for c in t.encoder_counts):
             raise ConfigError(f"config key [drive].encoder_counts {list(t.encoder_counts)} "
@@ -509,5 +572,6 @@ class DriveTable(Table):
 
 
 for _cls in (RobotTable, PathTable, LawTable, InertiaTable, FrictionTable, GravityTable,
-             ControlTable, PaperTable, OutputTable, TolerancesTable, MotorsTable, DriveTable):
+             ControlTable, PaperTable, OutputTable, TolerancesTable, MotorsTable, DriveTable,
+             InstrumentTable):
     register_table(_cls)

@@ -25,7 +25,13 @@ from .html_page import figures, page
 
 #: Colour of each working mode in the figures.
 MODE_COLOURS = {"++": "tab:blue", "+-": "tab:orange", "-+": "tab:green", "--": "tab:red"}
-STATUS_WORDS = {0: "calibrated", 1: "not converged", 2: "residuals above the stated noise"}
+STATUS_WORDS = {0: "calibrated", 1: "not converged", 2: "residuals above the stated noise",
+                3: "outliers"}
+#: The status code of a fit whose data hold outliers (no calibrated config is written).
+OUTLIERS = 3
+#: Every file of ``dextar calibrate``.
+CALIBRATION_FILES = ("calibrated.toml", "parameters.csv", "summary.json", "residuals.png",
+                     "accuracy.png", "report.html")
 
 
 # ---------------------------------------------------------------------------------- poses
@@ -92,22 +98,31 @@ def parameters_csv(res: CalibrationResult) -> str:
 
 def calibration_summary(res: CalibrationResult, *, data: str = "", config: str = "",
                         accuracy: Sequence[AccuracyMap] = (),
-                        encoder_counts: float | None = None) -> dict[str, Any]:
+                        encoder_counts: float | None = None,
+                        outliers: Sequence[int] = (), outlier_message: str = ""
+                        ) -> dict[str, Any]:
     """The calibration's summary, JSON-ready (mm, deg, um): ``status``, ``n_poses``,
     ``identifiable``, ``not_identifiable``, the RMS and largest errors before and after,
     ``validation`` (the same on held-out poses), the parameters, their correlation, the
-    observability and the accuracy maps' figures."""
+    observability and the accuracy maps' figures.
+
+    ``outliers``: row numbers of outliers the fit ``res`` kept (a diagnosis): the status is
+    then ``"outliers"`` (code 3), the message ``outlier_message``, ``outlier_rows`` the
+    rows."""
     e = res.errors.as_dict()
+    status = OUTLIERS if outliers else res.status
     params = []
     for p in res.parameters:
         unit, nom, val, std = p.in_file_units()
         params.append({"name": p.name, "unit": unit, "nominal": nom, "value": val,
                        "std": std, "identifiable": p.identifiable})
     out: dict[str, Any] = {
-        "status": STATUS_WORDS.get(res.status, str(res.status)), "status_code": res.status,
-        "success": res.success, "message": res.message, "data": data,
+        "status": STATUS_WORDS.get(status, str(status)), "status_code": status,
+        "success": status == 0, "message": outlier_message if outliers else res.message,
+        "data": data,
         "config": config or "defaults", "frame": res.frame, "n_poses": len(res.errors.rows),
         "n_read": len(res.data), "rejected_rows": list(res.rejected),
+        "outlier_rows": [int(r) for r in outliers],
         "modes": {m: res.data.subset(res.kept).modes.count(m) for m in WORKING_MODES
                   if m in res.data.subset(res.kept).modes},
         "identifiable": list(res.identifiable), "not_identifiable": list(res.not_identifiable),
@@ -271,6 +286,9 @@ def calibration_report(summary: Mapping[str, Any], pngs: dict[str, bytes]) -> st
         ("poses used / read", f"{summary['n_poses']} / {summary['n_read']}"),
         ("working modes", ", ".join(f"{k}: {v}" for k, v in summary["modes"].items())),
         ("rejected rows", ", ".join(str(r) for r in summary["rejected_rows"]) or "none"),
+        *([("outlier rows (kept in this fit; no calibrated config written)",
+            ", ".join(str(r) for r in summary["outlier_rows"]))]
+          if summary.get("outlier_rows") else []),
         ("identifiable", ", ".join(summary["identifiable"])),
         ("not identifiable (kept nominal)", "; ".join(
             summary["not_identifiable_combinations"].values()) or "none"),
@@ -341,12 +359,14 @@ def _toml_value(v: Any) -> str:
 
 def calibrated_toml(model: KinematicModel, *, working_mode: str, assembly_mode: str,
                     frame_identified: bool = True, encoder_counts: float | None = None,
-                    extra: Mapping[str, Any] | None = None, comment: str = "") -> str:
+                    extra: Mapping[str, Any] | None = None, comment: str = "",
+                    sigma_mm: float | None = None) -> str:
     """A config whose ``[robot]`` is the calibrated robot (lengths in mm and
     ``encoder_offset_deg = [phi, psi]``, with ``encoder_counts`` when given) and whose
     ``[instrument]`` (``x0_mm, y0_mm, theta0_deg``) is the identified frame (when
-    ``frame_identified``); the tables of ``extra`` (the rest of the user's config, raw TOML
-    values; arrays of tables as lists of tables) follow as given."""
+    ``frame_identified``; ``sigma_mm`` the instrument's noise, kept with it); the tables of
+    ``extra`` (the rest of the user's config, raw TOML values; arrays of tables as lists of
+    tables) follow as given."""
     r = FiveBar(*(to_file_units(n, v) for n, v in model.robot.as_dict().items()))
     top = {k: v for k, v in (extra or {}).items()
            if not isinstance(v, Mapping) and not (isinstance(v, list) and v
@@ -361,11 +381,16 @@ def calibrated_toml(model: KinematicModel, *, working_mode: str, assembly_mode: 
         f"{_num(to_file_units('psi_offset', model.psi_offset))}]   # geometric angle = "
         "reading + offset"]
     if encoder_counts is not None:
-        lines.append(f"encoder_counts = {_toml_value(encoder_counts)}")
+        c = float(encoder_counts)
+        lines.append(f"encoder_counts = {_toml_value(int(c) if c.is_integer() else c)}")
     if frame_identified:
         x0, y0, th = (model.in_file_units()[n] for n in FRAME)
         lines += ["", "[instrument]           # the robot frame in the instrument's frame",
                   f"x0_mm = {_num(x0)}", f"y0_mm = {_num(y0)}", f"theta0_deg = {_num(th)}"]
+    elif sigma_mm is not None:
+        lines += ["", "[instrument]           # points measured in the robot frame"]
+    if sigma_mm is not None:
+        lines.append(f"sigma_mm = {_num(sigma_mm)}   # per axis")
     for name, table in (extra or {}).items():
         if name in ("robot", "instrument") or name in top:
             continue
@@ -387,7 +412,9 @@ def calibration_files(res: CalibrationResult, *, data: str, config: str = "",
                       encoder_counts: float | None = None,
                       extra: Mapping[str, Any] | None = None,
                       validation: PoseData | None = None, figures: bool = True,
-                      resolution: int = 121, dpi: int = 110) -> dict[str, str | bytes]:
+                      resolution: int = 121, dpi: int = 110, outliers: Sequence[int] = (),
+                      outlier_message: str = "", sigma_mm: float | None = None
+                      ) -> dict[str, str | bytes]:
     """Every file of ``dextar calibrate`` by name: ``calibrated.toml``, ``parameters.csv``,
     ``summary.json`` and, with ``figures``, ``residuals.png``, ``accuracy.png`` and
     ``report.html`` (the accuracy maps of the working modes of the kept poses, in
@@ -395,7 +422,9 @@ def calibration_files(res: CalibrationResult, *, data: str, config: str = "",
 
     ``extra`` holds the user's other config tables (raw TOML values) to carry into
     ``calibrated.toml``; ``validation`` the held-out poses of ``res.validation`` (drawn in
-    ``residuals.png``); ``resolution`` the accuracy maps' grid, ``dpi`` the figures'.
+    ``residuals.png``); ``resolution`` the accuracy maps' grid, ``dpi`` the figures';
+    ``sigma_mm`` the instrument's noise (``[instrument].sigma_mm``), kept in the config. With ``outliers`` (the rows of a fit that kept them, see :func:`calibration_summary`)
+    every file but ``calibrated.toml`` is written: a diagnosis, not a calibration.
     """
     import json
 
@@ -410,17 +439,19 @@ def calibration_files(res: CalibrationResult, *, data: str, config: str = "",
                          assembly=assembly_mode, reading_std=reading_std,
                          resolution=resolution) for m in modes] if figures else []
     summary = calibration_summary(res, data=data, config=config, accuracy=maps,
-                                  encoder_counts=encoder_counts)
+                                  encoder_counts=encoder_counts, outliers=outliers,
+                                  outlier_message=outlier_message)
     comment = (f"calibrated by dextar from {data} ({summary['status']}: "
                f"{summary['rms_error_before_mm']:.4g} -> {summary['rms_error_after_mm']:.4g} "
                f"mm RMS over {summary['n_poses']} poses)")
-    files: dict[str, str | bytes] = {
-        "calibrated.toml": calibrated_toml(
+    files: dict[str, str | bytes] = {}
+    if not outliers:
+        files["calibrated.toml"] = calibrated_toml(
             res.calibrated, working_mode=working_mode, assembly_mode=assembly_mode,
             frame_identified=res.frame == "instrument", encoder_counts=encoder_counts,
-            extra=extra, comment=comment),
-        "parameters.csv": parameters_csv(res),
-        "summary.json": json.dumps(summary, indent=2, allow_nan=False) + "\n"}
+            extra=extra, comment=comment, sigma_mm=sigma_mm)
+    files["parameters.csv"] = parameters_csv(res)
+    files["summary.json"] = json.dumps(summary, indent=2, allow_nan=False) + "\n"
     if figures:
         pts = {m: res.calibrated.to_robot(kept.points[[x == m for x in kept.modes]])
                for m in modes}

@@ -30,6 +30,9 @@ PROGRAM_FILES = ("setpoints.csv", "summary.json", "report.html", "csp.csv", "pvt
                    for e in ("png", "svg")))
 #: What the units of a program's outputs are.
 UNITS = "SI: s, rad, N m, W, J; positions in mm in setpoints.csv"
+#: What the joint angles of ``setpoints.csv`` are.
+ANGLES = ("phi_rad, psi_rad in setpoints.csv are encoder readings: geometric "
+          "angle - [robot].encoder_offset_deg")
 
 
 @dataclass(frozen=True)
@@ -45,6 +48,9 @@ class ProgramSummary:
     moves : tuple of MoveTiming
         Every move of the program, in order.
     sizing : Sizing
+    encoder_offset_deg : (float, float)
+        ``[robot].encoder_offset_deg``: the setpoints' angles are encoder readings, the
+        geometric angles minus these.
     """
 
     config: str
@@ -54,6 +60,13 @@ class ProgramSummary:
     sizing: Sizing
     rms_fit: RmsFit | None = None
     drive: dict[str, Any] | None = None
+    encoder_offset_deg: tuple[float, float] = (0.0, 0.0)
+
+    @property
+    def units(self) -> str:
+        """The units of the outputs, the setpoints' angles included."""
+        a, b = self.encoder_offset_deg
+        return f"{UNITS}; {ANGLES} [{a:g}, {b:g}] deg"
 
     @property
     def status(self) -> str:
@@ -66,7 +79,8 @@ class ProgramSummary:
                "servo_rate_hz": self.servo_rate_hz, "config": self.config,
                "moves": [asdict(m) for m in self.moves],
                "motors": [m.as_dict() for m in self.sizing.motors],
-               "violations": [v.as_dict() for v in self.sizing.violations], "units": UNITS}
+               "violations": [v.as_dict() for v in self.sizing.violations], "encoder_offset_deg": list(self.encoder_offset_deg),
+               "units": self.units}
         if self.rms_fit is not None:
             out["rms_fit"] = self.rms_fit.as_dict()
         if self.drive is not None:
@@ -94,15 +108,25 @@ class ProgramSummary:
                 + "; ".join(f"motor {m['motor']} peak {m['peak_speed_rpm']:.4g} rpm, "
                             f"{m['peak_torque_Nm']:.4g} N m" for m in self.drive["motors"])]),
             f"wrote {Path(out) / 'setpoints.csv'} ({samples} setpoints at "
-            f"{self.servo_rate_hz:g} Hz)"
+            f"{self.servo_rate_hz:g} Hz{self._angles_note()})"
             + (f", {Path(out) / 'csp.csv'}, {Path(out) / 'pvt.csv'}" if self.drive else "")
             + f" and {Path(out) / 'summary.json'}"]
 
+    def _angles_note(self) -> str:
+        if self.encoder_offset_deg == (0.0, 0.0):
+            return ""
+        a, b = self.encoder_offset_deg
+        return f"; angles in encoder readings, offsets [{a:g}, {b:g}] deg"
 
-def setpoint_columns(res: ProgramResult) -> dict[str, Array]:
-    """``setpoints.csv``: time, move, end-effector (mm), joint motion and torques (SI)."""
+
+def setpoint_columns(res: ProgramResult,
+                     encoder_offset_deg: tuple[float, float] = (0.0, 0.0)) -> dict[str, Array]:
+    """``setpoints.csv``: time, move, end-effector (mm), joint motion in encoder readings
+    (the geometric angles minus ``encoder_offset_deg``) and torques (SI)."""
+    off = np.radians(encoder_offset_deg)
     return {"t_s": res.t, "move": res.move_index.astype(float), "x_mm": res.P[:, 0] * 1e3,
-            "y_mm": res.P[:, 1] * 1e3, "phi_rad": res.q[:, 0], "psi_rad": res.q[:, 1],
+            "y_mm": res.P[:, 1] * 1e3, "phi_rad": res.q[:, 0] - off[0],
+            "psi_rad": res.q[:, 1] - off[1],
             "dphi_rad_s": res.dq[:, 0], "dpsi_rad_s": res.dq[:, 1],
             "ddphi_rad_s2": res.ddq[:, 0], "ddpsi_rad_s2": res.ddq[:, 1],
             "tau1_Nm": res.tau[:, 0], "tau2_Nm": res.tau[:, 1]}
@@ -117,7 +141,8 @@ def write_program(out: str, res: ProgramResult, summary: ProgramSummary, robot_m
     from ..program.drive import csp_columns, pvt_points
 
     with OutputDir(out, force=force, produces=PROGRAM_FILES) as od:
-        od.write_text("setpoints.csv", csv_text(setpoint_columns(res)))
+        od.write_text("setpoints.csv", csv_text(setpoint_columns(res,
+                                                                 summary.encoder_offset_deg)))
         if drive is not None:
             od.write_text("csp.csv", _counts_csv(csp_columns(res, drive)))
             od.write_text("pvt.csv", _counts_csv((pvt or pvt_points(res, drive)).columns()))
@@ -271,6 +296,6 @@ def program_report(summary: ProgramSummary, pngs: dict[str, bytes]) -> str:
     return page(
         f"Program {name}: {summary.status} the motors",
         f"<p>Task file {esc(summary.config)}. Cycle time {summary.cycle_time_s:.4f} s; "
-        f"setpoints at {summary.servo_rate_hz:g} Hz. Units: {esc(UNITS)}.</p>"
+        f"setpoints at {summary.servo_rate_hz:g} Hz. Units: {esc(summary.units)}.</p>"
         f"<h2>Moves</h2>{moves}<h2>Motor sizing</h2>{sizing}<h2>Violations</h2>"
         f"<ul>{viol}</ul><h2>Figures</h2>{figures(pngs)}")

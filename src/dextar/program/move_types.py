@@ -146,7 +146,8 @@ register_move(MoveType(
     _plan_dwell, has_law=False, help="hold still (gravity still loads the motors)"))
 register_move(MoveType(
     "joint", {"to": Param("point", "mm", None, "target point [x, y] in mm"),
-              "to_deg": Param("point", "deg", None, "target angles [phi, psi] in deg"),
+              "to_deg": Param("point", "deg", None, "target angles [phi, psi] in deg (encoder "
+                              "readings: geometric angle - [robot].encoder_offset_deg)"),
               "working_mode": Param("text", "", None, "the target's working mode")},
     _plan_joint, check=_check_joint, si_keys={"to_deg": "to_q"},
     help="a straight line in joint space (it may change the working mode)"))

@@ -1,0 +1,84 @@
+"""``dextar poses CONFIG.toml --count N --out poses.csv``: measurement poses for a kinematic
+calibration, D-optimal (the observability index O1) over the working modes asked for, away
+from both singularity types, in an order the robot can visit."""
+
+from __future__ import annotations
+
+import argparse
+
+from .base import Result, config_argument, json_flag, out_file, write_or_hand_back
+
+NAME = "poses"
+HELP = ("measurement poses for a kinematic calibration (D-optimal over the working modes) "
+        "to CSV")
+
+
+def _modes(text: str) -> tuple[str, ...]:
+    """``all`` or working modes separated by commas (names or aliases)."""
+    from ..errors import DextarError
+    from ..geometry import WORKING_MODES, canonical_working_mode
+
+    text = text.strip()
+    if text == "all":
+        return WORKING_MODES
+    try:
+        names = tuple(dict.fromkeys(canonical_working_mode(m.strip())
+                                    for m in text.split(",") if m.strip()))
+    except DextarError as exc:
+        raise argparse.ArgumentTypeError(f"{exc} (or all)") from None
+    if not names:
+        raise argparse.ArgumentTypeError("no working mode given: all, or modes such as +-,--")
+    return names
+
+
+def add_arguments(sp: argparse.ArgumentParser) -> None:
+    """``config``, ``--count``, ``--out``, ``--modes``, ``--margin``, ``--seed``,
+    ``--frame``, ``--json``, ``--quiet``."""
+    config_argument(sp, help="TOML config: [robot] (its encoder offsets and counts), "
+                    "[instrument].sigma_mm (default: the DexTAR)")
+    sp.add_argument("--count", type=int, required=True, help="number of poses")
+    sp.add_argument("--out", required=True, help="CSV file (- for stdout)")
+    sp.add_argument("--modes", type=_modes, default=None,
+                    help="working modes to measure in: all (default) or a list such as +-,-- "
+                    "(aliases pm,mm)")
+    sp.add_argument("--margin", type=float, default=None,
+                    help="least normalised distance to both singularity types (default 0.2)")
+    sp.add_argument("--seed", type=int, default=0, help="offset of the candidate grid")
+    sp.add_argument("--frame", choices=["instrument", "robot"], default="instrument",
+                    help="the frame the points will be measured in: an instrument's "
+                    "anywhere (10 parameters, default) or the robot's (7)")
+    json_flag(sp)
+    sp.add_argument("--quiet", action="store_true", help="no summary output")
+
+
+def run(args: argparse.Namespace) -> Result:
+    """Choose the poses, write them, word the observability."""
+    from ..calibration import select_poses
+    from ..calibration.fit import encoder_std
+    from ..calibration.poses import DEFAULT_MARGIN
+    from ..config import load_scenario
+    from ..geometry import WORKING_MODES
+    from ..output.calibration import poses_csv, poses_summary
+
+    target = out_file(args.out, ".csv")
+    sc = load_scenario(args.config)
+    rt, inst = sc.robot_table, sc.instrument_table
+    point_std = None if inst.sigma_mm is None else 1e-3 * inst.sigma_mm
+    reading_std = None if rt.encoder_counts is None else encoder_std(rt.encoder_counts)
+    sel = select_poses(sc.kinematic_model, args.count, modes=args.modes or WORKING_MODES,
+                       start_mode=rt.working_mode, assembly=rt.assembly_mode,
+                       frame=args.frame,
+                       margin=DEFAULT_MARGIN if args.margin is None else args.margin,
+                       point_std=point_std, reading_std=reading_std, seed=args.seed)
+    where, data = write_or_hand_back(target, poses_csv(sel))
+    payload = {**poses_summary(sel), "out": where, "config": args.config or "defaults",
+               "frame": args.frame, "encoder_offset_deg": list(rt.encoder_offset_deg),
+               "units": "phi_deg, psi_deg: the encoder readings to command (geometric angle "
+                        "- [robot].encoder_offset_deg); x_mm, y_mm: the nominal point, robot "
+                        "frame"}
+    text = (f"{sel.message}\nwrote {where}: mode, assembly, phi_deg, psi_deg (encoder "
+            "readings to command), x_mm, y_mm (nominal point, robot frame); at each pose "
+            "record the readings and the measured point in phi_deg, psi_deg, x_mm, y_mm: "
+            "the file of dextar calibrate")
+    warnings = [] if sel.success else [f"dextar poses: warning: {sel.message}"]
+    return Result(payload, text, warnings, data)
