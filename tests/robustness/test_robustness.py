@@ -23,7 +23,7 @@ from .harness import (
 )
 from .strategies import COMMANDS, configs, kinematics_argv, motion_files, programs
 
-SETTINGS = settings(max_examples=150, deadline=None, derandomize=True,
+SETTINGS = settings(max_examples=100, deadline=None, derandomize=True,
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
 
 
