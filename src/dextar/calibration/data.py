@@ -178,16 +178,90 @@ def read_poses_csv(path: str | Path, *, working_mode: str | None = None) -> Pose
         infinite values (the rows), sigma not positive.
     """
     p = Path(path)
+    t = _table(p, working_mode)
+    readings = np.radians(np.stack([t.numbers("phi_deg"), t.numbers("psi_deg")], axis=-1))
+    points = 1e-3 * np.stack([t.numbers("x_mm"), t.numbers("y_mm")], axis=-1)
+    modes, assembly = t.modes_and_assembly(working_mode)
+    sigma = 1e-3 * t.numbers("sigma_mm") if "sigma_mm" in t.col else None
+    return PoseData(readings, points, modes, assembly, sigma, t.rows, str(p))
+
+
+@dataclass(frozen=True)
+class _Table:
+    """The poses of a file as text: its lines after the header (``body``), the index of
+    each known column present (``col``) and the lines' row numbers (``rows``)."""
+
+    path: Path
+    body: list[list[str]]
+    col: dict[str, int]
+    rows: Array
+
+    def cell(self, i: int, name: str) -> str:
+        """The stripped text of line ``i`` in column ``name``."""
+        return self.body[i][self.col[name]].strip()
+
+    def numbers(self, name: str) -> Array:
+        """Column ``name`` as numbers (n,); :class:`ParameterError` at the first that is
+        not one."""
+        out = np.empty(len(self.body))
+        for i in range(len(self.body)):
+            text = self.cell(i, name)
+            try:
+                out[i] = float(text)
+            except ValueError:
+                raise ParameterError(f"{self.path}: row {self.rows[i]}, column {name}: "
+                                     f"{text!r} is not a number") from None
+        return out
+
+    def modes_and_assembly(self, working_mode: str | None) -> tuple[tuple[str, ...], Array]:
+        """The working mode (column ``mode``, else ``working_mode``) and the assembly (+1/-1,
+        0 where not given) of each line, checked line by line."""
+        default = None
+        if "mode" not in self.col:
+            assert working_mode is not None
+            default = canonical_working_mode(working_mode)
+        modes: list[str] = []
+        assembly = np.zeros(len(self.body), int)
+        for i in range(len(self.body)):
+            modes.append(self._mode(i) if default is None else default)
+            if "assembly" in self.col:
+                assembly[i] = self._assembly(i)
+        return tuple(modes), assembly
+
+    def _mode(self, i: int) -> str:
+        text = self.cell(i, "mode")
+        try:
+            return canonical_working_mode(text)
+        except ParameterError:
+            raise ParameterError(f"{self.path}: row {self.rows[i]}, column mode: {text!r} is "
+                                 "not a working mode (++, +-, -+, -- or pp, pm, mp, mm)"
+                                 ) from None
+
+    def _assembly(self, i: int) -> int:
+        text = self.cell(i, "assembly")
+        if not text:
+            return 0
+        try:
+            return parse_assembly_mode(text)
+        except ParameterError:
+            raise ParameterError(f"{self.path}: row {self.rows[i]}, column assembly: {text!r} "
+                                 "is not up or down") from None
+
+
+def _table(p: Path, working_mode: str | None) -> _Table:
+    """The file ``p`` read and its layout checked: readable text, not empty, the required
+    columns (and ``mode`` unless ``working_mode``), poses after the header, as many fields
+    in every line as in the header."""
     try:
         with p.open(newline="") as fh:
-            table = [row for row in csv.reader(fh) if row and any(c.strip() for c in row)]
+            lines = [row for row in csv.reader(fh) if row and any(c.strip() for c in row)]
     except OSError as exc:
         raise ConfigError(f"poses file {str(p)!r} cannot be read: {exc.strerror or exc}") from None
     except UnicodeDecodeError:
         raise ConfigError(f"poses file {str(p)!r} is not a text (CSV) file") from None
-    if not table:
+    if not lines:
         raise ConfigError(f"poses file {str(p)!r} is empty")
-    head = [h.strip() for h in table[0]]
+    head = [h.strip() for h in lines[0]]
     missing = [c for c in REQUIRED if c not in head]
     if missing:
         raise ConfigError(f"poses file {str(p)!r} lacks the column"
@@ -196,51 +270,11 @@ def read_poses_csv(path: str | Path, *, working_mode: str | None = None) -> Pose
     if "mode" not in head and working_mode is None:
         raise ConfigError(f"poses file {str(p)!r} has no mode column and no working mode is "
                           "given for its rows ([robot].working_mode)")
-    body = table[1:]
+    body = lines[1:]
     if not body:
         raise ParameterError(f"{p}: no poses after the header")
-    col = {c: head.index(c) for c in REQUIRED + OPTIONAL if c in head}
     rows = np.arange(len(body)) + 2
     for r, line in zip(rows, body, strict=True):
         if len(line) != len(head):
             raise ParameterError(f"{p}: row {r} has {len(line)} fields, the header {len(head)}")
-
-    def numbers(name: str, blank: float | None = None) -> Array:
-        out = np.empty(len(body))
-        for i, line in enumerate(body):
-            text = line[col[name]].strip()
-            if not text and blank is not None:
-                out[i] = blank
-                continue
-            try:
-                out[i] = float(text)
-            except ValueError:
-                raise ParameterError(f"{p}: row {rows[i]}, column {name}: {text!r} is not a "
-                                     "number") from None
-        return out
-
-    readings = np.radians(np.stack([numbers("phi_deg"), numbers("psi_deg")], axis=-1))
-    points = 1e-3 * np.stack([numbers("x_mm"), numbers("y_mm")], axis=-1)
-    modes: list[str] = []
-    assembly = np.zeros(len(body), int)
-    for i, line in enumerate(body):
-        if "mode" in col:
-            text = line[col["mode"]].strip()
-            try:
-                modes.append(canonical_working_mode(text))
-            except ParameterError:
-                raise ParameterError(f"{p}: row {rows[i]}, column mode: {text!r} is not a "
-                                     "working mode (++, +-, -+, -- or pp, pm, mp, mm)") from None
-        else:
-            assert working_mode is not None
-            modes.append(canonical_working_mode(working_mode))
-        if "assembly" in col:
-            text = line[col["assembly"]].strip()
-            if text:
-                try:
-                    assembly[i] = parse_assembly_mode(text)
-                except ParameterError:
-                    raise ParameterError(f"{p}: row {rows[i]}, column assembly: {text!r} is "
-                                         "not up or down") from None
-    sigma = 1e-3 * numbers("sigma_mm") if "sigma_mm" in col else None
-    return PoseData(readings, points, tuple(modes), assembly, sigma, rows, str(p))
+    return _Table(p, body, {c: head.index(c) for c in REQUIRED + OPTIONAL if c in head}, rows)

@@ -484,6 +484,67 @@ def calibrate(data: PoseData, nominal: KinematicModel, *, frame: str = "instrume
     ReachError
         A measured point neither the nominal nor the fitted robot reaches in its mode.
     """
+    o = _options(frame, fit, robust, outlier_factor, point_std, reading_std, max_nfev)
+    p_nom = nominal.vector()
+    if frame == "robot":
+        p_nom[7:] = 0.0
+    sigma = data.sigma if data.sigma is not None else (
+        None if point_std is None else np.full(len(data), float(point_std)))
+    # 1. assembly modes and frame (rows the nominal robot cannot assemble wait for the fit)
+    _, usable = _nearer(p_nom, data.readings, data.points)
+    p_start, assembly = _resolve_frame(p_nom, data, frame, usable)
+    f = _fit(p_start, data, assembly, sigma, o)
+    r = _checked_residuals(f, p_nom, o)
+    warnings = ([] if f.fit.status == 0 else
+                ["reach and outlier checks skipped: the fit did not converge"])
+    cov, s2, rss, dof = _covariance(r)
+    corr = correlation(cov)
+    warnings += _coupling(corr, f.ident, r.d, allow_coupled)
+    ident_names = f.ident.identifiable
+    obs = observability(r.J, ident_names, characteristic_scales(nominal.robot))
+    chi2, status, message = _chi_square(f, rss, dof, s2)
+    e_before = r.d.points - predict_of(p_start, closure_of(p_start, r.d.readings,
+                                                           r.d.assembly))
+    errors = Errors.of(e_before, r.e, r.d.rows)
+    if status == 0:
+        message = (f"calibrated {len(ident_names)} parameters from {len(r.d)} poses: RMS "
+                   f"error {_mm(errors.rms_after)} (nominal robot {_mm(errors.rms_before)})")
+    if obs.condition_number > 1e4:
+        warnings.append(f"condition number {obs.condition_number:.3g} of the scaled "
+                        "identification Jacobian: some parameters are poorly determined")
+    p = f.fit.p
+    params = _parameters(o.model_names, ident_names, p_start, p,
+                         np.sqrt(np.clip(np.diag(cov), 0.0, None)))
+    before_model = KinematicModel.from_vector(p_start)
+    calibrated = KinematicModel.from_vector(p)
+    val = None if validation is None else validation_errors(validation, before_model,
+                                                            calibrated)
+    not_ident = f.ident.not_identifiable
+    return CalibrationResult(
+        status, message, nominal, before_model, calibrated, frame, params, ident_names,
+        not_ident, {x: f.ident.combinations[x] for x in not_ident}, cov, corr, obs, f.data,
+        f.use, f.rejected, errors, val, math.sqrt(s2) * (1.0 if f.W is not None else 1e-3),
+        chi2, f.fit.nfev, tuple(warnings))
+
+
+# ------------------------------------------------------------------ the steps of calibrate
+@dataclass(frozen=True)
+class _Options:
+    """The checked options of :func:`calibrate` (``free``: the free parameters)."""
+
+    model_names: tuple[str, ...]
+    free: tuple[str, ...]
+    robust: str | None
+    outlier_factor: float
+    reading_std: float | None
+    max_nfev: int
+
+
+def _options(frame: str, fit: Sequence[str] | None, robust: str | None,
+             outlier_factor: float, point_std: float | None, reading_std: float | None,
+             max_nfev: int) -> _Options:
+    """The options of :func:`calibrate`, checked (:class:`ParameterError` naming the one
+    that is wrong)."""
     if frame not in ("instrument", "robot"):
         raise ParameterError(f"frame {frame!r} must be 'instrument' or 'robot'")
     if robust is not None and robust not in ROBUST_LOSSES:
@@ -499,169 +560,61 @@ def calibrate(data: PoseData, nominal: KinematicModel, *, frame: str = "instrume
     if unknown:
         raise ParameterError(f"cannot fit {', '.join(unknown)}: the parameters of the "
                              f"{frame} frame are {', '.join(model_names)}")
-    p_nom = nominal.vector()
-    if frame == "robot":
-        p_nom[7:] = 0.0
-    n = len(data)
-    sigma = data.sigma if data.sigma is not None else (
-        None if point_std is None else np.full(n, float(point_std)))
-    warnings: list[str] = []
+    return _Options(model_names, free_names, robust, outlier_factor, reading_std, max_nfev)
 
-    # 1. assembly modes and frame (rows the nominal robot cannot assemble wait for the fit)
-    _, usable = _nearer(p_nom, data.readings, data.points)
-    p_start, assembly = _resolve_frame(p_nom, data, frame, usable)
-    kept = np.ones(n, bool)
-    free = [x for x in free_names]
-    p = p_start.copy()
+
+@dataclass(frozen=True)
+class _Fitted:
+    """The final fit (its ``p`` with ``theta0`` wrapped), the whitening of the rows it used
+    (``use``: kept and assembled), what they identify, the poses with their assembly
+    resolved, the rows the robust loss rejected."""
+
+    fit: _Fit
+    W: Array | None
+    ident: Identifiability
+    data: PoseData
+    use: Array
+    rejected: tuple[int, ...]
+
+
+def _fit(p: Array, data: PoseData, assembly: Array, sigma: Array | None,
+         o: _Options) -> _Fitted:
+    """Steps 2 to 4 of the module doc from the start ``p``: with a robust loss its
+    rejections first; then rows the start could not assemble (``assembly`` 0) take their
+    assembly under the fitted parameters and the fit is repeated once with them."""
+    assembly = assembly.copy()
+    kept = np.ones(len(data), bool)
     rejected: tuple[int, ...] = ()
     for _round in range(2):
+        if o.robust is not None:
+            p, kept, rejected = _robust_pass(p, data, assembly, kept, sigma, o, o.robust)
         use = kept & (assembly != 0)
-        if robust is not None:
-            p, out = _robust_pass(p, data.subset(use), assembly[use], sigma, use, free,
-                                  reading_std, robust, outlier_factor, max_nfev)
-            rows_use = np.flatnonzero(use)
-            kept[rows_use[out]] = False
-            rejected = tuple(int(v) for v in data.rows[~kept])
-            use = kept & (assembly != 0)
-        sol, W_all, ident = _plain_pass(p, data.subset(use), assembly[use],
-                                        None if sigma is None else sigma[use], free,
-                                        reading_std, max_nfev, rejected)
+        sol, W, ident = _plain_pass(p, data.subset(use), assembly[use],
+                                    None if sigma is None else sigma[use], o, rejected)
         p = sol.p
         waiting = kept & (assembly == 0)
         if not waiting.any():
             break
-        # rows the nominal robot could not assemble: their assembly with the fitted robot
-        kw = closure_of(p, data.readings[waiting], 1)
-        if kw.open.any():
-            i = int(np.flatnonzero(kw.open)[0])
-            raise AssemblyError(
-                f"{data.source}: row {int(data.rows[waiting][i])}: the distal rods cannot "
-                f"meet at readings ({math.degrees(data.readings[waiting][i, 0]):.6g}, "
-                f"{math.degrees(data.readings[waiting][i, 1]):.6g}) deg, with the nominal "
-                f"parameters nor with those fitted to the other rows (|B - C| "
-                f"{1e3 * kw.gap[i]:.4g} mm outside the rods' range)")
-        near, _ = _nearer(p, data.readings[waiting], data.points[waiting])
-        assembly[waiting] = np.where(data.assembly[waiting] != 0, data.assembly[waiting], near)
-    status, message, nfev = sol.status, sol.message, sol.nfev
+        assembly[waiting] = _assembly_of_waiting(p, data.subset(waiting))
     if not -math.pi < p[9] <= math.pi:
         p[9] = float(wrap(np.asarray(p[9])))
-    ident_names, not_ident, combos = (ident.identifiable, ident.not_identifiable,
-                                      ident.combinations)
-    use = kept & (assembly != 0)
     resolved = PoseData(data.readings, data.points, data.modes,
                         np.where(assembly != 0, assembly, data.assembly), data.sigma,
                         data.rows, data.source)
-    kd = resolved.subset(use)
-    k = closure_of(p, kd.readings, kd.assembly)
-    k.raise_if_open(kd.rows)
-    _check_modes(k, kd)
-    e_after = kd.points - predict_of(p, k)
-    if status == 0:
-        _check_reach(p_nom, p, kd, outlier_factor * _robust_scale(np.hypot(*e_after.T)))
-    else:
-        warnings.append("reach and outlier checks skipped: the fit did not converge")
-    J = jacobian_of(p, k)
-    fidx = [INDEX[x] for x in ident_names]
-    Jw = _apply_jac(W_all, J[:, :, fidx]).reshape(-1, len(fidx))
-    rw = _apply(W_all, -e_after)
-    dw = np.hypot(*rw.T)
-    if robust is None and status == 0:
-        scale = _robust_scale(dw)
-        out = dw > outlier_factor * scale
-        if out.any():
-            order = np.argsort(-dw[out])
-            rows_out = kd.rows[out][order]
-            dist = np.hypot(*e_after[out].T)[order]
-            listed = ", ".join(f"{int(r)} ({1e3 * d:.3g} mm)" for r, d in
-                               zip(rows_out[:5], dist[:5], strict=True))
-            more = f" and {len(rows_out) - 5} more" if len(rows_out) > 5 else ""
-            scale_text = (f"{scale:.3g} mm" if W_all is None else
-                          f"{scale:.3g} standard deviations of the stated noise")
-            raise OutlierError(
-                f"{data.source}: row{'s' if len(rows_out) > 1 else ''} {listed}{more} "
-                f"measured farther from the prediction than {outlier_factor:g} x the "
-                f"residual scale ({scale_text}): remove them or calibrate with a robust loss",
-                tuple(int(r) for r in rows_out))
-    dof = max(rw.size - len(fidx), 1)
-    rss = float((rw * rw).sum())
-    s2 = rss / dof
-    try:
-        JtJ_inv = np.linalg.inv(Jw.T @ Jw)
-    except np.linalg.LinAlgError:
-        JtJ_inv = np.linalg.pinv(Jw.T @ Jw)
-    cov = s2 * JtJ_inv
-    corr = correlation(cov)
-    # coupling: parameters nearly a combination of the others
-    mult = multiple_correlation(corr)
-    coupled = [ident_names[i] for i in np.argsort(-mult) if mult[i] >= COUPLING_LIMIT]
-    single = len(set(kd.modes)) == 1
-    if coupled or not_ident:
-        what = "; ".join([*(combos[x] for x in not_ident),
-                          *([", ".join(f"{x} ({mult[ident_names.index(x)]:.5f})"
-                                       for x in coupled[:4])
-                             + (f" and {len(coupled) - 4} more" if len(coupled) > 4 else "")
-                             + " nearly combinations of the others (multiple correlation)"]
-                            if coupled else [])])
-        if single:
-            text = (f"{data.source}: poses of the single working mode {kd.modes[0]} leave "
-                    f"parameters coupled: {what}; measure poses in other working modes too "
-                    "(all four: dextar poses --modes all)")
-            if not allow_coupled:
-                raise CouplingError(text, tuple(dict.fromkeys([*not_ident, *coupled])))
-        else:
-            text = (f"parameters coupled by these poses: {what}; not identifiable ones kept "
-                    "nominal")
-        warnings.append(text)
-    obs = observability(J, ident_names, characteristic_scales(nominal.robot))
-    chi2 = None
-    if W_all is not None:
-        from scipy.stats import chi2 as chi2_dist
+    return _Fitted(sol, W, ident, resolved, kept & (assembly != 0), rejected)
 
-        chi2 = s2
-        pval = float(chi2_dist.sf(rss, dof))
-        if status == 0 and pval < CHI2_ALPHA:
-            status = 2
-            message = (f"the residuals are {math.sqrt(s2):.3g} times what the stated noise "
-                       f"explains (chi-square p = {pval:.2g}): the model misses something (a "
-                       "parameter held fixed, a wrong mode or assembly, play in a joint)")
-    e_before = kd.points - predict_of(p_start, closure_of(p_start, kd.readings, kd.assembly))
-    errors = Errors.of(e_before, e_after, kd.rows)
-    if status == 0:
-        message = (f"calibrated {len(ident_names)} parameters from {len(kd)} poses: RMS "
-                   f"error {_mm(errors.rms_after)} (nominal robot {_mm(errors.rms_before)})")
-    if obs.condition_number > 1e4:
-        warnings.append(f"condition number {obs.condition_number:.3g} of the scaled "
-                        "identification Jacobian: some parameters are poorly determined")
-    std = np.sqrt(np.clip(np.diag(cov), 0.0, None))
-    params = []
-    for name in model_names:
-        i = INDEX[name]
-        if name in ident_names:
-            j = ident_names.index(name)
-            params.append(Parameter(name, "m" if name in LENGTHS else "rad", float(p_start[i]),
-                                    float(p[i]), float(std[j]), True))
-        else:
-            params.append(Parameter(name, "m" if name in LENGTHS else "rad", float(p_start[i]),
-                                    float(p[i]), None, False))
-    before_model = KinematicModel.from_vector(p_start)
-    calibrated = KinematicModel.from_vector(p)
-    val = None if validation is None else validation_errors(validation, before_model,
-                                                            calibrated)
-    return CalibrationResult(
-        status, message, nominal, before_model, calibrated, frame, tuple(params), ident_names,
-        not_ident, {x: combos[x] for x in not_ident}, cov, corr, obs, resolved, use,
-        rejected, errors, val, math.sqrt(s2) * (1.0 if W_all is not None else 1e-3), chi2,
-        nfev, tuple(warnings))
 
-def _robust_pass(p: Array, d: PoseData, a: Array, sigma: Array | None, use: Array,
-                 free: Sequence[str], reading_std: float | None, loss: str,
-                 factor: float, max_nfev: int) -> tuple[Array, Array]:
-    """Two robust solves (the loss's scale from the residuals before each) and the rows
-    beyond ``factor`` residual scales after them: ``(p, outliers (m,) bool)``."""
-    W = _whitening(None if sigma is None else sigma[use], reading_std,
+def _robust_pass(p: Array, data: PoseData, assembly: Array, kept: Array, sigma: Array | None,
+                 o: _Options, loss: str) -> tuple[Array, Array, tuple[int, ...]]:
+    """Two robust solves on the kept, assembled rows (the loss's scale from the residuals
+    before each); the rows beyond ``o.outlier_factor`` residual scales after them are no
+    longer kept: ``(p, kept (n,) bool, rejected row numbers)``."""
+    use = kept & (assembly != 0)
+    d, a = data.subset(use), assembly[use]
+    W = _whitening(None if sigma is None else sigma[use], o.reading_std,
                    jacobian_of(p, closure_of(p, d.readings, a))[:, :, 5:7])
     ident = identifiability(_apply_jac(W, jacobian_of(p, closure_of(p, d.readings, a))),
-                            free)
+                            o.free)
     fidx = [INDEX[x] for x in ident.identifiable]
     _enough(len(d), len(fidx), d.source, ())
 
@@ -672,22 +625,169 @@ def _robust_pass(p: Array, d: PoseData, a: Array, sigma: Array | None, use: Arra
     for factor_scale in (3.0, 2.0):
         scale = max(_robust_scale(dist(p)), 1e-12)
         p = _solve(p, fidx, d.readings, d.points, a, W, loss=loss,
-                   f_scale=factor_scale * scale, max_nfev=max_nfev).p
+                   f_scale=factor_scale * scale, max_nfev=o.max_nfev).p
     e = dist(p)
-    return p, e > factor * _robust_scale(e)
+    kept = kept.copy()
+    kept[np.flatnonzero(use)[e > o.outlier_factor * _robust_scale(e)]] = False
+    return p, kept, tuple(int(v) for v in data.rows[~kept])
 
 
-def _plain_pass(p: Array, d: PoseData, a: Array, sigma: Array | None, free: Sequence[str],
-                reading_std: float | None, max_nfev: int, rejected: tuple[int, ...]
-                ) -> tuple[_Fit, Array | None, Identifiability]:
+def _plain_pass(p: Array, d: PoseData, a: Array, sigma: Array | None, o: _Options,
+                rejected: tuple[int, ...]) -> tuple[_Fit, Array | None, Identifiability]:
     """Whitening, identifiability and the least-squares solve on the poses ``d``."""
     k0 = closure_of(p, d.readings, a)
     J0 = jacobian_of(p, k0)
-    W = _whitening(sigma, reading_std, J0[:, :, 5:7])
-    ident = identifiability(_apply_jac(W, J0), free)
+    W = _whitening(sigma, o.reading_std, J0[:, :, 5:7])
+    ident = identifiability(_apply_jac(W, J0), o.free)
     fidx = [INDEX[x] for x in ident.identifiable]
     _enough(len(d), len(fidx), d.source, rejected)
-    return _solve(p, fidx, d.readings, d.points, a, W, max_nfev=max_nfev), W, ident
+    return _solve(p, fidx, d.readings, d.points, a, W, max_nfev=o.max_nfev), W, ident
+
+
+def _assembly_of_waiting(p: Array, d: PoseData) -> Array:
+    """The assembly (+1/-1) of rows the nominal robot could not assemble, under the fitted
+    ``p``: the given one, else the one nearer the measured point; :class:`AssemblyError`
+    for the first whose rods still cannot meet."""
+    kw = closure_of(p, d.readings, 1)
+    if kw.open.any():
+        i = int(np.flatnonzero(kw.open)[0])
+        raise AssemblyError(
+            f"{d.source}: row {int(d.rows[i])}: the distal rods cannot "
+            f"meet at readings ({math.degrees(d.readings[i, 0]):.6g}, "
+            f"{math.degrees(d.readings[i, 1]):.6g}) deg, with the nominal "
+            f"parameters nor with those fitted to the other rows (|B - C| "
+            f"{1e3 * kw.gap[i]:.4g} mm outside the rods' range)")
+    near, _ = _nearer(p, d.readings, d.points)
+    return np.where(d.assembly != 0, d.assembly, near)
+
+
+@dataclass(frozen=True)
+class _Residuals:
+    """The poses of the fit at its solution: ``d`` the poses, ``k`` their closures, ``e``
+    ``measured - predicted`` (n, 2) (m), ``J`` the Jacobian (n, 2, 10), ``Jw`` the whitened
+    Jacobian of the identifiable parameters (2 n, k), ``rw`` the whitened residuals (n, 2)."""
+
+    d: PoseData
+    k: Closure
+    e: Array
+    J: Array
+    Jw: Array
+    rw: Array
+
+
+def _checked_residuals(f: _Fitted, p_nom: Array, o: _Options) -> _Residuals:
+    """The residuals of the fit ``f``, checked (step 5 of the module doc): every row
+    assembles in its stated working mode, and, when the fit converged, every measured point
+    is within reach and (without a robust loss) no row is an outlier."""
+    p, converged = f.fit.p, f.fit.status == 0
+    kd = f.data.subset(f.use)
+    k = closure_of(p, kd.readings, kd.assembly)
+    k.raise_if_open(kd.rows)
+    _check_modes(k, kd)
+    e = kd.points - predict_of(p, k)
+    if converged:
+        _check_reach(p_nom, p, kd, o.outlier_factor * _robust_scale(np.hypot(*e.T)))
+    J = jacobian_of(p, k)
+    fidx = [INDEX[x] for x in f.ident.identifiable]
+    r = _Residuals(kd, k, e, J, _apply_jac(f.W, J[:, :, fidx]).reshape(-1, len(fidx)),
+                   _apply(f.W, -e))
+    if o.robust is None and converged:
+        _check_outliers(r, f.W is None, o.outlier_factor)
+    return r
+
+
+def _check_outliers(r: _Residuals, unweighted: bool, factor: float) -> None:
+    """Raise :class:`OutlierError` listing the rows (farthest first) beyond ``factor``
+    residual scales of their prediction."""
+    dw = np.hypot(*r.rw.T)
+    scale = _robust_scale(dw)
+    out = dw > factor * scale
+    if not out.any():
+        return
+    order = np.argsort(-dw[out])
+    rows_out = r.d.rows[out][order]
+    dist = np.hypot(*r.e[out].T)[order]
+    listed = ", ".join(f"{int(row)} ({1e3 * v:.3g} mm)" for row, v in
+                       zip(rows_out[:5], dist[:5], strict=True))
+    more = f" and {len(rows_out) - 5} more" if len(rows_out) > 5 else ""
+    scale_text = (f"{scale:.3g} mm" if unweighted else
+                  f"{scale:.3g} standard deviations of the stated noise")
+    raise OutlierError(
+        f"{r.d.source}: row{'s' if len(rows_out) > 1 else ''} {listed}{more} "
+        f"measured farther from the prediction than {factor:g} x the "
+        f"residual scale ({scale_text}): remove them or calibrate with a robust loss",
+        tuple(int(row) for row in rows_out))
+
+
+def _covariance(r: _Residuals) -> tuple[Array, float, float, int]:
+    """Step 6 of the module doc: the covariance ``s^2 (J^T J)^-1`` of the identifiable
+    parameters, ``s^2``, the residual sum of squares and the degrees of freedom."""
+    dof = max(r.rw.size - r.Jw.shape[1], 1)
+    rss = float((r.rw * r.rw).sum())
+    s2 = rss / dof
+    try:
+        JtJ_inv = np.linalg.inv(r.Jw.T @ r.Jw)
+    except np.linalg.LinAlgError:
+        JtJ_inv = np.linalg.pinv(r.Jw.T @ r.Jw)
+    return s2 * JtJ_inv, s2, rss, dof
+
+
+def _coupling(corr: Array, ident: Identifiability, d: PoseData,
+              allow_coupled: bool) -> list[str]:
+    """The warning (none or one) of parameters not identifiable or nearly combinations of
+    the others (multiple correlation at least :data:`COUPLING_LIMIT`); for poses ``d`` of a
+    single working mode a :class:`CouplingError` unless ``allow_coupled``."""
+    names, not_ident = ident.identifiable, ident.not_identifiable
+    mult = multiple_correlation(corr)
+    coupled = [names[i] for i in np.argsort(-mult) if mult[i] >= COUPLING_LIMIT]
+    if not (coupled or not_ident):
+        return []
+    what = "; ".join([*(ident.combinations[x] for x in not_ident),
+                      *([", ".join(f"{x} ({mult[names.index(x)]:.5f})" for x in coupled[:4])
+                         + (f" and {len(coupled) - 4} more" if len(coupled) > 4 else "")
+                         + " nearly combinations of the others (multiple correlation)"]
+                        if coupled else [])])
+    if len(set(d.modes)) != 1:
+        return [f"parameters coupled by these poses: {what}; not identifiable ones kept "
+                "nominal"]
+    text = (f"{d.source}: poses of the single working mode {d.modes[0]} leave "
+            f"parameters coupled: {what}; measure poses in other working modes too "
+            "(all four: dextar poses --modes all)")
+    if not allow_coupled:
+        raise CouplingError(text, tuple(dict.fromkeys([*not_ident, *coupled])))
+    return [text]
+
+
+def _chi_square(f: _Fitted, rss: float, dof: int, s2: float) -> tuple[float | None, int, str]:
+    """The reduced chi-square of a weighted fit (None unweighted), and the status and message
+    of the fit ``f``: status 2 when it converged but the residuals fail the chi-square test
+    at :data:`CHI2_ALPHA`."""
+    status, message = f.fit.status, f.fit.message
+    if f.W is None:
+        return None, status, message
+    from scipy.stats import chi2 as chi2_dist
+
+    pval = float(chi2_dist.sf(rss, dof))
+    if status == 0 and pval < CHI2_ALPHA:
+        return s2, 2, (f"the residuals are {math.sqrt(s2):.3g} times what the stated noise "
+                       f"explains (chi-square p = {pval:.2g}): the model misses something (a "
+                       "parameter held fixed, a wrong mode or assembly, play in a joint)")
+    return s2, status, message
+
+
+def _parameters(model_names: Sequence[str], ident_names: Sequence[str], p_start: Array,
+                p: Array, std: Array) -> tuple[Parameter, ...]:
+    """The model's parameters: nominal (``p_start``), fitted (``p``) and, for the
+    identifiable ones, the standard deviation ``std`` (in the order of ``ident_names``)."""
+    params = []
+    for name in model_names:
+        i = INDEX[name]
+        known = name in ident_names
+        params.append(Parameter(name, "m" if name in LENGTHS else "rad", float(p_start[i]),
+                                float(p[i]),
+                                float(std[ident_names.index(name)]) if known else None,
+                                known))
+    return tuple(params)
 
 
 def _enough(m: int, k: int, source: str, rejected: tuple[int, ...]) -> None:

@@ -306,18 +306,7 @@ def select_poses(nominal: KinematicModel, count: int, *,
     ParameterError
         Too few poses asked for, or fewer candidates than poses.
     """
-    if frame not in ("instrument", "robot"):
-        raise ParameterError(f"frame {frame!r} must be 'instrument' or 'robot'")
-    names = NAMES if frame == "instrument" else ROBOT
-    if not (isinstance(count, (int, np.integer)) and count >= 2 * len(names)):
-        raise ParameterError(f"{count!r} poses: a calibration of {len(names)} parameters "
-                             f"needs at least {2 * len(names)}")
-    if not (math.isfinite(margin) and 0.0 <= margin < 1.0):
-        raise ParameterError(f"singularity margin {margin!r} must be in [0, 1)")
-    if not 10 <= resolution <= 1001:
-        raise ParameterError(f"pose grid resolution {resolution} must be in 10 ... 1001")
-    if not modes:
-        raise ParameterError("no working mode to choose poses in")
+    names = _checked_parameters(frame, count, margin, resolution, modes)
     sign = parse_assembly_mode(assembly)
     r = nominal.robot
     if spacing is None:
@@ -331,34 +320,15 @@ def select_poses(nominal: KinematicModel, count: int, *,
             f"{n_c} candidate poses in working mode{'s' if len(mode_names) > 1 else ''} "
             f"{', '.join(mode_names)} (assembly {assembly}, margin {margin:g} from the "
             f"singularities), fewer than the {count} asked for: lower the margin or the count")
-    idx = [NAMES.index(x) for x in names]
     ident = identifiability(cand.J, names)
     if ident.not_identifiable:
         names = ident.identifiable
-        idx = [NAMES.index(x) for x in names]
     S = characteristic_scales(r)
-    Js = cand.J[:, :, idx] * S[idx]
-    if point_std is not None and reading_std is not None:
-        Jq = cand.J[:, :, 5:7]
-        Sig = point_std ** 2 * np.eye(2) + reading_std ** 2 * np.einsum("cik,cjk->cij", Jq, Jq)
-        Lc = np.linalg.cholesky(Sig)
-        Js = np.linalg.solve(Lc, Js) * point_std
+    Js = _information(cand.J, [NAMES.index(x) for x in names], S, point_std, reading_std)
     chosen, spaced = _d_optimal(Js, cand.modes, cand.P, int(count), float(spacing),
                                 passes)
-    # visiting order
-    order: list[int] = []
-    prev = None
-    for m in _gray_order([mode_names[i] for i in cand.modes[chosen]],
-                         canonical_working_mode(start_mode)):
-        sel = chosen[cand.modes[chosen] == mode_names.index(m)]
-        q = cand.q[sel]
-        begin = q[0] if prev is None else prev
-        tour = _tour(q, begin)
-        order.extend(int(sel[t]) for t in tour)
-        prev = q[tour[-1]]
-    o = np.array(order)
+    o = _visiting_order(cand, chosen, mode_names, canonical_working_mode(start_mode))
     obs = observability(cand.J[o], names, S)
-    status = 0 if spaced else 1
     msg = (f"{count} poses in {len(set(cand.modes[o].tolist()))} working modes from {n_c} "
            f"candidates: O1 {obs.o1:.4g}, O3 {obs.o3:.4g}, condition number "
            f"{obs.condition_number:.4g}")
@@ -367,4 +337,54 @@ def select_poses(nominal: KinematicModel, count: int, *,
     return PoseSelection(tuple(mode_names[i] for i in cand.modes[o]),
                          "up" if sign > 0 else "down",
                          cand.q[o] - nominal.offsets, cand.P[o], cand.type1[o],
-                         cand.type2[o], tuple(names), obs, "O1", n_c, status, msg)
+                         cand.type2[o], tuple(names), obs, "O1", n_c, 0 if spaced else 1, msg)
+
+
+def _checked_parameters(frame: str, count: int, margin: float, resolution: int,
+                        modes: Sequence[str]) -> tuple[str, ...]:
+    """The parameters of a calibration in ``frame``, the request of :func:`select_poses`
+    checked (:class:`ParameterError` naming what is wrong)."""
+    if frame not in ("instrument", "robot"):
+        raise ParameterError(f"frame {frame!r} must be 'instrument' or 'robot'")
+    names = NAMES if frame == "instrument" else ROBOT
+    if not (isinstance(count, (int, np.integer)) and count >= 2 * len(names)):
+        raise ParameterError(f"{count!r} poses: a calibration of {len(names)} parameters "
+                             f"needs at least {2 * len(names)}")
+    if not (math.isfinite(margin) and 0.0 <= margin < 1.0):
+        raise ParameterError(f"singularity margin {margin!r} must be in [0, 1)")
+    if not 10 <= resolution <= 1001:
+        raise ParameterError(f"pose grid resolution {resolution} must be in 10 ... 1001")
+    if not modes:
+        raise ParameterError("no working mode to choose poses in")
+    return names
+
+
+def _information(J: Array, idx: Sequence[int], S: Array, point_std: float | None,
+                 reading_std: float | None) -> Array:
+    """The candidates' scaled Jacobians (c, 2, k) of the parameters ``idx`` (scales ``S``),
+    whitened by each one's covariance ``sigma^2 I + s_r^2 J_q J_q^T`` (times ``sigma``)
+    when both noises are given (step 2 of the module doc)."""
+    Js = J[:, :, idx] * S[idx]
+    if point_std is None or reading_std is None:
+        return Js
+    Jq = J[:, :, 5:7]
+    Sig = point_std ** 2 * np.eye(2) + reading_std ** 2 * np.einsum("cik,cjk->cij", Jq, Jq)
+    Lc = np.linalg.cholesky(Sig)
+    return np.asarray(np.linalg.solve(Lc, Js) * point_std)
+
+
+def _visiting_order(cand: _Candidates, chosen: Array, mode_names: Sequence[str],
+                    start: str) -> Array:
+    """The chosen candidates' indices in visiting order (step 3 of the module doc): the
+    modes in Gray-code order from ``start``, each mode's poses by a tour from where the
+    previous mode's ended."""
+    order: list[int] = []
+    prev = None
+    for m in _gray_order([mode_names[i] for i in cand.modes[chosen]], start):
+        sel = chosen[cand.modes[chosen] == mode_names.index(m)]
+        q = cand.q[sel]
+        begin = q[0] if prev is None else prev
+        tour = _tour(q, begin)
+        order.extend(int(sel[t]) for t in tour)
+        prev = q[tour[-1]]
+    return np.array(order)

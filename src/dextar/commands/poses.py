@@ -58,7 +58,7 @@ def run(args: argparse.Namespace) -> Result:
     from ..calibration.poses import DEFAULT_MARGIN
     from ..config import load_scenario
     from ..geometry import WORKING_MODES
-    from ..output.calibration import poses_csv, poses_summary
+    from ..output.calibration import poses_csv, poses_payload, poses_text, poses_warnings
 
     target = out_file(args.out, ".csv")
     sc = load_scenario(args.config)
@@ -71,14 +71,6 @@ def run(args: argparse.Namespace) -> Result:
                        margin=DEFAULT_MARGIN if args.margin is None else args.margin,
                        point_std=point_std, reading_std=reading_std, seed=args.seed)
     where, data = write_or_hand_back(target, poses_csv(sel))
-    payload = {**poses_summary(sel), "out": where, "config": args.config or "defaults",
-               "frame": args.frame, "encoder_offset_deg": list(rt.encoder_offset_deg),
-               "units": "phi_deg, psi_deg: the encoder readings to command (geometric angle "
-                        "- [robot].encoder_offset_deg); x_mm, y_mm: the nominal point, robot "
-                        "frame"}
-    text = (f"{sel.message}\nwrote {where}: mode, assembly, phi_deg, psi_deg (encoder "
-            "readings to command), x_mm, y_mm (nominal point, robot frame); at each pose "
-            "record the readings and the measured point in phi_deg, psi_deg, x_mm, y_mm: "
-            "the file of dextar calibrate")
-    warnings = [] if sel.success else [f"dextar poses: warning: {sel.message}"]
-    return Result(payload, text, warnings, data)
+    payload = poses_payload(sel, where=where, config=args.config or "", frame=args.frame,
+                            encoder_offset_deg=rt.encoder_offset_deg)
+    return Result(payload, poses_text(sel, where), poses_warnings(sel), data)

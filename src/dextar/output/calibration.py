@@ -1,12 +1,16 @@
 """Writing a calibration: the measurement poses, the parameter table, the summary, the
 residual and accuracy figures, the report and the calibrated config (texts and Figure
-objects; the command writes them). Files speak mm, degrees and micrometres."""
+objects, written by :func:`write_calibration`), and what ``dextar poses`` and ``dextar
+calibrate`` say (payloads, words, warnings). Files speak mm, degrees and micrometres."""
 
 from __future__ import annotations
 
 import html
+import json
 import math
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -14,13 +18,14 @@ from matplotlib.figure import Figure
 
 from .._arrays import Array
 from ..calibration.accuracy import AccuracyMap
-from ..calibration.data import PoseData
+from ..calibration.data import PoseData, rows_text
 from ..calibration.fit import CalibrationResult, Errors
 from ..calibration.model import FRAME, KinematicModel, to_file_units
 from ..calibration.poses import PoseSelection
 from ..errors import NumericalError
 from ..geometry import WORKING_MODES, FiveBar
 from .config_file import toml_number as _num
+from .files import OutputDir
 from .html_page import figures, page
 
 #: Colour of each working mode in the figures.
@@ -426,8 +431,6 @@ def calibration_files(res: CalibrationResult, *, data: str, config: str = "",
     ``sigma_mm`` the instrument's noise (``[instrument].sigma_mm``), kept in the config. With ``outliers`` (the rows of a fit that kept them, see :func:`calibration_summary`)
     every file but ``calibrated.toml`` is written: a diagnosis, not a calibration.
     """
-    import json
-
     from ..calibration.accuracy import accuracy_map
     from ..calibration.fit import encoder_std
     from .figures import png_bytes
@@ -461,3 +464,146 @@ def calibration_files(res: CalibrationResult, *, data: str, config: str = "",
         files["accuracy.png"] = pngs["accuracy"]
         files["report.html"] = calibration_report(summary, pngs)
     return files
+
+
+# ------------------------------------------------------------------------ the commands' words
+#: Below this RMS error (m) of the nominal robot the measured points are its own predictions:
+#: a poses.csv, not measurements.
+NOMINAL_ECHO = 1e-9
+#: What the columns of a poses file of ``dextar poses`` are.
+POSES_UNITS = ("phi_deg, psi_deg: the encoder readings to command (geometric angle - "
+               "[robot].encoder_offset_deg); x_mm, y_mm: the nominal point, robot frame")
+
+
+def poses_payload(sel: PoseSelection, *, where: str, config: str, frame: str,
+                  encoder_offset_deg: Sequence[float]) -> dict[str, Any]:
+    """The JSON payload of ``dextar poses``: :func:`poses_summary`, where the file went
+    (``where``), the config (``""``: the defaults), the frame and the encoder offsets."""
+    return {**poses_summary(sel), "out": where, "config": config or "defaults",
+            "frame": frame, "encoder_offset_deg": list(encoder_offset_deg),
+            "units": POSES_UNITS}
+
+
+def poses_text(sel: PoseSelection, where: str) -> str:
+    """``dextar poses`` in words: the selection and what to record at each pose."""
+    return (f"{sel.message}\nwrote {where}: mode, assembly, phi_deg, psi_deg (encoder "
+            "readings to command), x_mm, y_mm (nominal point, robot frame); at each pose "
+            "record the readings and the measured point in phi_deg, psi_deg, x_mm, y_mm: "
+            "the file of dextar calibrate")
+
+
+def poses_warnings(sel: PoseSelection) -> list[str]:
+    """A warning when the selection relaxed its spacing."""
+    return [] if sel.success else [f"dextar poses: warning: {sel.message}"]
+
+
+def write_calibration(od: OutputDir, files: Mapping[str, str | bytes]) -> tuple[str, ...]:
+    """Write ``files`` (:func:`calibration_files`) into ``od`` in the order of
+    :data:`CALIBRATION_FILES`; the names written."""
+    with od:
+        for name in CALIBRATION_FILES:
+            content = files.get(name)
+            if isinstance(content, bytes):
+                od.write_bytes(name, content)
+            elif content is not None:
+                od.write_text(name, content)
+    return tuple(n for n in CALIBRATION_FILES if n in files)
+
+
+@dataclass(frozen=True)
+class CalibrationRun:
+    """What ``dextar calibrate`` says of a fit besides its files.
+
+    Attributes
+    ----------
+    result : CalibrationResult
+    out : str
+        The output directory as printed.
+    written : tuple of str
+        The files written there (:func:`write_calibration`).
+    outliers : tuple of int
+        Rows of the outliers the fit kept (a diagnosis; ``problem`` the error's words).
+    problem : str
+    robust : str or None
+        The robust loss asked for.
+    sigma_mm : float or None
+        The config's ``[instrument].sigma_mm``.
+    default_robot : FiveBar or None
+        The nominal robot (mm) when no config was given (a note names it), in
+        ``working_mode``.
+    working_mode : str
+    """
+
+    result: CalibrationResult
+    out: str
+    written: tuple[str, ...]
+    outliers: tuple[int, ...] = ()
+    problem: str = ""
+    robust: str | None = None
+    sigma_mm: float | None = None
+    default_robot: FiveBar | None = None
+    working_mode: str = ""
+
+    @property
+    def code(self) -> int:
+        """The exit status: 0 calibrated, 1 a fit that does not fit its data."""
+        return 0 if self.result.status == 0 and not self.outliers else 1
+
+    def payload(self, files: Mapping[str, str | bytes]) -> dict[str, Any]:
+        """The JSON payload: the summary of ``files``, the directory and the files."""
+        summary = files["summary.json"]
+        return {**json.loads(summary), "out": self.out, "files": list(self.written)}
+
+    def text(self) -> str:
+        """The fit in words: status, errors before and after, the parameters, the files."""
+        res = self.result
+        lines = [f"{STATUS_WORDS[OUTLIERS]}: {self.problem}" if self.outliers else res.message,
+                 _errors_line(f"{len(res.errors.rows)} poses", res.errors)
+                 + " (nominal robot -> calibrated)"]
+        if res.validation is not None:
+            lines.append(_errors_line(f"{len(res.validation.rows)} held-out poses",
+                                      res.validation))
+        for p in res.parameters:
+            unit, nom, val, std = p.in_file_units()
+            spread = f" +- {std:.3g}" if std is not None else " (not identifiable: nominal)"
+            lines.append(f"  {p.name:<10} {nom:12.6g} -> {val:12.6g}{spread} {unit}")
+        first, *rest = self.written
+        lines.append(f"wrote {Path(self.out) / first}, {', '.join(rest)}")
+        return "\n".join(lines)
+
+    def warnings(self) -> list[str]:
+        """The lines for stderr: the outliers and where their diagnosis is, or the status,
+        the rows rejected, the fit's warnings, a poses file given as measurements, the
+        nominal robot assumed."""
+        res = self.result
+        if self.outliers:  # one line: the rows, what to do, where the diagnosis is
+            return [f"dextar calibrate: {self.problem} (--robust soft_l1); the fit with them "
+                    f"kept is in {self.out} (no calibrated.toml)"]
+        out: list[str] = []
+        if res.status != 0:
+            stated = (f"; or [instrument].sigma_mm = {self.sigma_mm:g} mm understates the "
+                      "instrument's noise" if res.status == 2 and res.data.sigma is None
+                      and self.sigma_mm is not None else "")
+            out.append(f"dextar calibrate: {STATUS_WORDS.get(res.status)}: "
+                       f"{res.message}{stated}")
+        if res.rejected:
+            out.append(f"dextar calibrate: note: the robust loss {self.robust} rejected "
+                       f"row{'s' if len(res.rejected) > 1 else ''} "
+                       f"{rows_text(np.asarray(res.rejected))}")
+        out += [f"dextar calibrate: warning: {w}" for w in res.warnings]
+        if res.rms_error_before < NOMINAL_ECHO:
+            out.append("dextar calibrate: warning: the measured points are the nominal "
+                       f"robot's own predictions (RMS error {1e3 * res.rms_error_before:.2g} "
+                       "mm): is this the file of dextar poses rather than the measurements?")
+        if self.default_robot is not None:
+            g = self.default_robot
+            out.insert(0, f"dextar calibrate: note: no --config: the nominal robot is the "
+                       f"DexTAR (l1 = {g.l1:g}, l2 = {g.l2:g}, L1 = {g.L1:g}, L2 = {g.L2:g}, "
+                       f"d = {g.d:g} mm, encoder offsets 0, working mode {self.working_mode})")
+        return out
+
+
+def _errors_line(what: str, e: Errors) -> str:
+    """``what``: RMS and largest errors before -> after calibration (mm)."""
+    return (f"  {what}: RMS error {1e3 * e.rms_before:.4g} -> {1e3 * e.rms_after:.4g} mm, "
+            f"max {1e3 * e.max_before:.4g} -> {1e3 * e.max_after:.4g} mm")
