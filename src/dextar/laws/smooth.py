@@ -102,6 +102,8 @@ MAX_PROGRAMMES = 24
 #: the one after a refinement or a tightening (from a motion near the answer).
 START_DELTA = 0.3
 RESTART_DELTA = 0.1
+#: The trust region's share for ``T``: it moves by at most this times ``delta`` (relative).
+T_SHARE = 0.5
 #: Rounds of refinement after the output check, then of tightening.
 MAX_REFINE = 3
 MAX_TIGHTEN = 2
@@ -408,6 +410,13 @@ class _Rows:
             i -= n
         return "?"
 
+    def powers(self) -> Array:
+        """How each row's use scales with ``1 / T`` for a fixed normalised motion (about:
+        the speed cap 1, the torques and accelerations 2, the third-order limits 3; 0 for
+        the rows that do not scale)."""
+        p = {"second-order": 2.0, "cap": 1.0, "w>=0": 0.0}
+        return np.concatenate([np.full(n, p.get(name, 3.0)) for name, n in self.kinds])
+
     def linear(self, d_sigma: Array, d_w: Array, d_alpha: Array, d_T: float) -> Array:
         """The rows' linear model after a change of the knots' states and of ``T``."""
         k, C = self.k, self.C
@@ -505,7 +514,7 @@ class _Model:
             Fs.append(F3)
             Cs.append(C3)
             ks.append(k3)
-            names.append(f"third {th3[0] if len(th3) else 0:.2g}")
+            names.append("third")
         return _Rows(np.concatenate(Fs), np.concatenate(ks), np.concatenate(Cs),
                      tuple((n, len(f)) for n, f in zip(names, Fs, strict=True)))
 
@@ -636,7 +645,7 @@ class _Programme:
                        shape=(R, n))
         x0 = np.concatenate([mo.sigma, mo.w, mo.alpha, [mo.T, 0.0]])
         b = A @ x0 - rows.F[sel]
-        dT = 0.25 * delta
+        dT = T_SHARE * delta
         lo = np.concatenate([np.zeros(M + 1), np.zeros(M + 1), mo.alpha - delta * scale,
                              [mo.T * (1 - dT), 0.0]])
         hi = np.concatenate([np.full(M + 1, self.length), np.full(M + 1, np.inf),
@@ -649,6 +658,22 @@ class _Programme:
         cost[n - 2] = 1.0 / T_ref
         return linprog(cost, A_ub=A, b_ub=b, A_eq=self.A_eq, b_eq=np.zeros(2 * M),
                        bounds=np.stack([lo, hi], axis=1), method="highs-ds")
+
+
+def _time_scaled(model: _Model, J: Array, T: float) -> float:
+    """The duration that brings the normalised motion ``J`` just within its rows (a start
+    that is slower than the limits allow is sped up, one beyond them slowed down): each
+    row's use scales about as ``T^-p`` (:meth:`_Rows.powers`)."""
+    for _ in range(3):
+        rows = model.rows(_motion(model.mesh, J, T, model.length))
+        p = rows.powers()
+        use = np.maximum(rows.F + 1.0, 0.0)
+        on = p > 0
+        factor = float(np.max(use[on] ** (1.0 / p[on]))) if on.any() else 1.0
+        if abs(factor - 1.0) < 1e-3 and rows.F.max() <= 0.0:
+            break
+        T *= factor * (1 + 1e-4)
+    return T
 
 
 def _slp(model: _Model, J: Array, T: float, budget: int, delta: float) -> _Run:
@@ -703,7 +728,7 @@ def _slp(model: _Model, J: Array, T: float, budget: int, delta: float) -> _Run:
             print(f"    T {Tn:.7f} eps {eps:.1e} max row {new.F.max():.2e} "
                   f"({new.kind_of(i)}) rows {int(use.sum())}/{len(use)} pred {pred:.1e} "
                   f"ratio {ratio:.2f} delta {delta:.2g} nit {res.nit}")
-        step = max(float(np.abs(an - mo.alpha).max()) / scale, 4.0 * abs(Tn - T) / T)
+        step = max(float(np.abs(an - mo.alpha).max()) / scale, abs(Tn - T) / (T_SHARE * T))
         if DEBUG and ratio < -100:
             i = int(np.argmax(new.F))
             kk = int(new.k[i])
@@ -977,6 +1002,8 @@ def solve_jerk_limited_law(dynamics: PathDynamics, *, motors: MotorLimits | None
     while True:
         model = _Model(mesh, table, [c.scaled(scales) for c in second],
                        [c.scaled(scales) for c in third], length)
+        if programmes == 0:
+            T = _time_scaled(model, J, T)
         run = _slp(model, J, T, MAX_PROGRAMMES, delta)
         delta = RESTART_DELTA
         programmes += run.programmes
