@@ -8,13 +8,15 @@ import json
 import sys
 import time
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from ..analysis import Analysis
 from ..errors import DextarError
-from ..trajectory import Trajectory
 from .files import OutputDir
 from .tables import csv_text, run_columns
+
+if TYPE_CHECKING:
+    from ..analysis import Analysis
+    from ..trajectory import Trajectory
 
 #: Figures a run can draw (``[output].figures``).
 FIGURES = ("fig3", "fig4", "fig5", "fig6", "fig7", "fig8", "fig9", "workspace", "animation")
