@@ -32,6 +32,15 @@ def tight_layout(fig: Any) -> None:
     fig.set_layout_engine(None)
 
 
+def warm_up() -> None:
+    """Load the fonts and build matplotlib's mathtext parser (a fifth of a second the first
+    time in a process) before the figures are shared with a forked child
+    (:mod:`dextar.output.parallel`), which then starts with them instead of doing it again."""
+    fig = Figure(figsize=(1, 1))
+    fig.text(0.5, 0.5, r"$x$ x")
+    FigureCanvasAgg(fig).draw()  # type: ignore[no-untyped-call]  # matplotlib's Agg canvas
+
+
 def _labels(an: Analysis) -> dict[str, str]:
     n = an.inputs.units.names
     return {"t": f"time t [{n['time']}]", "E": f"energy [{n['energy']}]",

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+import signal
 import sys
 from collections.abc import Callable, Mapping
 from typing import Any, TypeVar
@@ -77,19 +78,21 @@ def _forked(jobs: Mapping[str, Job[R]], names: list[str],
             ok, theirs = receive.recv()
         except EOFError:  # the child died without a word
             ok, theirs = False, None
+        child.join()  # (it exits once its word is sent)
         if not ok:
             theirs = {n: jobs[n][0]() for n in names}
         out.update(theirs)
         return out
     finally:
         receive.close()
-        if child.is_alive():
+        if child.is_alive():  # this process failed or was interrupted: the child's work is moot
             child.terminate()
         child.join()
 
 
 def _child(jobs: Mapping[str, Job[Any]], names: list[str], send: Any) -> None:
     """The child's work: its jobs' results, or word that it failed (the parent redoes them)."""
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)  # ended by the parent: quietly
     result: tuple[bool, dict[str, Any] | None]
     try:
         result = (True, {n: jobs[n][0]() for n in names})

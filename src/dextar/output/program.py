@@ -20,7 +20,7 @@ from .._arrays import Array
 from ..geometry import FiveBar
 from ..kinematics import workspace_map
 from ..program import MoveTiming, ProgramResult, Sizing
-from .figures import plot_workspace, png_bytes, svg_bytes, tight_layout
+from .figures import plot_workspace, png_bytes, svg_bytes, tight_layout, warm_up
 from .files import OutputDir
 from .html_page import figures, grid, page
 from .tables import csv_text
@@ -122,6 +122,7 @@ def _figures(res: ProgramResult, summary: ProgramSummary, robot_mm: FiveBar, mod
         return png_bytes(fig), svg_bytes(fig)
 
     jobs: dict[str, Job[tuple[bytes, bytes]]] = {n: (partial(files, n), 1.0) for n in makers}
+    warm_up()
     return render(jobs)
 
 

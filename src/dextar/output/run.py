@@ -132,6 +132,7 @@ def _figures(an: Analysis, uniform: Any, wanted: tuple[str, ...], animation_fram
     if "animation" in wanted:
         jobs["animation"] = (lambda: {"animation.gif": fg.animation_gif(an, animation_frames)},
                              _COSTS["animation"])
+    fg.warm_up()
     return {k: v for part in render(jobs).values() for k, v in part.items()}
 
 
