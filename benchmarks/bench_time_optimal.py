@@ -1,25 +1,39 @@
-"""Our time-optimal law against toppra 0.6.10 on the same path, dynamics and grid, in one run.
+"""Our time-optimal law against toppra 0.6.10 on the same path, dynamics and grid, in one run,
+and where our time goes.
 
-Run: python benchmarks/bench_time_optimal.py   (toppra: pip install -e '.[bench]')
+Run: python benchmarks/bench_time_optimal.py [--rounds N]  (toppra: pip install -e '.[bench]')
 
 Both solve the same problem: the paper's semicircle in SI (0.1 kg end-effector, rods,
 rotors, gravity along -y), motor torque limits 0.5 N m, the interpolation discretisation on
-400 and 2000 segments. toppra gets the path dynamics as arrays (the coefficients ``a, b, c``
-of ``tau = a u + b x + c`` that ours computes, through a ``LinearConstraint``), so its time is
-its solver's; ours is timed end to end (coefficients, solve, and the output check that ours
-adds). Prints both times and both durations (floor: ours no slower than toppra, durations
-within 1e-4 relative).
+100, 400 and 2000 segments. toppra gets the path dynamics as arrays (the coefficients
+``a, b, c`` of ``tau = a u + b x + c`` that ours computes, through a ``LinearConstraint``), so
+its time is its solver's (the seidel solver wrapper, its fastest). Ours is timed end to end
+(``solve_time_optimal_law``: the coefficients, the solve and the output check, which toppra
+does not do) and in parts:
+
+* coefficients: the path dynamics on the grid (kinematics and the exact model);
+* rows + setup: the constraints' rows and their elimination for all stages at once (NumPy);
+* passes: the backward (controllable sets) and forward passes (pure Python loops);
+* check: the law sampled nine times a segment through the exact model (the inverse dynamics
+  of ``dextar.dynamics.exact`` on 9 N samples) and the ratios to the limits.
+
+"solver" is rows + setup + passes + the law: the part toppra's time is comparable with. The
+rounds interleave ours and toppra's (ratios taken round by round: the machine's speed drifts);
+best of the rounds, the median and the worst shown. Floor: ours end to end within 0.3 of
+toppra's time at 400 and 2000 segments and no slower at 100; durations within 1e-4.
 """
 
 from __future__ import annotations
 
+import argparse
 import time
+from collections import defaultdict
 
 import numpy as np
 
+import dextar.laws.time_optimal as to
 from dextar.config import scenario_from_dict
 from dextar.dynamics import RobotAlongPath
-from dextar.laws import solve_time_optimal_law
 
 DOC = {"path": {"type": "arc", "radius": 120.0},
        "inertia": {"effector_mass": 0.1, "proximal_mass": 0.03, "distal_mass": 0.02,
@@ -27,18 +41,60 @@ DOC = {"path": {"type": "arc", "radius": 120.0},
        "gravity": {"vector": [0.0, -9810.0]},
        "law": {"type": "time-optimal", "torque_limit": 0.5}, "output": {"units": "si"}}
 LIMIT = np.array([0.5, 0.5])
+GRIDS = (100, 400, 2000)
+
+#: The solver's parts, by the module functions that do them (older versions: what exists).
+PARTS = {"_rows": "rows + setup", "_stages": "rows + setup", "_controllable": "backward pass",
+         "_fastest": "forward pass", "_reachability": "rows + setup + passes", "_law": "law",
+         "ratios_by_kind": "check"}
 
 
-def best(fn, repeat: int = 15) -> tuple[float, object]:
-    out, t_best = None, np.inf
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        t_best = min(t_best, time.perf_counter() - t0)
-    return t_best, out
+class Timed:
+    """The robot along the path, its coefficients and check samples timed."""
+
+    def __init__(self, along: RobotAlongPath, acc: dict[str, float]) -> None:
+        self.along, self.acc = along, acc
+
+    @property
+    def length(self) -> float:
+        return self.along.length
+
+    def coefficients(self, s):
+        t = time.perf_counter()
+        out = self.along.coefficients(s)
+        self.acc["coefficients"] += time.perf_counter() - t
+        return out
+
+    def samples(self, law, times):
+        t = time.perf_counter()
+        out = self.along.samples(law, times)
+        self.acc["check"] += time.perf_counter() - t
+        return out
 
 
-def toppra_duration(along: RobotAlongPath, n: int) -> tuple[float, float]:
+def instrument(acc: dict[str, float]) -> None:
+    """Time the solver's module functions into ``acc`` (outermost call only)."""
+    depth = [0]
+    for name, part in PARTS.items():
+        fn = getattr(to, name, None)
+        if fn is None or (name == "_reachability" and hasattr(to, "_stages")):
+            continue  # (a version with the passes in functions of their own: those)
+
+        def timed(*a, _fn=fn, _part=part, **k):
+            depth[0] += 1
+            t = time.perf_counter()
+            try:
+                return _fn(*a, **k)
+            finally:
+                depth[0] -= 1
+                if depth[0] == 0:
+                    acc[_part] += time.perf_counter() - t
+
+        setattr(to, name, timed)
+
+
+def toppra_solver(along: RobotAlongPath, n: int):
+    """toppra's solve on our coefficients: (callable returning the duration)."""
     import toppra as ta
     from toppra.constraint.linear_constraint import (
         DiscretizationType,
@@ -69,34 +125,73 @@ def toppra_duration(along: RobotAlongPath, n: int) -> tuple[float, float]:
 
     grid = co.s
 
-    def solve() -> np.ndarray:
+    def solve() -> float:
         inst = ta.algorithm.TOPPRA([Torque()], JointPath(), gridpoints=grid,
                                    solver_wrapper="seidel")
         _, sd, _ = inst.compute_parameterization(0, 0)  # (sdd, sd, v)
-        return np.asarray(sd)
+        sd = np.asarray(sd)
+        return float(np.sum(2 * np.diff(grid) / (sd[:-1] + sd[1:])))
 
-    t, sd = best(solve)
-    sd = np.asarray(sd)
-    duration = float(np.sum(2 * np.diff(grid) / (sd[:-1] + sd[1:])))
-    return t, duration
+    return solve
+
+
+def spread(v: list[float], scale: float = 1e3) -> str:
+    return (f"best {min(v) * scale:7.2f} median {np.median(v) * scale:7.2f} worst "
+            f"{max(v) * scale:7.2f}")
 
 
 def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--rounds", type=int, default=15)
+    args = ap.parse_args()
     sc = scenario_from_dict(DOC)
     along = RobotAlongPath(sc.model(), sc.path, sc.mode, sc.units)
-    for n in (400, 2000):
-        t_ours, law = best(lambda n=n: solve_time_optimal_law(along, torque_limit=tuple(LIMIT),
-                                                               grid=n))
-        line = f"grid {n:5d}: ours {t_ours * 1e3:7.1f} ms, duration {law.duration:.8f} s"
+    acc: dict[str, float] = defaultdict(float)
+    instrument(acc)
+    timed = Timed(along, acc)
+    for n in GRIDS:
         try:
-            t_tp, d_tp = toppra_duration(along, n)
+            theirs = toppra_solver(along, n)
         except ImportError:
-            print(line + "; toppra not installed (pip install -e '.[bench]')")
+            theirs = None
+        ours_t, tp_t, parts = [], [], defaultdict(list)
+        law = None
+        for _ in range(args.rounds):
+            acc.clear()
+            t0 = time.perf_counter()
+            law = to.solve_time_optimal_law(timed, torque_limit=tuple(LIMIT), grid=n)
+            ours_t.append(time.perf_counter() - t0)
+            for k, v in acc.items():
+                parts[k].append(v)
+            parts["other"].append(ours_t[-1] - sum(acc.values()))
+            if theirs is not None:
+                t0 = time.perf_counter()
+                d_tp = theirs()
+                tp_t.append(time.perf_counter() - t0)
+        assert law is not None
+        solver = [sum(parts[p][i] for p in parts if p not in ("coefficients", "check",
+                                                             "other"))
+                  for i in range(args.rounds)]
+        print(f"grid {n:5d}: duration {law.duration:.10f} s, {law.solves} solve(s)")
+        print(f"  ours end to end   {spread(ours_t)} ms")
+        for p in ("coefficients", *sorted({v for v in PARTS.values()} & set(parts) - {"check"}),
+                  "check", "other"):
+            if p in parts:
+                print(f"    {p:22s}  {spread(parts[p])} ms")
+        print(f"  ours solver       {spread(solver)} ms (rows, setup, passes, law)")
+        if theirs is None:
+            print("  toppra not installed (pip install -e '.[bench]')")
             continue
         rel = abs(law.duration - d_tp) / d_tp
-        print(f"{line} | toppra {t_tp * 1e3:7.1f} ms, duration {d_tp:.8f} s | durations "
-              f"differ by {rel:.1e} relative; ours/toppra time {t_ours / t_tp:.2f}")
-    print("floor: ours no slower than toppra at both grids, durations within 1e-4")
+        r_all = np.array(ours_t) / np.array(tp_t)
+        r_solver = np.array(solver) / np.array(tp_t)
+        print(f"  toppra solver     {spread(tp_t)} ms, duration {d_tp:.10f} s (differs by "
+              f"{rel:.1e})")
+        print(f"  ours/toppra: end to end {min(ours_t) / min(tp_t):.2f} best/best, "
+              f"{np.median(r_all):.2f} median of the rounds' ratios; solver "
+              f"{min(solver) / min(tp_t):.2f} best/best, {np.median(r_solver):.2f} median")
+    print("floor: ours end to end <= 0.3 of toppra at 400 and 2000 segments, <= 1 at 100; "
+          "durations within 1e-4")
 
 
 if __name__ == "__main__":

@@ -1,5 +1,6 @@
 """Importing dextar is light and leaves no state behind (benchmarks/bench_import.py times it)."""
 
+import ast
 import subprocess
 import sys
 
@@ -20,3 +21,28 @@ def test_library_never_selects_a_matplotlib_backend():
     offenders = [p.name for p in src.rglob("*.py")
                  if "matplotlib.use(" in p.read_text() or "import matplotlib.pyplot" in p.read_text()]
     assert offenders == []
+
+
+def _loaded(code: str) -> list[str]:
+    """The heavy modules (scipy, matplotlib, PIL and dextar's stages that bring them) that
+    ``code`` leaves imported, in a fresh interpreter."""
+    probe = (f"import sys; {code}; print(sorted({{m.split('.')[0] if not m.startswith('dextar') "
+             "else m for m in sys.modules if m.split('.')[0] in ('scipy', 'matplotlib', 'PIL') "
+             "or m in ('dextar.laws', 'dextar.analysis', 'dextar.program', 'dextar.trajectory', "
+             "'dextar.output.figures')}))")
+    r = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True)
+    return ast.literal_eval(r.stdout)
+
+
+def test_the_command_line_and_its_parser_load_no_scipy_matplotlib_or_stages():
+    # the command modules import what their run needs inside it (start-up time:
+    # benchmarks/bench_start.py); the parser of every command is built here
+    assert _loaded("import dextar.cli") == []
+    assert _loaded("import dextar.cli; dextar.cli.build_parser()") == []
+
+
+def test_reading_a_robot_table_loads_no_scipy_and_no_stage_above_the_config():
+    # dextar ik / fk / workspace read [robot] only; a scenario's run objects import their
+    # stages when they are built
+    assert _loaded("from dextar.config import load_robot_table; load_robot_table(None)") == []
+    assert "scipy" in _loaded("from dextar.config import load_scenario; load_scenario(None)")

@@ -7,6 +7,7 @@ import subprocess
 import sys
 import time
 from html.parser import HTMLParser
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -128,8 +129,11 @@ def test_killed_run_leaves_no_partial_file(tmp_path, sig):
     proc = subprocess.Popen([sys.executable, "-m", "dextar", "run", "--out", str(out),
                              "--quiet"], stderr=subprocess.PIPE)
     deadline = time.time() + 60
-    while time.time() < deadline and not (out / "fig4.png").exists():
+    # trajectory.csv is written before the figures are drawn (they are written together
+    # when all are drawn): the signal lands while they are drawn
+    while time.time() < deadline and not (out / "trajectory.csv").exists():
         time.sleep(0.01)
+    time.sleep(0.2)
     proc.send_signal(sig)
     proc.wait(timeout=30)
     files = list(out.iterdir())
@@ -141,6 +145,43 @@ def test_killed_run_leaves_no_partial_file(tmp_path, sig):
         assert proc.returncode != 0 or (out / "summary.json").exists()
         assert b"Traceback" not in proc.stderr.read()
         assert not list(tmp_path.glob(".out.staging-*"))
+
+
+def _processes_writing(out):
+    """Processes whose command line names ``out`` (a run and its forked drawing child)."""
+    found = []
+    for p in Path("/proc").glob("[0-9]*/cmdline"):
+        try:
+            if str(out).encode() in p.read_bytes():
+                found.append(p.parent.name)
+        except OSError:
+            pass
+    return found
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="/proc and fork: Linux")
+def test_terminated_while_drawing_on_two_cores_leaves_no_process_and_no_traceback(tmp_path):
+    out = tmp_path / "out"
+    proc = subprocess.Popen([sys.executable, "-m", "dextar", "run", "--out", str(out),
+                             "--quiet"], stderr=subprocess.PIPE)
+    deadline = time.time() + 60
+    while time.time() < deadline and not (out / "trajectory.csv").exists():
+        time.sleep(0.005)  # the CSV is written just before the figures are drawn
+    time.sleep(0.2)
+    drawing = _processes_writing(out)
+    proc.send_signal(signal.SIGTERM)
+    proc.wait(timeout=30)
+    err = proc.stderr.read()
+    assert b"Traceback" not in err, err.decode()[-2000:]
+    if proc.returncode == 0:  # a loaded machine: the run ended before the signal; whole
+        assert (out / "summary.json").exists()
+        return
+    assert proc.returncode == 130 and b"interrupted" in err
+    assert not (out / "summary.json").exists()
+    assert not list(tmp_path.glob(".out.staging-*"))
+    time.sleep(0.2)
+    assert _processes_writing(out) == []  # the drawing child ended with the run
+    assert len(drawing) in (1, 2)  # the run, and its child when two CPUs are allowed
 
 
 def test_run_general_robot_without_paper_model(tmp_path, capsys):

@@ -24,8 +24,7 @@ from .kinematics import (
     direct_kinematics,
     elbows,
     inverse_kinematics,
-    joint_acceleration,
-    joint_velocity,
+    joint_rates,
     task_acceleration,
     working_mode,
 )
@@ -101,8 +100,8 @@ def path_motion(path: Path, law: Law, t: Array) -> tuple[Array, ...]:
     s, ds, dds, _ = law.evaluate(t)
     p = path.parameter_at(s)
     r, r1, r2, _ = path.derivatives(p)
-    v = np.linalg.norm(r1, axis=-1)
-    dv = np.sum(r1 * r2, axis=-1) / v
+    v = np.sqrt(r1[..., 0] * r1[..., 0] + r1[..., 1] * r1[..., 1])
+    dv = (r1[..., 0] * r2[..., 0] + r1[..., 1] * r2[..., 1]) / v
     dp = ds / v
     ddp = (dds - dv * dp * dp) / v
     dP = r1 * dp[:, None]
@@ -165,8 +164,7 @@ def sample_trajectory(robot: FiveBar, path: Path, law: Law, *, mode: str = "+-",
     if checked:
         check_poses(robot, q, P, tolerances=tolerances, where=where, point=words.point,
                     mode=mode)
-    dq = joint_velocity(robot, q, P, dP, tol=0.0)
-    ddq = joint_acceleration(robot, q, P, dq, dP, ddP, tol=0.0)
+    dq, ddq = joint_rates(robot, q, P, dP, ddP, tol=0.0)
     sig = assembly_mode(robot, q[:1], P[:1])  # the motion's, named by its first pose
     return Trajectory(robot, path, law, mode, assembly_mode_name(int(sig[0])), t, s, ds, dds,
                       p, dp, ddp, P, dP, ddP, q, dq, ddq)

@@ -13,26 +13,16 @@ from functools import cached_property
 from pathlib import Path as FilePath
 from typing import TYPE_CHECKING, Any, TypeVar
 
-from ..analysis import RunInputs
-from ..dynamics import Inertia, Model, RobotAlongPath
+from ..dynamics import Inertia, Model
 from ..errors import ConfigError, DextarError
 from ..geometry import FiveBar
 from ..kinematics.checker import Tolerances
-from ..laws import Law, LawRequest, law_type
 from ..motors import MotorLimits
 from ..params import read_params
 from ..paths import Path
-from ..program import Move, ProgramRequest
-from ..trajectory import Trajectory, check_path, sample_trajectory
 from ..units import SI, Units
 from .design import DesignTable
 from .program import ProgramTable, read_moves
-
-if TYPE_CHECKING:
-    from ..calibration import KinematicModel
-    from ..design.evaluate import Task
-    from ..design.space import DesignSpace
-    from ..program.drive import DriveUnits
 from .tables import (
     TABLES,
     ControlTable,
@@ -51,6 +41,19 @@ from .tables import (
     TolerancesTable,
 )
 from .toml import check_tables, read_config
+
+if TYPE_CHECKING:
+    from ..analysis import RunInputs
+    from ..calibration import KinematicModel
+    from ..design.evaluate import Task
+    from ..design.space import DesignSpace
+    from ..laws import Law
+    from ..program import Move, ProgramRequest
+    from ..program.drive import DriveUnits
+    from ..trajectory import Trajectory
+
+# The stages a scenario builds (laws, programs, the analysis) are imported by the methods
+# that build them: reading a config, or only its [robot] table, stays light.
 
 T = TypeVar("T", bound=Table)
 
@@ -300,6 +303,8 @@ class Scenario:
 
     def program_request(self) -> ProgramRequest:
         """The program of a task file (``[program]``, ``[[move]]``, ``[motors]``) in SI."""
+        from ..program import ProgramRequest
+
         if not self.moves:
             raise ConfigError("the task has no move: add [[move]] tables")
         m = self.si_model
@@ -332,6 +337,10 @@ class Scenario:
     def law(self, kind: str | None = None) -> Law:
         """The configured law, or the registered law ``kind`` with its defaults and the
         configured duration. The path is checked first (reach and singularities)."""
+        from ..dynamics.along_path import RobotAlongPath
+        from ..laws import LawRequest, law_type
+        from ..trajectory import check_path
+
         check_path(self.robot, self.path, mode=self.mode, tolerances=self.tolerances,
                    units=self.units)
         table = self.law_table
@@ -348,6 +357,8 @@ class Scenario:
 
     def inputs(self) -> RunInputs:
         """What the analysis of a run needs, in run units (no config beyond this point)."""
+        from ..analysis import RunInputs
+
         p = self.paper
         return RunInputs(self.robot, self.robot_mm, self.path, self.path_spec, self.mode,
                          self.assembly, self.inertia, self.units, self.output.samples,
@@ -356,6 +367,8 @@ class Scenario:
 
     def trajectory(self, law: Law | None = None, samples: int | None = None) -> Trajectory:
         """The law sampled along the path (``[output].samples`` by default)."""
+        from ..trajectory import sample_trajectory
+
         return sample_trajectory(self.robot, self.path, law or self.law(), mode=self.mode,
                                  samples=samples or self.output.samples,
                                  tolerances=self.tolerances, units=self.units)

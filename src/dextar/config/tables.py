@@ -14,19 +14,21 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any, ClassVar, TypeVar
+from typing import TYPE_CHECKING, Any, ClassVar, TypeVar
 
 from ..dynamics import Inertia, Rod
 from ..dynamics.friction import DEFAULT_COULOMB_SPEED_DEG_S
 from ..errors import ConfigError, DextarError
 from ..geometry import DEXTAR_MM, FiveBar, canonical_working_mode, parse_assembly_mode, preset
 from ..kinematics.checker import Tolerances
-from ..laws import LawType, law_type
 from ..motors import MotorLimits
 from ..output.run import FIGURES as FIGURES
 from ..params import Param, read_params, to_run_units
 from ..paths import Path, PathType, path_type
 from ..units import Units
+
+if TYPE_CHECKING:
+    from ..laws import LawType
 
 T = TypeVar("T", bound="Table")
 
@@ -217,12 +219,16 @@ class LawTable(Table):
         if "samples" in raw:
             raise ConfigError("config key [law].samples is not known: use [output].samples "
                               "(the number of samples written)")
+        from ..laws import law_type  # the laws (and scipy) only for a table that names one
+
         kind = law_type(raw.get("type", "optimal"))
         return cls(kind.name, read_params(cls.NAME, raw, kind.params, ignore=("type",)))
 
     @property
     def kind(self) -> LawType:
         """The registered law."""
+        from ..laws import law_type
+
         return law_type(self.type)
 
     def run_values(self, units: Units) -> dict[str, Any]:

@@ -13,7 +13,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy import ndimage
 
 from .._arrays import Array
 from ..dynamics import Inertia, Model, RobotAlongPath, Rod, inverse_dynamics
@@ -135,6 +134,8 @@ def usable_area_mm2(robot_mm: FiveBar, mode: str, start_mm: Sequence[float],
     x, y = ws.x, ws.y
     i = int(np.argmin(np.abs(y - start_mm[1])))
     j = int(np.argmin(np.abs(x - start_mm[0])))
+    from scipy import ndimage
+
     labels, _ = ndimage.label(free)
     lab = labels[i, j]
     if lab == 0:  # the start's cell is on the boundary of the grid's region: its neighbours

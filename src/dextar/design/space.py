@@ -14,7 +14,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.stats import qmc
 
 from .._arrays import Array
 from ..errors import ConfigError
@@ -100,6 +99,8 @@ class DesignSpace:
         k = len(self.dims)
         n = self.samples
         if self.sampling == "sobol":
+            from scipy.stats import qmc  # (scipy.stats costs half a second to import)
+
             with warnings.catch_warnings():  # not a power of 2: balance is not needed here
                 warnings.simplefilter("ignore", UserWarning)
                 u = qmc.Sobol(d=k, scramble=True, seed=self.seed).random(n)

@@ -13,13 +13,14 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .._arrays import Array
-from ..kinematics import direct_kinematics
+from ..geometry import assembly_mode_name
+from ..kinematics import assembly_mode, direct_kinematics, inverse_kinematics, joint_rates
 from ..laws import Law, UniformLaw
 from ..laws.constraints import JointSamples, PathCoefficients
 from ..laws.time_optimal import TimeOptimalLaw, solve_time_optimal_law
 from ..motors import MotorLimits
 from ..paths import Path
-from ..trajectory import JointLine, sample_trajectory
+from ..trajectory import JointLine, path_motion, sample_trajectory
 from ..units import Units
 from .exact import Model, inverse_dynamics, path_dynamics
 
@@ -62,11 +63,16 @@ class RobotAlongPath:
                                                                           assembly=assembly)
 
     def samples(self, law: Law, times: Array) -> JointSamples:
-        """``law`` at ``times`` through the exact model."""
-        tr = sample_trajectory(self.model.robot, self.path, law, mode=self.mode, times=times,
-                               checked=False)  # the path was checked by coefficients()
-        tau = inverse_dynamics(self._model(tr.assembly), tr.q, tr.dq, tr.ddq)
-        return JointSamples(tau, tr.dq, tr.ddq, np.asarray(times, float))
+        """``law`` at ``times`` through the exact model (the path was checked by
+        :meth:`coefficients`; the angles are not unwrapped: the model needs only their sines
+        and cosines)."""
+        robot = self.model.robot
+        P, dP, ddP = path_motion(self.path, law, np.asarray(times, float))[6:]
+        q = inverse_kinematics(robot, P, self.mode)
+        dq, ddq = joint_rates(robot, q, P, dP, ddP, tol=0.0)
+        assembly = assembly_mode_name(int(assembly_mode(robot, q[:1], P[:1])[0]))
+        return JointSamples(inverse_dynamics(self._model(assembly), q, dq, ddq), dq, ddq,
+                            np.asarray(times, float))
 
 
 def time_optimal_law(model: Model, path: Path, *,

@@ -6,8 +6,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.integrate import solve_ivp
-from scipy.interpolate import CubicSpline
 
 from .._arrays import Array
 from ..errors import ConvergenceError, ParameterError, SingularityError
@@ -63,6 +61,8 @@ def torques_from_samples(t: Array, tau: Array) -> TorqueFunction:
     tau = np.asarray(tau, dtype=float)
     if tau.shape != (t.size, 2):
         raise ParameterError(f"torque samples must have shape ({t.size}, 2), got {tau.shape}")
+    from scipy.interpolate import CubicSpline
+
     spl = CubicSpline(t, tau, axis=0)
 
     def fn(time: float, _q: Array, _dq: Array) -> Array:
@@ -91,6 +91,8 @@ def forward_dynamics(model: Model, torque: TorqueFunction, q0: object, dq0: obje
     ConvergenceError
         If the integrator fails.
     """
+    from scipy.integrate import solve_ivp
+
     t_eval = np.asarray(t_eval, dtype=float)
     if t_eval.ndim != 1 or t_eval.size < 2 or np.any(np.diff(t_eval) <= 0):
         raise ParameterError("t_eval must be an increasing sequence of at least two times")

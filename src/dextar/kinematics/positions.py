@@ -93,7 +93,8 @@ def inverse_kinematics(
                 raise _reach_error(P, shape, blk.start + j, float(rho2[j]), l, L, leg + 1)
             q[blk, leg] = ang
     q = q.reshape(P0.shape)
-    if unwrap and q.ndim > 1:
+    # np.unwrap changes nothing when no step reaches pi: the common case, seen at once
+    if unwrap and q.ndim > 1 and len(q) > 1 and not np.abs(np.diff(q, axis=0)).max() < np.pi:
         q = np.unwrap(q, axis=0)
     return q
 

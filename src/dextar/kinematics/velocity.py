@@ -195,8 +195,57 @@ def joint_velocity(
     Raises :class:`SingularityError` within ``tol`` of a serial singularity.
     """
     f = _frame(robot, q, points)
-    _raise_if_near(1, _type1(robot, f), tol, q, points)
-    dP = as_points(dpoints, "dpoints")
+    _check_type1(robot, f, tol, q, points)
+    return _rates(f, as_points(dpoints, "dpoints"))
+
+
+def joint_acceleration(
+    robot: FiveBar,
+    q: object,
+    points: object,
+    dq: object,
+    dpoints: object,
+    ddpoints: object,
+    *,
+    tol: float = DEFAULT_SINGULARITY_TOL,
+) -> Array:
+    """Actuator accelerations ``qddot = B^-1 (A Pddot - b)``, shape (..., 2)."""
+    f = _frame(robot, q, points)
+    _check_type1(robot, f, tol, q, points)
+    dq, dP, ddP = (
+        as_points(dq, "dq"),
+        as_points(dpoints, "dpoints"),
+        as_points(ddpoints, "ddpoints"),
+    )
+    return _accelerations(robot, f, dq, dP, ddP)
+
+
+def joint_rates(
+    robot: FiveBar,
+    q: object,
+    points: object,
+    dpoints: object,
+    ddpoints: object,
+    *,
+    tol: float = DEFAULT_SINGULARITY_TOL,
+) -> tuple[Array, Array]:
+    """Actuator rates and accelerations ``(qdot, qddot)`` (..., 2) from the end-effector's
+    velocity and acceleration: :func:`joint_velocity` and :func:`joint_acceleration` on one
+    set of kinematic quantities (the same numbers, computed once)."""
+    f = _frame(robot, q, points)
+    _check_type1(robot, f, tol, q, points)
+    dP, ddP = as_points(dpoints, "dpoints"), as_points(ddpoints, "ddpoints")
+    dq = _rates(f, dP)
+    return dq, _accelerations(robot, f, dq, dP, ddP)
+
+
+def _check_type1(robot: FiveBar, f: _Frame, tol: float, q: object, points: object) -> None:
+    if tol > 0:  # (a distance is never below a tolerance of zero)
+        _raise_if_near(1, _type1(robot, f), tol, q, points)
+
+
+def _rates(f: _Frame, dP: Array) -> Array:
+    """``qdot = B^-1 A Pdot``."""
     return np.stack(
         [
             (f.ux * dP[..., 0] + f.uy * dP[..., 1]) / f.b1,
@@ -221,24 +270,8 @@ def _bias(
     return bias1, bias2
 
 
-def joint_acceleration(
-    robot: FiveBar,
-    q: object,
-    points: object,
-    dq: object,
-    dpoints: object,
-    ddpoints: object,
-    *,
-    tol: float = DEFAULT_SINGULARITY_TOL,
-) -> Array:
-    """Actuator accelerations ``qddot = B^-1 (A Pddot - b)``, shape (..., 2)."""
-    f = _frame(robot, q, points)
-    _raise_if_near(1, _type1(robot, f), tol, q, points)
-    dq, dP, ddP = (
-        as_points(dq, "dq"),
-        as_points(dpoints, "dpoints"),
-        as_points(ddpoints, "ddpoints"),
-    )
+def _accelerations(robot: FiveBar, f: _Frame, dq: Array, dP: Array, ddP: Array) -> Array:
+    """``qddot = B^-1 (A Pddot - b)``."""
     bias1, bias2 = _bias(robot, f, dq, dP)
     return np.stack(
         [

@@ -565,8 +565,8 @@ class _Model:
             kk, tt = np.repeat(k, 2), np.repeat(theta, 2)
             for sign in (1.0, -1.0):
                 Fs.append(((sign * val - scale) / scale).reshape(-1))
-                g = [(sign * x / scale).reshape(-1) for x in (gs, gw, ga, gj)]
-                Cs.append(_local(h, kk, tt, *g,
+                g_s, g_w, g_a, g_j = ((sign * x / scale).reshape(-1) for x in (gs, gw, ga, gj))
+                Cs.append(_local(h, kk, tt, g_s, g_w, g_a, g_j,
                                  ((sign * gT - 3 * lim * T * T) / scale).reshape(-1)))
         if not Fs:
             return np.zeros(0), np.zeros((0, 5)), np.zeros(0, int)
@@ -857,7 +857,8 @@ def _fractions(start: _Start, table: _Table, cons: Sequence[Constraint], segment
     f[0], f[-1] = 0.0, 1.0
     # the joints: the nearest inner knot of each moves to where the start passes it
     joints = table.joints[(table.joints > 0) & (table.joints < s[-1])]
-    pin_f, pin_s = [], []
+    pin_f: list[float] = []
+    pin_s: list[float] = []
     for sj in joints:
         fj = float(np.interp(sj, s, t)) / start.T
         k = int(np.argmin(np.abs(f - fj)))

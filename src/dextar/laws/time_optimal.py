@@ -34,8 +34,9 @@ point, the motor and the torque.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -345,48 +346,106 @@ def _stage_rows(pu: Array, px: Array, ph: Array, xmax: Array, ds: Array
 
 def _reachability(co: PathCoefficients, ds: Array, constraints: Sequence[Constraint],
                   x0: Array | None, units: Units | None) -> Array:
-    """Squared speeds ``x`` at the grid points of the fastest admissible motion."""
-    Gu, Gx, h = _rows(co, ds, constraints, x0)
+    """Squared speeds ``x`` at the grid points of the fastest admissible motion: the
+    controllable sets from rest at the end backward, then the largest acceleration from rest
+    at the start forward."""
+    st = _stages(*_rows(co, ds, constraints, x0), ds)
     tmax = np.asarray(_torque_limit(constraints), float)  # for the words of an error
-    n = Gu.shape[0]
+
+    def unreachable(k: int) -> InfeasibleError:
+        return _unreachable(co, k, tmax, units)
+
+    K_lo, K_hi = _controllable(st, unreachable)
+    return _fastest(st, K_lo, K_hi, unreachable)
+
+
+#: Coefficients ``m, q`` of bounds ``m y + q`` for the sequential passes, every stage's as
+#: flat Python lists, stage ``k``'s at indices ``starts[k]`` to ``starts[k + 1]``.
+_Flat = tuple[list[float], list[float], list[int]]
+
+
+@dataclass(frozen=True)
+class _Stages:
+    """The stages' rows solved for ``u`` (Fourier-Motzkin elimination), for all stages at
+    once, in the form the passes evaluate (floats in lists: faster there than NumPy scalars).
+
+    With ``lo <= x' <= hi`` the next point's controllable set and ``x' = x + 2 ds u``, the
+    lower rows (``u >= a x + b``) give bounds on ``x`` linear in ``hi`` and the upper rows
+    (``u <= a x + b``) bounds linear in ``lo``; ``x <= m y + q`` and ``x >= m y + q``.
+    """
+
+    n: int
+    x_lo: list[float]  # the static interval of x: every row of the stage on its own
+    x_hi: list[float]
+    x_lo0: list[float]  # ... with the upper rows' bounds at lo = 0 (rest reachable next)
+    x_hi0: list[float]
+    hi_caps: _Flat  # x <= m hi + q
+    hi_floors: _Flat  # x >= m hi + q
+    upper: _Flat  # u <= a x + b, for the forward pass
+    lo_rows: tuple[Array, Array, Array, Array]  # m, q and the masks of x <= / >= m lo + q
+    two_ds: list[float]
+    half: list[float]  # 1 / (2 ds)
+
+    @cached_property
+    def lo_caps_floors(self) -> tuple[_Flat, _Flat]:
+        """The bounds linear in ``lo`` (needed only where rest is not reachable next)."""
+        m, q, caps, floors = self.lo_rows
+        return _flat(m, q, caps), _flat(m, q, floors)
+
+
+def _stages(Gu: Array, Gx: Array, h: Array, ds: Array) -> _Stages:
+    """Rows ``Gu u + Gx x <= h`` (N, m) of the stages of lengths ``ds`` (N,) as
+    :class:`_Stages`."""
     tiny = 1e-12 * (np.abs(Gu) + 2 * ds[:, None] * np.abs(Gx))
-    up, lo_, xonly = Gu > tiny, Gu < -tiny, np.abs(Gu) <= tiny
+    up, down, xonly = Gu > tiny, Gu < -tiny, np.abs(Gu) <= tiny
     with np.errstate(divide="ignore", invalid="ignore"):
         alpha = np.where(xonly, 0.0, -Gx / Gu)
         beta = np.where(xonly, 0.0, h / Gu)
         # u <= alpha x + beta (uppers), u >= alpha x + beta (lowers), active rows first
         au, bu = _compact(alpha, beta, up, np.inf)
-        al, bl = _compact(alpha, beta, lo_, -np.inf)
-        # static x-interval: every lower below every upper, and the x-only rows
-        c = al[:, None, :] - au[:, :, None]
-        d = bu[:, :, None] - bl[:, None, :]
-        hi_pairs = np.where(c > 0, d / c, np.inf)
-        lo_pairs = np.where(c < 0, d / c, -np.inf)
-        x_hi = np.minimum(hi_pairs.min(axis=(1, 2), initial=np.inf),
-                          np.where(xonly & (Gx > 0), h / Gx, np.inf).min(axis=1))
-        x_lo = np.maximum(lo_pairs.max(axis=(1, 2), initial=-np.inf),
-                          np.where(xonly & (Gx < 0), h / Gx, -np.inf).max(axis=1))
-        empty = ((c == 0) & (d < 0)).any(axis=(1, 2)) | (xonly & (Gx == 0) & (h < 0)).any(axis=1)
-    x_lo = np.where(empty, np.inf, np.maximum(x_lo, 0.0))
-    inv2 = (1.0 / (2 * ds))[:, None]
-    # The controllability rows lo <= x + 2 ds u <= hi combine with the static rows into bounds
-    # on x linear in hi (lower rows) or lo (upper rows): x <= m hi + q or x >= m hi + q. The
-    # coefficients are precomputed for all stages at once; the pass only evaluates them.
-    act_l, act_u = np.isfinite(bl), np.isfinite(bu)  # the compacted rows that are real
-    with np.errstate(divide="ignore", invalid="ignore"):
-        cl = al + inv2  # lower row vs u <= (hi - x) / (2 ds): cl x <= hi / (2 ds) - bl
+        al, bl = _compact(alpha, beta, down, -np.inf)
+        x_lo, x_hi = _static_interval(au, bu, al, bl, xonly, Gx, h)
+        inv2 = (1.0 / (2 * ds))[:, None]
+        # lower row vs u <= (hi - x) / (2 ds): cl x <= hi / (2 ds) - bl
+        cl = al + inv2
         m_l, q_l = inv2 / cl, -bl / cl
-        cu = -inv2 - au  # u >= (lo - x) / (2 ds) vs upper row: cu x <= bu - lo / (2 ds)
+        # u >= (lo - x) / (2 ds) vs upper row: cu x <= bu - lo / (2 ds)
+        cu = -inv2 - au
         m_u, q_u = -inv2 / cu, bu / cu
-    lhm, lhq, lhs = _flat(m_l, q_l, act_l & (cl > 0))  # x <= m hi + q
-    llm, llq, lls = _flat(m_l, q_l, act_l & (cl < 0))  # x >= m hi + q
-    uh, ul = act_u & (cu > 0), act_u & (cu < 0)
-    upper: list[tuple[list[float], list[float], list[int]]] = []  # made when lo > 0 first
-    aum, auq, aus = _flat(au, bu, act_u)  # u <= a x + b
-    XL, XH = x_lo.tolist(), x_hi.tolist()
-    # with lo = 0 (rest is reachable, the usual case) the upper rows' bounds are constants
-    XL0 = np.maximum(x_lo, np.where(ul, q_u, -np.inf).max(axis=1, initial=-np.inf)).tolist()
-    XH0 = np.minimum(x_hi, np.where(uh, q_u, np.inf).min(axis=1, initial=np.inf)).tolist()
+    real_l, real_u = np.isfinite(bl), np.isfinite(bu)  # the compacted rows that are real
+    caps, floors = real_u & (cu > 0), real_u & (cu < 0)
+    x_lo0 = np.maximum(x_lo, np.where(floors, q_u, -np.inf).max(axis=1, initial=-np.inf))
+    x_hi0 = np.minimum(x_hi, np.where(caps, q_u, np.inf).min(axis=1, initial=np.inf))
+    return _Stages(len(ds), x_lo.tolist(), x_hi.tolist(), x_lo0.tolist(), x_hi0.tolist(),
+                   _flat(m_l, q_l, real_l & (cl > 0)), _flat(m_l, q_l, real_l & (cl < 0)),
+                   _flat(au, bu, real_u), (m_u, q_u, caps, floors), (2 * ds).tolist(),
+                   inv2[:, 0].tolist())
+
+
+def _static_interval(au: Array, bu: Array, al: Array, bl: Array, xonly: Array, Gx: Array,
+                     h: Array) -> tuple[Array, Array]:
+    """The interval of ``x`` each stage allows on its own: every lower row below every upper
+    row (pairs of the compacted rows, (N, wu, wl)), and the rows in ``x`` alone (``xonly``);
+    empty (``lo = inf``) when some pair or row cannot hold."""
+    c = al[:, None, :] - au[:, :, None]
+    d = bu[:, :, None] - bl[:, None, :]
+    r = d / c
+    rx = h / Gx
+    x_hi = np.minimum(np.where(c > 0, r, np.inf).min(axis=(1, 2), initial=np.inf),
+                      np.where(xonly & (Gx > 0), rx, np.inf).min(axis=1))
+    x_lo = np.maximum(np.where(c < 0, r, -np.inf).max(axis=(1, 2), initial=-np.inf),
+                      np.where(xonly & (Gx < 0), rx, -np.inf).max(axis=1))
+    empty = ((c == 0) & (d < 0)).any(axis=(1, 2)) | (xonly & (Gx == 0) & (h < 0)).any(axis=1)
+    return np.where(empty, np.inf, np.maximum(x_lo, 0.0)), x_hi
+
+
+def _controllable(st: _Stages, unreachable: Callable[[int], InfeasibleError]
+                  ) -> tuple[list[float], list[float]]:
+    """The backward pass: the controllable interval ``[K_lo, K_hi]`` of ``x`` at each grid
+    point, from rest at the end."""
+    n = st.n
+    hcm, hcq, hcs = st.hi_caps
+    hfm, hfq, hfs = st.hi_floors
     K_lo, K_hi = [0.0] * (n + 1), [0.0] * (n + 1)
     big = 1e300  # an unbounded hi stays finite, so that 0 * hi is 0
     for k in range(n - 1, -1, -1):
@@ -394,36 +453,43 @@ def _reachability(co: PathCoefficients, ds: Array, constraints: Sequence[Constra
         if hi > big:  # (comparisons inline: builtin min and max calls cost more here)
             hi = big
         if lo == 0.0:
-            xl, xh = XL0[k], XH0[k]
-        else:
-            if not upper:  # x <= m lo + q, x >= m lo + q
-                upper += [_flat(m_u, q_u, uh), _flat(m_u, q_u, ul)]
-            (uhm, uhq, uhs), (ulm, ulq, uls) = upper
-            xl, xh = XL[k], XH[k]
-            for j in range(uhs[k], uhs[k + 1]):
-                v = uhm[j] * lo + uhq[j]
+            xl, xh = st.x_lo0[k], st.x_hi0[k]
+        else:  # x <= m lo + q, x >= m lo + q
+            (lcm, lcq, lcs), (lfm, lfq, lfs) = st.lo_caps_floors
+            xl, xh = st.x_lo[k], st.x_hi[k]
+            for j in range(lcs[k], lcs[k + 1]):
+                v = lcm[j] * lo + lcq[j]
                 if v < xh:
                     xh = v
-            for j in range(uls[k], uls[k + 1]):
-                v = ulm[j] * lo + ulq[j]
+            for j in range(lfs[k], lfs[k + 1]):
+                v = lfm[j] * lo + lfq[j]
                 if v > xl:
                     xl = v
-        for j in range(lhs[k], lhs[k + 1]):
-            v = lhm[j] * hi + lhq[j]
+        for j in range(hcs[k], hcs[k + 1]):
+            v = hcm[j] * hi + hcq[j]
             if v < xh:
                 xh = v
-        for j in range(lls[k], lls[k + 1]):
-            v = llm[j] * hi + llq[j]
+        for j in range(hfs[k], hfs[k + 1]):
+            v = hfm[j] * hi + hfq[j]
             if v > xl:
                 xl = v
         if xl > xh + 1e-12 * (1.0 + abs(xh)):
-            raise _unreachable(co, k, tmax, units)
+            raise unreachable(k)
         v = xh if xh < xl else xl
         K_lo[k], K_hi[k] = (v if v > 0.0 else 0.0), (xh if xh > 0.0 else 0.0)
     if K_lo[0] > 1e-12 * (1.0 + K_hi[0]):
-        raise _unreachable(co, 0, tmax, units)
+        raise unreachable(0)
+    return K_lo, K_hi
+
+
+def _fastest(st: _Stages, K_lo: list[float], K_hi: list[float],
+             unreachable: Callable[[int], InfeasibleError]) -> Array:
+    """The forward pass: from rest, the largest acceleration that every row allows and that
+    keeps the next point controllable; the squared speeds (N + 1,)."""
+    n = st.n
+    aum, auq, aus = st.upper
+    two_ds, half = st.two_ds, st.half
     x = [0.0] * (n + 1)
-    two_ds, half = (2 * ds).tolist(), inv2[:, 0].tolist()
     for k in range(n):
         xk = x[k]
         u_hi = (K_hi[k + 1] - xk) * half[k]
@@ -435,7 +501,7 @@ def _reachability(co: PathCoefficients, ds: Array, constraints: Sequence[Constra
         # (the lower rows hold at the largest acceleration: x[k] is controllable, so some
         # acceleration meets every row and reaches K[k + 1], and the largest one does)
         if u_lo > u_hi + 1e-9 * (1.0 + abs(u_hi)):
-            raise _unreachable(co, k, tmax, units)
+            raise unreachable(k)
         v = xk + two_ds[k] * u_hi
         if v < K_lo[k + 1]:
             v = K_lo[k + 1]
@@ -456,10 +522,8 @@ def _compact(m: Array, q: Array, active: Array, fill: float) -> tuple[Array, Arr
     return mm, qq
 
 
-def _flat(m: Array, q: Array, active: Array) -> tuple[list[float], list[float], list[int]]:
-    """The active coefficients of all stages (rows of the arrays (N, w)) as flat Python lists,
-    stage ``k``'s at indices ``starts[k]`` to ``starts[k + 1]``, for the sequential passes
-    (floats are faster there than NumPy scalars)."""
+def _flat(m: Array, q: Array, active: Array) -> _Flat:
+    """The active coefficients of all stages (rows of the arrays (N, w)) as flat lists."""
     starts = np.concatenate([[0], np.cumsum(active.sum(axis=1))]).tolist()
     return m[active].tolist(), q[active].tolist(), starts
 

@@ -7,7 +7,9 @@ from __future__ import annotations
 
 import html
 import json
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -19,7 +21,7 @@ from ..geometry import FiveBar
 from ..kinematics import workspace_map
 from ..program import MoveTiming, ProgramResult, RmsFit, Sizing
 from ..program.drive import DriveUnits, PvtPoints
-from .figures import plot_workspace, png_bytes, svg_bytes
+from .figures import plot_workspace, png_bytes, svg_bytes, tight_layout, warm_up
 from .files import OutputDir
 from .html_page import figures, grid, page
 from .tables import csv_text
@@ -148,13 +150,10 @@ def write_program(out: str, res: ProgramResult, summary: ProgramSummary, robot_m
             od.write_text("pvt.csv", _counts_csv((pvt or pvt_points(res, drive)).columns()))
         if with_figures:
             pngs: dict[str, bytes] = {}
-            for name, fig in (("moves", moves_figure(res, robot_mm, mode)),
-                              ("motion", motion_figure(res)),
-                              ("operating_points", operating_points_figure(res,
-                                                                           summary.sizing))):
-                pngs[name] = png_bytes(fig)
-                od.write_bytes(f"{name}.png", pngs[name])
-                od.write_bytes(f"{name}.svg", svg_bytes(fig))
+            for name, (png, svg) in _figures(res, summary, robot_mm, mode).items():
+                pngs[name] = png
+                od.write_bytes(f"{name}.png", png)
+                od.write_bytes(f"{name}.svg", svg)
             od.write_text("report.html", program_report(summary, pngs))
         od.write_text("summary.json", json.dumps(summary.as_json(), indent=2,
                                                  allow_nan=False) + "\n")
@@ -170,6 +169,25 @@ def _counts_csv(columns: dict[str, Array]) -> str:
                                                                        strict=True))
             for r in text[1:]]
     return "\n".join([text[0], *rows]) + "\n"
+
+
+def _figures(res: ProgramResult, summary: ProgramSummary, robot_mm: FiveBar, mode: str
+             ) -> dict[str, tuple[bytes, bytes]]:
+    """Each figure's PNG and SVG, drawn on two cores where there are two
+    (:mod:`dextar.output.parallel`)."""
+    from .parallel import Job, render
+
+    makers: dict[str, Callable[[], Figure]] = {
+        "moves": lambda: moves_figure(res, robot_mm, mode), "motion": lambda: motion_figure(res),
+        "operating_points": lambda: operating_points_figure(res, summary.sizing)}
+
+    def files(name: str) -> tuple[bytes, bytes]:
+        fig = makers[name]()
+        return png_bytes(fig), svg_bytes(fig)
+
+    jobs: dict[str, Job[tuple[bytes, bytes]]] = {n: (partial(files, n), 1.0) for n in makers}
+    warm_up()
+    return render(jobs)
 
 
 def moves_figure(res: ProgramResult, robot_mm: FiveBar, mode: str) -> Figure:
@@ -233,7 +251,7 @@ def motion_figure(res: ProgramResult) -> Figure:
     axes[0].legend(fontsize=8)
     axes[0].set_title("Joint motion and torques (dashed: the motors' limits; dotted: moves)",
                       fontsize=10)
-    fig.tight_layout()
+    tight_layout(fig)
     return fig
 
 
@@ -263,7 +281,7 @@ def operating_points_figure(res: ProgramResult, sizing: Sizing) -> Figure:
         ax.set_title(f"motor {'AD'[i]}", fontsize=10)
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7)
-    fig.tight_layout()
+    tight_layout(fig)
     return fig
 
 

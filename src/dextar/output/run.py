@@ -8,13 +8,16 @@ import json
 import sys
 import time
 from collections.abc import Callable
-from typing import Any
+from functools import partial
+from typing import TYPE_CHECKING, Any
 
-from ..analysis import Analysis
 from ..errors import DextarError
-from ..trajectory import Trajectory
 from .files import OutputDir
 from .tables import csv_text, run_columns
+
+if TYPE_CHECKING:
+    from ..analysis import Analysis
+    from ..trajectory import Trajectory
 
 #: Figures a run can draw (``[output].figures``).
 FIGURES = ("fig3", "fig4", "fig5", "fig6", "fig7", "fig8", "fig9", "workspace", "animation")
@@ -85,38 +88,52 @@ def write_run(od: OutputDir, an: Analysis, uniform: Trajectory, summary: dict[st
     if figures is None:
         figures = default_figures(an)
     stage("trajectory.csv", lambda: od.write_text("trajectory.csv", csv_text(run_columns(an))))
-    figs = stage("figures", lambda: _figures(an, uniform, od, figures))
-    gif = None
-    if "animation" in figures:
-        from .figures import animation_gif
-
-        gif = stage("animation.gif", lambda: animation_gif(an, animation_frames))
-        od.write_bytes("animation.gif", gif)
+    files = stage("figures and animation.gif",
+                  lambda: _figures(an, uniform, figures, animation_frames))
+    for name, data in files.items():
+        od.write_bytes(name, data)
+    pngs = {n[:-4]: files[n] for n in files if n.endswith(".png")}
     summary["timing_s"] = progress.timings
     summary["files"] = sorted(set(od.written) | {"summary.json", "report.html"})
-    stage("report.html", lambda: od.write_text("report.html", _report(an, summary, figs, gif)))
+    stage("report.html", lambda: od.write_text("report.html",
+                                               _report(an, summary, pngs,
+                                                       files.get("animation.gif"))))
     od.write_text("summary.json", json.dumps(summary, indent=2, allow_nan=False) + "\n")
 
 
-def _figures(an: Analysis, uniform: Any, od: OutputDir, wanted: tuple[str, ...]
+#: What each figure costs to draw, relative to the others (measured), to share them out.
+_COSTS = {"fig3": 1.0, "fig4": 0.8, "fig5": 0.7, "fig6": 1.0, "fig7": 1.0, "fig8": 0.9,
+          "fig9": 1.4, "workspace": 1.1, "animation": 1.8}
+
+
+def _figures(an: Analysis, uniform: Any, wanted: tuple[str, ...], animation_frames: int
              ) -> dict[str, bytes]:
+    """The figures in ``wanted`` (PNG, and SVG but for the workspace) and the animation, by
+    file name, drawn on two cores where there are two (:mod:`dextar.output.parallel`)."""
     from . import figures as fg
+    from .parallel import Job, render
 
     makers: dict[str, Callable[[], Any]] = {
         "fig3": lambda: fg.fig3(an, uniform), "fig4": lambda: fg.fig4(an),
         "fig5": lambda: fg.fig5(an), "fig6": lambda: fg.fig6(an), "fig7": lambda: fg.fig7(an),
         "fig8": lambda: fg.fig8(an), "fig9": lambda: fg.fig9(an),
         "workspace": lambda: fg.workspace_figure(an)}
-    pngs: dict[str, bytes] = {}
-    for name, make in makers.items():
-        if name not in wanted or (name in ("fig6", "fig7") and an.paper is None):
-            continue
-        fig = make()
-        pngs[name] = fg.png_bytes(fig)
-        od.write_bytes(f"{name}.png", pngs[name])
+
+    def files(name: str) -> dict[str, bytes]:
+        fig = makers[name]()
+        out = {f"{name}.png": fg.png_bytes(fig)}
         if name != "workspace":
-            od.write_bytes(f"{name}.svg", fg.svg_bytes(fig))
-    return pngs
+            out[f"{name}.svg"] = fg.svg_bytes(fig)
+        return out
+
+    jobs: dict[str, Job[dict[str, bytes]]] = {
+        name: (partial(files, name), _COSTS[name]) for name in makers
+        if name in wanted and not (name in ("fig6", "fig7") and an.paper is None)}
+    if "animation" in wanted:
+        jobs["animation"] = (lambda: {"animation.gif": fg.animation_gif(an, animation_frames)},
+                             _COSTS["animation"])
+    fg.warm_up()
+    return {k: v for part in render(jobs).values() for k, v in part.items()}
 
 
 def _report(an: Analysis, summary: dict[str, Any], pngs: dict[str, bytes],

@@ -13,14 +13,19 @@ import math
 from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from scipy.interpolate import CubicHermiteSpline, make_interp_spline
 
 from .._arrays import Array
 from ..errors import ParameterError
 from .expression import Expression
+
+if TYPE_CHECKING:
+    from scipy.interpolate import CubicHermiteSpline
+
+# scipy.interpolate is imported where a table or a spline is first built: it costs a third of
+# a second to import, and lines and arcs (closed forms) never need it.
 
 
 def _cross(a: Array, b: Array) -> Array:
@@ -96,11 +101,15 @@ class Path(ABC):
 
     @cached_property
     def _forward(self) -> CubicHermiteSpline:
+        from scipy.interpolate import CubicHermiteSpline
+
         nodes, s, v = self._table
         return CubicHermiteSpline(nodes, s, v)
 
     @cached_property
     def _inverse(self) -> CubicHermiteSpline:
+        from scipy.interpolate import CubicHermiteSpline
+
         nodes, s, v = self._table
         return CubicHermiteSpline(s, nodes, 1.0 / v)
 
@@ -251,6 +260,8 @@ class Spline(Path):
 
     @cached_property
     def _spl(self) -> Any:
+        from scipy.interpolate import make_interp_spline
+
         w = np.asarray(self.waypoints, dtype=float)
         if len(w) == 2:  # the straight segment (a quintic would overshoot it)
             return make_interp_spline(self._knots, w, k=1)

@@ -1,0 +1,86 @@
+"""The time-optimal solver's passes against linear programmes solved by scipy, on random
+stages, among them stages that need a least speed (the branch where rest is not reachable
+next is otherwise rare: no example or test path has it)."""
+
+import numpy as np
+import pytest
+from scipy.optimize import linprog
+
+from dextar.errors import InfeasibleError
+from dextar.laws.time_optimal import _controllable, _fastest, _stages
+
+
+def _random_stages(rng, n, floors, top=0.3):
+    """Rows ``Gu u + Gx x <= h`` (n, m): two torque-like pairs ``|a u + b x + c| <= T``, x >= 0
+    and a cap on x; ``floors`` stages also x >= a least squared speed."""
+    a = rng.uniform(0.5, 2.0, (n, 2)) * rng.choice([-1, 1], (n, 2))
+    b = rng.uniform(-1.0, 1.0, (n, 2))
+    c = rng.uniform(-0.2, 0.2, (n, 2))
+    T = np.ones((n, 2))
+    xmin = np.zeros(n)
+    xmin[floors] = rng.uniform(0.05, top, len(floors))
+    # and a steep upper row u <= 20 - 40 x before and at the floors: going faster costs
+    # acceleration, so reaching a least speed next caps this point's speed (x <= m lo + q)
+    steep = np.zeros(n)
+    steep[floors[0] - 4:floors[-1] + 1] = 1.0
+    Gu = np.concatenate([a, -a, np.zeros((n, 3)), steep[:, None]], axis=1)
+    Gx = np.concatenate([b, -b, -np.ones((n, 1)), np.ones((n, 1)), -np.ones((n, 1)),
+                         40 * steep[:, None]], axis=1)
+    h = np.concatenate([T - c, T + c, np.zeros((n, 1)), np.full((n, 1), 5.0), -xmin[:, None],
+                        np.where(steep > 0, 20.0, 1.0)[:, None]], axis=1)
+    ds = rng.uniform(0.01, 0.05, n)
+    return Gu, Gx, h, ds
+
+
+def _lp(obj_x, obj_u, Gu, Gx, h, ds, lo, hi, x=None):
+    """Optimum of ``obj_x x + obj_u u`` over the stage's rows and ``lo <= x + 2 ds u <= hi``
+    (``x`` fixed when given); None when infeasible."""
+    A = np.column_stack([Gx, Gu])
+    rows = [A, [[1.0, 2 * ds]], [[-1.0, -2 * ds]]]
+    rhs = [h, [hi], [-lo]]
+    bounds = [(0, None) if x is None else (x, x), (None, None)]
+    r = linprog([obj_x, obj_u], A_ub=np.vstack(rows), b_ub=np.concatenate(rhs), bounds=bounds,
+                method="highs")
+    return r.x if r.status == 0 else None
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_passes_agree_with_linear_programmes_also_where_a_least_speed_is_needed(seed):
+    rng = np.random.default_rng(seed)
+    n = 30
+    # even seeds: least speeds the motion can meet; odd: some that it cannot (no motion)
+    Gu, Gx, h, ds = _random_stages(rng, n, np.arange(12, 18), top=0.3 if seed % 2 == 0 else 4.0)
+    st = _stages(Gu, Gx, h, ds)
+
+    def unreachable(k):
+        return InfeasibleError(f"stage {k}")
+
+    try:
+        K_lo, K_hi = _controllable(st, unreachable)
+    except InfeasibleError:
+        K_lo = None
+    # the reference: the controllable sets stage by stage, backward from rest at the end
+    ref_lo, ref_hi, feasible = [0.0] * (n + 1), [0.0] * (n + 1), True
+    for k in range(n - 1, -1, -1):
+        top = _lp(-1.0, 0.0, Gu[k], Gx[k], h[k], ds[k], ref_lo[k + 1], ref_hi[k + 1])
+        low = _lp(1.0, 0.0, Gu[k], Gx[k], h[k], ds[k], ref_lo[k + 1], ref_hi[k + 1])
+        if top is None:
+            feasible = False
+            break
+        ref_hi[k], ref_lo[k] = top[0], low[0]
+    feasible = feasible and ref_lo[0] <= 1e-9
+    assert feasible == (seed % 2 == 0)  # both kinds of case occur
+    assert (K_lo is not None) == feasible
+    if not feasible:
+        return
+    assert np.allclose(K_hi, ref_hi, rtol=1e-9, atol=1e-12)
+    assert np.allclose(K_lo, ref_lo, rtol=1e-9, atol=1e-12)
+    assert max(K_lo[12:19]) > 0.01  # some stages cannot be left at rest: the lo > 0 branch ran
+    # forward: the largest acceleration at each point that keeps the next one controllable
+    x = _fastest(st, K_lo, K_hi, unreachable)
+    for k in range(n):
+        best = _lp(0.0, -1.0, Gu[k], Gx[k], h[k], ds[k], K_lo[k + 1], K_hi[k + 1], x=x[k])
+        assert best is not None
+        assert x[k + 1] == pytest.approx(x[k] + 2 * ds[k] * best[1], rel=1e-9, abs=1e-12) \
+            or k == n - 1
+    assert x[0] == x[-1] == 0.0

@@ -1,0 +1,57 @@
+"""Figure helpers: the animation's one palette, a laid-out figure saved without a re-layout."""
+
+import io
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from dextar.output.figures import _one_palette, png_bytes, svg_bytes, tight_layout
+
+
+def test_frames_share_one_palette_and_keep_their_colours():
+    rng = np.random.default_rng(3)
+    still = np.full((60, 80, 3), 255, np.uint8)
+    still[20:22, :] = (0, 0, 0)
+    frames = []
+    for k in range(6):  # a moving orange square with soft edges over the still part
+        f = still.copy()
+        f[10:20, 5 + 10 * k:15 + 10 * k] = (255, 127, 14)
+        f[9, 5 + 10 * k:15 + 10 * k] = (255, 200, 150)
+        frames.append(f)
+    frames[3][40:45, 40:45] = rng.integers(0, 256, (5, 5, 3), dtype=np.uint8)  # many colours
+    images = _one_palette(frames)
+    assert len(images) == 6 and all(im.mode == "P" for im in images)
+    assert len({bytes(im.getpalette()) for im in images}) == 1  # one palette
+    for f, im in zip(frames, images, strict=True):
+        back = np.asarray(im.convert("RGB"))
+        # the few colours of a drawing are exact (white stays white, not PIL's 252)
+        plain = np.ones(f.shape[:2], bool)
+        plain[40:45, 40:45] = False
+        assert np.array_equal(back[plain], f[plain])
+    # the noisy patch: every pixel takes its nearest palette colour
+    pal = np.asarray(images[3].getpalette(), int).reshape(-1, 3)
+    patch = frames[3][40:45, 40:45].reshape(-1, 1, 3).astype(int)
+    best = ((patch - pal[None]) ** 2).sum(-1).min(axis=1)
+    got = ((patch[:, 0] - np.asarray(images[3].convert("RGB"))[40:45, 40:45].reshape(-1, 3))
+           ** 2).sum(-1)
+    assert np.array_equal(got, best)
+
+
+def test_a_laid_out_figure_saves_the_same_bytes_without_its_layout_engine():
+    def figure():
+        fig = Figure(figsize=(3, 2))
+        ax = fig.subplots()
+        ax.plot([0, 1], [0, 2], label=r"$\varphi$")
+        ax.set_xlabel("time")
+        ax.legend()
+        return fig
+
+    plain = figure()
+    plain.tight_layout()
+    ours = figure()
+    tight_layout(ours)
+    assert plain.get_layout_engine() is not None  # matplotlib's placeholder: a second draw
+    assert ours.get_layout_engine() is None
+    assert png_bytes(ours, dpi=50) == png_bytes(plain, dpi=50)
+    assert b"<svg" in svg_bytes(ours)
+    assert io.BytesIO(png_bytes(ours, dpi=50)).read(8) == b"\x89PNG\r\n\x1a\n"

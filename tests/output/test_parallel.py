@@ -1,0 +1,63 @@
+"""Rendering shared with a forked child: the same results as in turn, errors raised here."""
+
+import os
+import sys
+
+import pytest
+
+from dextar.errors import ParameterError
+from dextar.output.parallel import _split, render
+
+fork_only = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="fork on Linux")
+
+
+def _jobs():
+    # each job says where it ran: the shared run must use two processes and agree otherwise
+    return {f"j{k}": (lambda k=k: (k * k, os.getpid()), float(k % 3 + 1)) for k in range(7)}
+
+
+@fork_only
+def test_two_processes_give_what_one_gives_in_the_jobs_order():
+    one = render(_jobs(), workers=1)
+    two = render(_jobs(), workers=2)
+    assert list(two) == list(_jobs()) == list(one)
+    assert {k: v[0] for k, v in two.items()} == {k: v[0] for k, v in one.items()}
+    assert {pid for _, pid in one.values()} == {os.getpid()}
+    assert len({pid for _, pid in two.values()}) == 2  # shared with a child
+
+
+def test_split_balances_the_costs_and_keeps_every_job():
+    jobs = {n: (lambda: None, c) for n, c in zip("abcdef", (5.0, 1.0, 1.0, 2.0, 2.0, 1.0),
+                                                   strict=True)}
+    here, there = _split(jobs, 2)
+    assert sorted(here + there) == sorted(jobs)
+    loads = [sum(jobs[n][1] for n in side) for side in (here, there)]
+    assert loads == [6.0, 6.0]
+    assert _split(jobs, 1) == (list(jobs), [])
+
+
+@fork_only
+def test_a_job_failing_in_the_child_raises_its_error_here():
+    calls = []
+
+    def bad():
+        calls.append(os.getpid())
+        raise ParameterError("job 'bad' cannot be drawn")
+
+    jobs = {"big": (lambda: 0, 10.0), "bad": (bad, 5.0)}  # "bad" is the child's
+    assert _split(jobs, 2) == (["big"], ["bad"])
+    with pytest.raises(ParameterError, match="job 'bad' cannot be drawn"):
+        render(jobs, workers=2)
+    assert calls == [os.getpid()]  # the child's failure is redone (and raised) here
+
+
+@fork_only
+def test_a_child_that_dies_is_replaced_by_this_process():
+    def dies():
+        if os.getpid() != parent:
+            os._exit(3)  # a child killed mid-job
+        return "drawn here"
+
+    parent = os.getpid()
+    jobs = {"big": (lambda: 1, 10.0), "dies": (dies, 5.0)}  # "dies" is the child's
+    assert render(jobs, workers=2) == {"big": 1, "dies": "drawn here"}
