@@ -173,8 +173,8 @@ def test_terminated_while_drawing_on_two_cores_leaves_no_process_and_no_tracebac
     proc.wait(timeout=30)
     err = proc.stderr.read()
     assert b"Traceback" not in err, err.decode()[-2000:]
-    if proc.returncode == 0:  # a loaded machine: the run ended before the signal; whole
-        assert (out / "summary.json").exists()
+    if proc.returncode in (0, -signal.SIGTERM):  # a loaded machine: the run had written its
+        assert (out / "summary.json").exists()  # files (the signal came as it exited)
         return
     assert proc.returncode == 130 and b"interrupted" in err
     assert not (out / "summary.json").exists()

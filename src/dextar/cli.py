@@ -63,8 +63,10 @@ def _command(name: str) -> ModuleType:
     return importlib.import_module(f".commands.{name}", __package__)
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The argument parser of every command."""
+def build_parser(only: str | None = None) -> argparse.ArgumentParser:
+    """The argument parser of every command (with ``only``, a command's name: every command
+    is listed, and only that one's arguments are added: what parsing its command line
+    needs, at a tenth of the cost)."""
     p = _Parser(prog="dextar", description="Five-bar (DexTAR) robot toolkit. Lengths in mm, "
                 "angles in degrees on the command line.")
     p.add_argument("--version", action="version", version=f"dextar {__version__}")
@@ -74,7 +76,8 @@ def build_parser() -> argparse.ArgumentParser:
         mod = _command(name)
         sp = sub.add_parser(mod.NAME, help=mod.HELP, description=mod.HELP)
         sp.registries = getattr(mod, "REGISTRIES_HELP", False)
-        mod.add_arguments(sp)
+        if only is None or only == mod.NAME:
+            mod.add_arguments(sp)
         p.get_default("parsers")[mod.NAME] = sp
         sp.set_defaults(run=mod.run)
     return p
@@ -96,9 +99,9 @@ def _emit(args: argparse.Namespace, res: Result) -> int:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line ``argv``; returns the exit status (0, 1 or 2; 130 on interrupt)."""
-    parser = build_parser()
     # negative numbers are values, not options: "dextar ik -10 120"
     argv = list(sys.argv[1:] if argv is None else argv)
+    parser = build_parser(argv[0] if argv and argv[0] in COMMANDS else None)
     try:
         args, extra = parser.parse_known_args(_protect_negatives(argv))
         if extra:  # the command's own parser says it, pointing to the command's help
@@ -110,33 +113,52 @@ def main(argv: Sequence[str] | None = None) -> int:
         with warnings.catch_warnings():  # numerical warnings of a failing solve: the error
             warnings.simplefilter("ignore", RuntimeWarning)  # that follows says it in words
             return _emit(args, args.run(args))
-    except DextarError as exc:
-        sys.stderr.write(f"dextar {args.command}: error: {exc}\n")
-        return 2
-    except OSError as exc:
-        sys.stderr.write(f"dextar {args.command}: error: {exc.strerror or exc}: "
-                         f"{exc.filename or ''}\n")
-        return 2
     except KeyboardInterrupt:
-        sys.stderr.write(f"dextar {args.command}: interrupted\n")
-        return 130
-    except Exception as exc:  # a bug, not bad input: still one line, no traceback
-        if os.environ.get("DEXTAR_DEBUG"):
-            raise
-        sys.stderr.write(f"dextar {args.command}: internal error: {type(exc).__name__}: {exc} "
+        return _interrupted(args.command)
+    except Exception as exc:
+        if _RECEIVED:  # the interrupt, seen through a library or a cut-short import
+            return _interrupted(args.command)
+        return _error(args.command, exc)
+
+
+def _interrupted(command: str) -> int:
+    sys.stderr.write(f"dextar {command}: interrupted\n")
+    return 130
+
+
+def _error(command: str, exc: Exception) -> int:
+    """One line on stderr for a command's error (bad input, a file, or a bug); 2."""
+    if isinstance(exc, DextarError):
+        sys.stderr.write(f"dextar {command}: error: {exc}\n")
+    elif isinstance(exc, OSError):
+        sys.stderr.write(f"dextar {command}: error: {exc.strerror or exc}: "
+                         f"{exc.filename or ''}\n")
+    elif os.environ.get("DEXTAR_DEBUG"):
+        raise exc
+    else:  # a bug, not bad input: still one line, no traceback
+        sys.stderr.write(f"dextar {command}: internal error: {type(exc).__name__}: {exc} "
                          "(set DEXTAR_DEBUG=1 for a traceback)\n")
-        return 2
+    return 2
+
+
+#: The interrupts (SIGINT, SIGTERM) this process received while a command ran.
+_RECEIVED: list[int] = []
 
 
 def _terminate_as_interrupt() -> None:
-    """SIGTERM unwinds like Ctrl-C, so staging files are removed on the way out."""
+    """SIGTERM unwinds like Ctrl-C, so staging files are removed on the way out; either is
+    noted, so that an error it causes on the way (a library that catches the interrupt and
+    fails later, a module whose import it cut short) is reported as the interrupt."""
     import signal
 
     def handler(signum: int, frame: object) -> None:
+        _RECEIVED.append(signum)
         raise KeyboardInterrupt
 
+    _RECEIVED.clear()
     try:
         signal.signal(signal.SIGTERM, handler)
+        signal.signal(signal.SIGINT, handler)
     except ValueError:  # not in the main thread (embedded use)
         pass
 

@@ -57,7 +57,7 @@ def test_a_fitted_trapezoid_is_the_shortest_within_the_motors(tmp_path, limits):
         'law = "min-jerk"\n', f'law = "trapezoid"\n{limits}')
     cfg = tmp_path / "task.toml"
     cfg.write_text(text)
-    assert main(["program", str(cfg), "--out", str(tmp_path / "o"), "--quiet"]) == 0
+    assert main(["program", "--no-figures", str(cfg), "--out", str(tmp_path / "o"), "--quiet"]) == 0
     sc = load_scenario(cfg)
     res = sc.program_request().plan()
     pm = next(p for p in res.moves if p.index == 6)
@@ -163,7 +163,7 @@ def test_csv_numbers_are_shortest_and_never_negative_zero(tmp_path):
     cfg = tmp_path / "task.toml"
     cfg.write_text((EXAMPLES / "mode_change.toml").read_text()
                    + "\n[output]\nservo_rate_hz = 2000\n")
-    assert main(["program", str(cfg), "--out", str(tmp_path / "o"), "--quiet"]) == 0
+    assert main(["program", "--no-figures", str(cfg), "--out", str(tmp_path / "o"), "--quiet"]) == 0
     lines = (tmp_path / "o" / "setpoints.csv").read_text().splitlines()[1:]
     cells = [c for line in lines for c in line.split(",")]
     assert "0.0005" in cells and not [c for c in cells if c in ("-0", "-0.0")]

@@ -325,8 +325,7 @@ def test_a_running_cluster_by_address_gives_the_same_file(sweep2, tmp_path):
     procs = [subprocess.Popen([str(dask_cli), "scheduler", "--host", "127.0.0.1", "--port",
                                str(port), "--no-dashboard"], start_new_session=True,
                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
-    try:
-        time.sleep(2)
+    try:  # the worker retries until the scheduler listens; the client waits for it
         procs.append(subprocess.Popen([str(dask_cli), "worker", address, "--nthreads", "1",
                                        "--no-dashboard"], start_new_session=True,
                                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))

@@ -44,7 +44,7 @@ def smooth(tmp_path_factory):
     d = tmp_path_factory.mktemp("smooth")
     cfg = d / "pp.toml"
     cfg.write_text(task(LIMITS, DRIVE))
-    assert main(["program", str(cfg), "--out", str(d / "o"), "--quiet"]) == 0
+    assert main(["program", "--no-figures", str(cfg), "--out", str(d / "o"), "--quiet"]) == 0
     return d / "o"
 
 
@@ -84,7 +84,7 @@ def test_jerk_limits_on_another_geometry(tmp_path):
     other = other.replace('preset = "dextar"', 'l1 = 70.0\nl2 = 70.0\nL1 = 110.0\nL2 = 110.0\n'
                           'd = 60.0')
     cfg.write_text(other)
-    assert main(["program", str(cfg), "--out", str(tmp_path / "o"), "--quiet"]) == 0
+    assert main(["program", "--no-figures", str(cfg), "--out", str(tmp_path / "o"), "--quiet"]) == 0
     s = json.loads((tmp_path / "o" / "summary.json").read_text())
     check_limits(columns(tmp_path / "o" / "setpoints.csv"), 40.0, 1500.0, 3.4,
                  30 * 2 * np.pi / 60, s["moves"])

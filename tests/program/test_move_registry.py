@@ -57,7 +57,7 @@ def nudge():
 def test_a_registered_move_type_plans_a_program(nudge, tmp_path, capsys):
     cfg = tmp_path / "task.toml"
     cfg.write_text(TASK)
-    assert main(["program", str(cfg), "--out", str(tmp_path / "o"), "--quiet"]) == 0
+    assert main(["program", "--no-figures", str(cfg), "--out", str(tmp_path / "o"), "--quiet"]) == 0
     s = json.loads((tmp_path / "o" / "summary.json").read_text())
     assert [m["type"] for m in s["moves"]] == ["nudge", "line", "nudge"]
     assert s["moves"][0]["blended_with_next"] and s["moves"][0]["law"] == "time-optimal"

@@ -25,8 +25,9 @@ def read(path):
 @pytest.fixture(scope="module")
 def pick_place(tmp_path_factory):
     out = tmp_path_factory.mktemp("pp") / "out"
-    assert main(["program", str(EXAMPLES / "pick_place.toml"), "--out", str(out),
+    assert main(["program", "--no-figures", str(EXAMPLES / "pick_place.toml"), "--out", str(out),
                  "--quiet"]) == 0
+    assert not [*out.glob("*.png"), *out.glob("*.svg"), *out.glob("*.html")]  # --no-figures
     head, data = read(out / "setpoints.csv")
     return dict(zip(head, data.T, strict=True)), json.loads((out / "summary.json").read_text())
 
@@ -111,7 +112,7 @@ def test_pd_loop_on_our_forward_dynamics_tracks_the_setpoints(tmp_path):
 
     out = tmp_path / "mc"
     cfg = EXAMPLES / "mode_change.toml"
-    assert main(["program", str(cfg), "--out", str(out), "--quiet"]) == 0
+    assert main(["program", "--no-figures", str(cfg), "--out", str(out), "--quiet"]) == 0
     head, data = read(out / "setpoints.csv")
     c = dict(zip(head, data.T, strict=True))
     m = load_scenario(str(cfg)).si_model
@@ -146,7 +147,7 @@ def test_pd_loop_on_our_forward_dynamics_tracks_the_setpoints(tmp_path):
 
 def test_mode_change_crosses_a_serial_singularity_smoothly(tmp_path):
     out = tmp_path / "mc"
-    assert main(["program", str(EXAMPLES / "mode_change.toml"), "--out", str(out),
+    assert main(["program", "--no-figures", str(EXAMPLES / "mode_change.toml"), "--out", str(out),
                  "--quiet"]) == 0
     s = json.loads((out / "summary.json").read_text())
     joint = s["moves"][1]
@@ -198,7 +199,7 @@ def test_a_program_that_exceeds_the_motors_exits_1_with_its_files(tmp_path, caps
     cfg.write_text(PROGRAM + '[[move]]\ntype = "line"\nto = [30.0, 120.0]\nlaw = "min-jerk"\n'
                    'duration = 0.01\n')
     out = tmp_path / "o"
-    assert main(["program", str(cfg), "--out", str(out), "--json"]) == 1
+    assert main(["program", "--no-figures", str(cfg), "--out", str(out), "--json"]) == 1
     io = capsys.readouterr()
     s = json.loads(io.out)
     assert s["status"] == "exceeds" and s["violations"][0]["move"] == 0
@@ -274,7 +275,7 @@ def test_the_readme_program_plans_within_the_motors(tmp_path):
     cfg = tmp_path / "readme.toml"
     cfg.write_text(re.search(r"```toml\n(\[motors\].*?)```", readme, re.S).group(1))
     out = tmp_path / "o"
-    assert main(["program", str(cfg), "--out", str(out), "--quiet"]) == 0
+    assert main(["program", "--no-figures", str(cfg), "--out", str(out), "--quiet"]) == 0
     s = json.loads((out / "summary.json").read_text())
     assert s["status"] == "fits" and s["moves"][0]["blended_with_next"]
     assert all(m["peak_torque_ratio"] <= 1 + 1e-3 for m in s["motors"])

@@ -13,14 +13,18 @@ HELP = ("plan a robot program under the motors: setpoints and sizing (exit 1 whe
 
 
 def add_arguments(sp: argparse.ArgumentParser) -> None:
-    """``config``, ``--out``, ``--force``, ``--quiet``, ``--json``."""
+    """``config``, ``--out``, ``--force``, ``--quiet``, ``--json``, ``--no-figures``."""
     config_argument(sp, required=True,
                     help="TOML task file with [program], [[move]] and [motors]")
     into_directory(sp)
+    sp.add_argument("--no-figures", dest="figures", action="store_false",
+                    help="write the setpoints, the drive's files and summary.json only (no "
+                         "figures, no report.html): for batches of programs")
 
 
 def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
-    """Plan, size, write, word."""
+    """Plan, size, write, word (the figures unless ``figures`` or ``--no-figures`` says
+    not)."""
     from ..config import load_scenario
     from ..output.program import ProgramSummary, write_program
     from ..program import sizing
@@ -38,7 +42,7 @@ def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
                              tuple(res.timeline()), sizing(res), res.rms_fit, report,
                              sc.robot_table.encoder_offset_deg)
     write_program(args.out, res, summary, sc.robot_mm, sc.program_mode, force=args.force,
-                  with_figures=figures, drive=drive, pvt=pvt)
+                  with_figures=figures and getattr(args, "figures", True), drive=drive, pvt=pvt)
     warnings = [f"dextar program: {v.text()}" for v in summary.sizing.violations]
     return Result(summary.as_json(), "\n".join(summary.lines(args.out, res.t.size)), warnings,
                   code=0 if summary.sizing.fits else 1)

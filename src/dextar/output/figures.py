@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import io
+import math
 from typing import TYPE_CHECKING, Any
 
 import matplotlib
@@ -164,7 +165,10 @@ def workspace_figure(an: Analysis) -> Any:
 
 
 def animation_gif(an: Analysis, frames: int = 41) -> bytes:
-    """A GIF of the robot following the path (``frames`` poses equally spaced in time).
+    """A GIF of the robot following the path, played in real time: at most ``frames``
+    poses, one every whole number of centiseconds (a GIF's clock; 20 ms at least, as
+    browsers play shorter delays slowly), the last at the end of the motion, then a pause
+    of :data:`ANIMATION_PAUSE_MS` before it loops.
 
     The still part (axes, path, pivots, title) is drawn once; each frame restores it and
     draws only the arm and the time over it (blitting), and the frames share one palette.
@@ -184,12 +188,19 @@ def animation_gif(an: Analysis, frames: int = 41) -> bytes:
     ax.set_xlim(pts[:, 0].min() - pad, pts[:, 0].max() + pad)
     ax.set_ylim(pts[:, 1].min() - pad, pts[:, 1].max() + pad)
     ax.set_aspect("equal")
-    ax.set_title(f"The robot following the path ({an.law.name} law)", fontsize=9)
+    length = an.inputs.units.names["length"]
+    ax.set_xlabel(f"x ({length})", fontsize=8)
+    ax.set_ylabel(f"y ({length})", fontsize=8)
+    ax.tick_params(labelsize=7)
+    ax.set_title(f"The robot following the path ({an.law.name} law), in real time",
+                 fontsize=9)
     tight_layout(fig)
     canvas.draw()  # type: ignore[no-untyped-call]  # matplotlib's Agg canvas is untyped
     still = canvas.copy_from_bbox(fig.bbox)  # type: ignore[no-untyped-call]  # the same
+    times_s = tr.t * an.inputs.units.time_s
+    index, durations = _real_time_frames(times_s - times_s[0], frames)
     rgb = []
-    for i in np.linspace(0, len(tr.t) - 1, frames).round().astype(int):
+    for i in index:
         canvas.restore_region(still)  # type: ignore[no-untyped-call]  # the same
         arm.set_data([r.A[0], B[i, 0], tr.P[i, 0], C[i, 0], r.D[0]],
                      [r.A[1], B[i, 1], tr.P[i, 1], C[i, 1], r.D[1]])
@@ -200,9 +211,32 @@ def animation_gif(an: Analysis, frames: int = 41) -> bytes:
         rgb.append(np.asarray(rgba)[..., :3].copy())
     images = _one_palette(rgb)
     buf = io.BytesIO()
-    images[0].save(buf, format="GIF", save_all=True, append_images=images[1:], duration=80,
-                   loop=0)
+    images[0].save(buf, format="GIF", save_all=True, append_images=images[1:],
+                   duration=durations, loop=0)
     return buf.getvalue()
+
+
+#: The animation's pause on its last frame before it loops (ms).
+ANIMATION_PAUSE_MS = 600
+#: The shortest delay between frames (ms): browsers play shorter GIF delays at 100 ms.
+MIN_FRAME_MS = 20
+
+
+def _real_time_frames(t_s: Array, frames: int) -> tuple[Array, list[int]]:
+    """The sample indices shown (at most ``frames``, the first and the last sample among
+    them) and each frame's delay in ms, so that the motion ``t_s`` (seconds from 0, rising)
+    plays in real time: a frame every ``step`` ms (whole centiseconds), the last one at the
+    motion's end within 5 ms."""
+    total_ms = 1e3 * float(t_s[-1])
+    step = max(MIN_FRAME_MS, 10 * math.ceil(total_ms / max(frames - 1, 1) / 10))
+    at = np.arange(0.0, total_ms, step)
+    if len(at) > 1 and total_ms - at[-1] < MIN_FRAME_MS:
+        at = at[:-1]  # the last gap too short to play: the one before takes it
+    at = np.append(at, total_ms)
+    index = np.minimum(np.searchsorted(t_s * 1e3, at - 1e-9), len(t_s) - 1)
+    gaps = np.diff(at)
+    delays = [int(step)] * (len(gaps) - 1) + [int(10 * round(gaps[-1] / 10))] if len(gaps) else []
+    return index, [*delays, ANIMATION_PAUSE_MS]
 
 
 def _one_palette(frames: list[Array]) -> list[Any]:

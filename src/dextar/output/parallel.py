@@ -47,6 +47,10 @@ def render(jobs: Mapping[str, Job[R]], *, workers: int | None = None) -> dict[st
     return {n: results[n] for n in jobs}
 
 
+#: The signals held while forking.
+_INTERRUPTS = {signal.SIGINT, signal.SIGTERM}
+
+
 def _split(jobs: Mapping[str, Job[Any]], parts: int) -> tuple[list[str], list[str]]:
     """The jobs of this process and of the child: the costliest first, each to the lighter
     side (the child's side gets no more than this one's)."""
@@ -70,7 +74,13 @@ def _forked(jobs: Mapping[str, Job[R]], names: list[str],
         stream.flush()
     receive, send = ctx.Pipe(duplex=False)
     child = ctx.Process(target=_child, args=(jobs, names, send), daemon=True)
-    child.start()
+    # no interrupt inside the fork (its handlers, logging's and ours, would swallow it):
+    # one that comes is held until the child exists, then raised here
+    held = signal.pthread_sigmask(signal.SIG_BLOCK, _INTERRUPTS)
+    try:
+        child.start()
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, held)
     send.close()
     try:
         out = mine()
@@ -93,6 +103,7 @@ def _forked(jobs: Mapping[str, Job[R]], names: list[str],
 def _child(jobs: Mapping[str, Job[Any]], names: list[str], send: Any) -> None:
     """The child's work: its jobs' results, or word that it failed (the parent redoes them)."""
     signal.signal(signal.SIGTERM, signal.SIG_DFL)  # ended by the parent: quietly
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, _INTERRUPTS)  # held by the fork
     result: tuple[bool, dict[str, Any] | None]
     try:
         result = (True, {n: jobs[n][0]() for n in names})

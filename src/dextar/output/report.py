@@ -145,7 +145,8 @@ def _figures(s: dict[str, Any], pngs: dict[str, bytes], gif: bytes | None) -> st
     law = s["law"]["type"]
     parts = [image(data, name, _caption(name, law)) for name, data in pngs.items()]
     if gif is not None:
-        parts.append(image(gif, "animation", f"The robot following the path ({law} law).",
+        parts.append(image(gif, "animation",
+                           f"The robot following the path ({law} law), in real time.",
                            mime="image/gif"))
     return "".join(parts)
 
