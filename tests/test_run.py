@@ -29,7 +29,7 @@ RUN_COLUMNS = ["t_T", "p", "dp_per_T", "ddp_per_T2", "x_L", "y_L", "dx_L_T", "dy
                "effector_energy_beta0_mL2_T2"]
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def run_dir(tmp_path_factory):
     out = tmp_path_factory.mktemp("run") / "dextar-out"
     assert main(["run", "--out", str(out), "--quiet"]) == 0

@@ -10,7 +10,7 @@ ROBOT = dx.DEXTAR_MM.scaled(1 / 87)  # paper units: L = 1
 SEMI = Arc(120 / 87, 0.0, np.pi)
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def paper():
     return sample_trajectory(ROBOT, SEMI, solve_optimal_law(SEMI, eta=0.1), samples=4001)
 

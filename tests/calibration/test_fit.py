@@ -31,7 +31,7 @@ def _delta(res, true):
     return d[[cal.NAMES.index(n) for n in res.identifiable]]
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def runs(four_modes, one_mode, held_out):
     """Each seed and noise: the truth, the data, the fits of four modes and of one, a fit
     with the encoder offsets frozen (the wrong model) and 30 targets reached end to end."""
@@ -144,7 +144,7 @@ def test_the_wrong_model_is_caught(runs):
 
 
 # ------------------------------------------------------------------------ one data set
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def case(four_modes, held_out):
     rng = np.random.default_rng(42)
     true = true_robot(rng)

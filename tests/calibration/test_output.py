@@ -18,7 +18,7 @@ from dextar.output import calibration as out
 from .conftest import COUNT, NOMINAL
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def result(four_modes, held_out):
     rng = np.random.default_rng(7)
     true = cal.perturbed(NOMINAL, rng)

@@ -78,7 +78,7 @@ def read_rows(path):
         return list(csv.reader(fh))
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def story(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("calibration")
     cfg = tmp / "robot.toml"

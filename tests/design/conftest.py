@@ -7,13 +7,6 @@ import pytest
 distributed = pytest.importorskip("distributed")
 
 
-def pytest_collection_modifyitems(items):
-    # one xdist worker runs every design test, so one cluster serves them all
-    for item in items:
-        if "tests/design/" in str(item.fspath).replace("\\", "/"):
-            item.add_marker(pytest.mark.xdist_group("dask"))
-
-
 @pytest.fixture(scope="session")
 def scheduler():
     """The address of the session's cluster."""

@@ -67,7 +67,7 @@ def rows_of(out: Path) -> list[dict]:
     return [parse_line(x) for x in lines]
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def sweep2(tmp_path_factory, scheduler):
     """The task swept on the session's two workers."""
     folder = tmp_path_factory.mktemp("sweep")

@@ -23,7 +23,7 @@ from dextar.program import plan_program
 from ..program.test_program import EXAMPLES
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def region(prior):
     """The joint region of the pick-and-place program (time-optimal: its peak speeds are 98 %
     of the motors')."""
@@ -34,7 +34,7 @@ def region(prior):
     return JointRegion.from_samples(res.q, res.dq)
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def designed(prior, base, region):
     model, mode, motors = prior
     return design_excitation(model, mode, harmonics=4, starts=2, duration=10.0, motors=motors,

@@ -42,7 +42,7 @@ def semicircle_motion():
     return motion, float(tr.t[-1])
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def runs(prior):
     model = prior[0]
     true = H.true_robot(model)

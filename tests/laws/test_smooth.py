@@ -15,7 +15,7 @@ from dextar.trajectory import JointLine
 from ..program.test_program import EXAMPLES
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def model():
     from dextar.config import load_scenario
 

@@ -20,7 +20,7 @@ def peak_torque(model, path, law, n=2001):
     return np.abs(inverse_dynamics(model, tr.q, tr.dq, tr.ddq)).max(axis=0)
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def law():
     return solve_time_optimal_law(MODEL, SEMI, torque_limit=(20.0, 20.0), grid=400)
 

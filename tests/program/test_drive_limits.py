@@ -39,7 +39,7 @@ def task(extra_motors="", tables="", program="", moves=None):
     return head + tables + "\n" + sep + rest
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def smooth(tmp_path_factory):
     d = tmp_path_factory.mktemp("smooth")
     cfg = d / "pp.toml"

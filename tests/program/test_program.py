@@ -22,7 +22,7 @@ def read(path):
     return rows[0], np.array(rows[1:], float)
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def pick_place(tmp_path_factory):
     out = tmp_path_factory.mktemp("pp") / "out"
     assert main(["program", "--no-figures", str(EXAMPLES / "pick_place.toml"), "--out", str(out),

@@ -15,7 +15,7 @@ LINE = Line((-0.5, 1.1), (0.5, 1.3))
 MODEL = Model(ROBOT, paper_inertia(ROBOT).with_(gravity=(0.0, -2.0), rotor=(0.01, 0.01)))
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def traj():
     return sample_trajectory(ROBOT, LINE, MinimumJerkLaw(LINE.length, 1.0), samples=401)
 
