@@ -37,7 +37,8 @@ ARGS = {"ik": ["0", "120"], "fk": ["60", "120"], "workspace": ["--out", "w.png"]
         "export": ["mjcf", "--out", "m.xml"], "program": ["task.toml", "--out", "p"],
         "excite": ["task.toml", "--out", "e.csv"],
         "identify": ["e.csv", "--config", "task.toml", "--out", "i"],
-        "design": ["task.toml", "--out", "d"], "run": []}
+        "design": ["task.toml", "--out", "d"], "poses": ["task.toml", "--count", "20", "--out", "poses.csv"],
+        "calibrate": ["poses.csv", "--config", "task.toml", "--out", "c"], "run": []}
 
 
 def timed(argv: list[str], runs: int) -> list[float]:

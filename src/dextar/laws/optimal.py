@@ -47,8 +47,6 @@ from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.polynomial import chebyshev as cheb
-from scipy.integrate import solve_bvp
-from scipy.interpolate import make_interp_spline
 
 from .._arrays import Array
 from ..errors import ConvergenceError, ParameterError
@@ -770,6 +768,9 @@ def _solve_local(path: Path, S: float, G: float, tol: float) -> _Solution:
     refinement (scipy's solve_bvp), by continuation in the curvature (``kappa -> lam kappa``,
     ``lam`` from 0, the straight line whose solution is exact, to 1) with adaptive steps, at
     most MAX_CONTINUATION_SOLVES solves."""
+    from scipy.integrate import solve_bvp
+    from scipy.interpolate import make_interp_spline
+
     # curvature along the normalised arc length, tabulated once at 4097 nodes and interpolated
     # by a quintic spline (smooth, so the mesh refinement does not chase interpolation kinks)
     grid = np.linspace(0.0, 1.0, 4097)

@@ -66,8 +66,6 @@ from functools import cached_property
 from typing import Any
 
 import numpy as np
-from scipy.optimize import linprog
-from scipy.sparse import csr_matrix
 
 from .._arrays import Array
 from ..errors import ParameterError
@@ -619,6 +617,8 @@ class _Programme:
                                         1).reshape(-1),
                                np.stack([np.ones(M), -np.ones(M), -h, -h * h / 3, -h * h / 6],
                                         1).reshape(-1)])
+        from scipy.sparse import csr_matrix
+
         self.A_eq = csr_matrix((vals, (rows, cols)), shape=(2 * M, n))
         self.cost = np.zeros(n)
         self.cost[n - 2], self.cost[n - 1] = 1.0, PENALTY
@@ -641,6 +641,9 @@ class _Programme:
         cols = np.stack([k, M + 1 + k, 2 * (M + 1) + k, 2 * (M + 1) + k + 1,
                          np.full(R, n - 2), np.full(R, n - 1)], axis=1)
         vals = np.concatenate([C, -np.ones((R, 1))], axis=1)
+        from scipy.optimize import linprog
+        from scipy.sparse import csr_matrix
+
         A = csr_matrix((vals.reshape(-1), (np.repeat(np.arange(R), 6), cols.reshape(-1))),
                        shape=(R, n))
         x0 = np.concatenate([mo.sigma, mo.w, mo.alpha, [mo.T, 0.0]])
