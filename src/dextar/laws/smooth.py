@@ -660,7 +660,8 @@ class _Programme:
         cost = self.cost.copy()
         cost[n - 2] = 1.0 / T_ref
         return linprog(cost, A_ub=A, b_ub=b, A_eq=self.A_eq, b_eq=np.zeros(2 * M),
-                       bounds=np.stack([lo, hi], axis=1), method="highs-ds")
+                       bounds=np.stack([lo, hi], axis=1), method="highs-ds",
+                       options={"presolve": False})
 
 
 def _time_scaled(model: _Model, J: Array, T: float) -> float:
