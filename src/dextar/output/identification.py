@@ -92,14 +92,17 @@ class IdentificationReport:
             "torque_scale": [float(v) for v in res.torque_scale],
             "poorly_determined": list(res.poorly_determined),
             "base_parameters": [{"name": n, "meaning": m, "unit": u, "value": float(v),
-                                 "std": float(s), "rel_std": float(r),
+                                 "std": float(s),
+                                 "rel_std": float(r) if math.isfinite(r) else None,
                                  "poorly_determined": n in res.poorly_determined}
                                 for n, m, u, v, s, r in zip(res.base.names, res.base.meanings,
                                                             res.base.units, res.beta, res.std,
                                                             res.rel_std, strict=True)],
             "unidentifiable": [NAMES[j] for j in res.base.unidentifiable],
             "physically_consistent": res.consistent, "warnings": list(res.warnings),
-            "units": "SI: s, rad, N m; base parameters in the unit of their column"}
+            "units": "SI: s, rad, N m; base parameters in the unit of their column",
+            "rel_std_note": "std / |value|; null where the value is 0 (a parameter held at "
+                            "its physical bound: poorly determined)"}
         panels = [("identification data", c.t, c.tau, res.base.columns(c.Y) @ res.beta)]
         v = None
         if vdata is not None:
