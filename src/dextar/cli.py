@@ -10,6 +10,7 @@ import argparse
 import importlib
 import json
 import os
+import signal
 import sys
 import warnings
 from collections.abc import Sequence
@@ -108,7 +109,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             args.parsers[args.command].error(f"unrecognized arguments: {' '.join(extra)}")
     except SystemExit as exc:  # --help, --version, or a usage error (already printed)
         return int(exc.code or 0) if not isinstance(exc.code, str) else 2
-    _terminate_as_interrupt()
+    previous = _terminate_as_interrupt()
     try:
         with warnings.catch_warnings():  # numerical warnings of a failing solve: the error
             warnings.simplefilter("ignore", RuntimeWarning)  # that follows says it in words
@@ -119,6 +120,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         if _RECEIVED:  # the interrupt, seen through a library or a cut-short import
             return _interrupted(args.command)
         return _error(args.command, exc)
+    finally:  # a caller's own handlers back (main called from a script or a notebook)
+        _restore(previous)
 
 
 def _interrupted(command: str) -> int:
@@ -145,22 +148,28 @@ def _error(command: str, exc: Exception) -> int:
 _RECEIVED: list[int] = []
 
 
-def _terminate_as_interrupt() -> None:
+def _terminate_as_interrupt() -> dict[int, Any]:
     """SIGTERM unwinds like Ctrl-C, so staging files are removed on the way out; either is
     noted, so that an error it causes on the way (a library that catches the interrupt and
-    fails later, a module whose import it cut short) is reported as the interrupt."""
-    import signal
-
+    fails later, a module whose import it cut short) is reported as the interrupt. Returns
+    the handlers it replaced."""
     def handler(signum: int, frame: object) -> None:
         _RECEIVED.append(signum)
         raise KeyboardInterrupt
 
     _RECEIVED.clear()
+    previous: dict[int, Any] = {}
     try:
-        signal.signal(signal.SIGTERM, handler)
-        signal.signal(signal.SIGINT, handler)
+        for sig in (signal.SIGTERM, signal.SIGINT):
+            previous[sig] = signal.signal(sig, handler)
     except ValueError:  # not in the main thread (embedded use)
         pass
+    return previous
+
+
+def _restore(previous: dict[int, Any]) -> None:
+    for sig, h in previous.items():
+        signal.signal(sig, h if h is not None else signal.SIG_DFL)
 
 
 def _protect_negatives(argv: list[str]) -> list[str]:

@@ -137,3 +137,32 @@ def test_law_samples_points_to_output_samples(tmp_path, capsys):
     cfg.write_text("[law]\nsamples = 11\n")
     code, _, err = run(["plan", str(cfg), "--out", str(tmp_path / "x.csv")], capsys)
     assert code == 2 and "[law].samples is not known: use [output].samples" in err
+
+
+def test_an_interrupt_a_library_swallows_is_still_reported_as_the_interrupt(monkeypatch, capsys):
+    """A SIGTERM whose KeyboardInterrupt a library catches, failing later with another error
+    (or a module import it cut short), ends as "interrupted" (130), not as an internal error;
+    the caller's signal handlers are back after main returns."""
+    import os
+    import signal
+    import time
+
+    from dextar.commands import ik
+
+    def run(args):
+        try:
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(5)
+        except KeyboardInterrupt:  # a library swallowing it
+            pass
+        raise ValueError("a half-initialised module")
+
+    monkeypatch.setattr(ik, "run", run)
+    before = signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)
+    assert main(["ik", "0", "120"]) == 130
+    assert capsys.readouterr().err == "dextar ik: interrupted\n"
+    assert (signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)) == before
+    # the same error without an interrupt is a bug, named as one
+    monkeypatch.setattr(ik, "run", lambda args: (_ for _ in ()).throw(ValueError("a bug")))
+    assert main(["ik", "0", "120"]) == 2
+    assert "internal error: ValueError: a bug" in capsys.readouterr().err
