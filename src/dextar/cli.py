@@ -161,7 +161,8 @@ def _terminate_as_interrupt() -> dict[int, Any]:
     previous: dict[int, Any] = {}
     try:
         for sig in (signal.SIGTERM, signal.SIGINT):
-            previous[sig] = signal.signal(sig, handler)
+            if signal.getsignal(sig) is not signal.SIG_IGN:  # (ignored by the caller: kept)
+                previous[sig] = signal.signal(sig, handler)
     except ValueError:  # not in the main thread (embedded use)
         pass
     return previous

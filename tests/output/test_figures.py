@@ -3,6 +3,7 @@
 import io
 
 import numpy as np
+import pytest
 from matplotlib.figure import Figure
 
 from dextar.output.figures import _one_palette, png_bytes, svg_bytes, tight_layout
@@ -55,3 +56,25 @@ def test_a_laid_out_figure_saves_the_same_bytes_without_its_layout_engine():
     assert png_bytes(ours, dpi=50) == png_bytes(plain, dpi=50)
     assert b"<svg" in svg_bytes(ours)
     assert io.BytesIO(png_bytes(ours, dpi=50)).read(8) == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize("total_s, frames", [(1.0, 41), (0.768, 41), (0.001, 41), (0.0, 41),
+                                             (60.0, 500), (60.0, 2), (8 * 3600.0, 2)])
+def test_the_animation_plays_in_real_time_within_a_gifs_delays(total_s, frames):
+    """Frames every whole number of centiseconds from 20 ms (browsers play shorter delays
+    slowly) to 60 s (a GIF's delay field ends at 655 s), the first and last samples shown,
+    the motion's time played within 5 ms (20 ms for a motion shorter than that)."""
+    from dextar.output.figures import ANIMATION_PAUSE_MS, _real_time_frames
+
+    t = np.linspace(0.0, total_s, 2001)
+    index, delays = _real_time_frames(t, frames)
+    if total_s == 0.0:  # no motion: one still frame
+        assert list(index) == [0] and delays == [ANIMATION_PAUSE_MS]
+        return
+    assert index[0] == 0 and index[-1] == len(t) - 1 and len(index) == len(delays)
+    assert delays[-1] == ANIMATION_PAUSE_MS
+    inner = delays[:-1]
+    assert all(20 <= d <= 60_000 and d % 10 == 0 for d in inner)
+    if total_s >= 0.02:
+        assert abs(sum(inner) - 1e3 * total_s) <= 5.0
+        assert len(index) <= frames or max(inner) == 60_000

@@ -61,3 +61,32 @@ def test_a_child_that_dies_is_replaced_by_this_process():
     parent = os.getpid()
     jobs = {"big": (lambda: 1, 10.0), "dies": (dies, 5.0)}  # "dies" is the child's
     assert render(jobs, workers=2) == {"big": 1, "dies": "drawn here"}
+
+
+@fork_only
+def test_an_interrupt_held_by_the_fork_ends_the_child(monkeypatch):
+    """An interrupt that comes while the child is forked waits until the fork is done, is
+    raised here, and the child is ended with this process's work (none left running)."""
+    import multiprocessing
+    import os
+    import signal
+    import time
+    from multiprocessing.process import BaseProcess
+
+    start = BaseProcess.start
+
+    def start_then_interrupt(self):
+        start(self)
+        os.kill(os.getpid(), signal.SIGINT)  # held: the mask is on while forking
+
+    monkeypatch.setattr(BaseProcess, "start", start_then_interrupt)
+
+    def slow():
+        time.sleep(3)
+        return 1
+
+    t0 = time.monotonic()
+    with pytest.raises(KeyboardInterrupt):
+        render({"a": (slow, 1.0), "b": (slow, 1.0)}, workers=2)
+    assert time.monotonic() - t0 < 2.5  # raised at once, not after this process's job
+    assert multiprocessing.active_children() == []

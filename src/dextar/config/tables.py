@@ -418,7 +418,8 @@ class OutputTable(Table):
         "figures": Param("text", "", None, "figures to draw (default: all that apply: the "
                          "paper's example all; another task without fig3 and fig7, which "
                          "are about the paper's own example)"),  # a list: read below
-        "animation_frames": Param("integer", "", 41, "frames of the animation", minimum=2,
+        "animation_frames": Param("integer", "", 41, "frames of the animation at most (it "
+                                  "plays in real time, 20 ms a frame at least)", minimum=2,
                                   maximum=1000),
         "servo_rate_hz": Param("number", "", 1000.0, "setpoint rate of a program, Hz",
                                positive=True, maximum=100_000.0),

@@ -220,22 +220,28 @@ def animation_gif(an: Analysis, frames: int = 41) -> bytes:
 ANIMATION_PAUSE_MS = 600
 #: The shortest delay between frames (ms): browsers play shorter GIF delays at 100 ms.
 MIN_FRAME_MS = 20
+#: The longest (ms): a GIF's delay is at most 65535 centiseconds; longer motions get more
+#: frames than asked.
+MAX_FRAME_MS = 60_000
 
 
 def _real_time_frames(t_s: Array, frames: int) -> tuple[Array, list[int]]:
     """The sample indices shown (at most ``frames``, the first and the last sample among
     them) and each frame's delay in ms, so that the motion ``t_s`` (seconds from 0, rising)
-    plays in real time: a frame every ``step`` ms (whole centiseconds), the last one at the
-    motion's end within 5 ms."""
+    plays in real time: a frame every ``step`` ms (whole centiseconds, from
+    :data:`MIN_FRAME_MS` to :data:`MAX_FRAME_MS`), the last one at the motion's end within
+    5 ms (a motion shorter than :data:`MIN_FRAME_MS` plays in that time)."""
     total_ms = 1e3 * float(t_s[-1])
-    step = max(MIN_FRAME_MS, 10 * math.ceil(total_ms / max(frames - 1, 1) / 10))
+    step = min(max(MIN_FRAME_MS, 10 * math.ceil(total_ms / max(frames - 1, 1) / 10)),
+               MAX_FRAME_MS)
     at = np.arange(0.0, total_ms, step)
     if len(at) > 1 and total_ms - at[-1] < MIN_FRAME_MS:
         at = at[:-1]  # the last gap too short to play: the one before takes it
     at = np.append(at, total_ms)
     index = np.minimum(np.searchsorted(t_s * 1e3, at - 1e-9), len(t_s) - 1)
     gaps = np.diff(at)
-    delays = [int(step)] * (len(gaps) - 1) + [int(10 * round(gaps[-1] / 10))] if len(gaps) else []
+    last = max(MIN_FRAME_MS, int(10 * round(gaps[-1] / 10))) if len(gaps) else 0
+    delays = [int(step)] * (len(gaps) - 1) + [last] if len(gaps) else []
     return index, [*delays, ANIMATION_PAUSE_MS]
 
 

@@ -75,14 +75,15 @@ def _forked(jobs: Mapping[str, Job[R]], names: list[str],
     receive, send = ctx.Pipe(duplex=False)
     child = ctx.Process(target=_child, args=(jobs, names, send), daemon=True)
     # no interrupt inside the fork (its handlers, logging's and ours, would swallow it):
-    # one that comes is held until the child exists, then raised here
+    # one that comes is held until the child exists, then raised here, where the child is
+    # ended with this process's work
     held = signal.pthread_sigmask(signal.SIG_BLOCK, _INTERRUPTS)
+    masked = True
     try:
         child.start()
-    finally:
+        send.close()
+        masked = False
         signal.pthread_sigmask(signal.SIG_SETMASK, held)
-    send.close()
-    try:
         out = mine()
         try:
             ok, theirs = receive.recv()
@@ -94,10 +95,13 @@ def _forked(jobs: Mapping[str, Job[R]], names: list[str],
         out.update(theirs)
         return out
     finally:
+        if masked:  # the fork itself failed
+            signal.pthread_sigmask(signal.SIG_SETMASK, held)
         receive.close()
-        if child.is_alive():  # this process failed or was interrupted: the child's work is moot
-            child.terminate()
-        child.join()
+        if child.pid is not None:
+            if child.is_alive():  # this process failed or was interrupted: the child's
+                child.terminate()  # work is moot
+            child.join()
 
 
 def _child(jobs: Mapping[str, Job[Any]], names: list[str], send: Any) -> None:
