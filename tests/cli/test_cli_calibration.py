@@ -21,7 +21,6 @@ from dextar.calibration.fit import validation_errors
 from dextar.calibration.poses import candidates
 from dextar.cli import main
 from dextar.commands import calibrate as calibrate_command
-from dextar.commands import program as program_command
 from dextar.config import load_scenario
 
 from ..calibration.conftest import COUNT, MODES, NOMINAL, true_robot
@@ -218,13 +217,10 @@ def test_targets_measured_in_the_instrument_frame(story, capsys):
     assert code == 2 and "needs an [instrument] table" in err and err.count("\n") == 1
 
 
-def test_calibrated_config_serves_run_and_program_in_readings(story, tmp_path, capsys,
-                                                              monkeypatch):
+def test_calibrated_config_serves_run_and_program_in_readings(story, tmp_path, capsys):
     """run takes calibrated.toml; program's setpoints are encoder readings: on the TRUE robot
     they trace the setpoints' points within the noise, and the joint move ends at the
     readings its to_deg gives."""
-    monkeypatch.setattr(program_command, "run",
-                        functools.partial(program_command.run, figures=False))
     cfg = story["out"] / "calibrated.toml"
     code, _, err = cli(["run", cfg, "--out", tmp_path / "run", "--quiet"], capsys)
     assert code == 0, err
@@ -234,7 +230,8 @@ def test_calibrated_config_serves_run_and_program_in_readings(story, tmp_path, c
     model = load_scenario(cfg).kinematic_model.in_file_units()
     assert model == pytest.approx(fitted, rel=1e-13, abs=1e-12)
     for config, name in ((cfg, "cal"), (story["cfg"], "nominal")):
-        code, _, err = cli(["program", config, "--out", tmp_path / name, "--quiet"], capsys)
+        code, _, err = cli(["program", "--no-figures", config, "--out", tmp_path / name,
+                            "--quiet"], capsys)
         assert code == 0, err
     rows = read_rows(tmp_path / "cal" / "setpoints.csv")
     c = dict(zip(rows[0], np.array(rows[1:], float).T, strict=True))

@@ -96,6 +96,15 @@ def model_argument(sp: argparse.ArgumentParser) -> None:
                     "(identified.toml, best.toml); the config's other tables are kept")
 
 
+def csv_command(sp: argparse.ArgumentParser) -> None:
+    """The options of a command that writes one CSV of a law's samples: ``[config]``,
+    ``--json``, ``--out`` (``-`` for stdout), ``--units``."""
+    config_argument(sp)
+    json_flag(sp)
+    sp.add_argument("--out", required=True, help="CSV file (- for stdout)")
+    units_argument(sp)
+
+
 def json_flag(sp: argparse.ArgumentParser) -> None:
     """``--json``: print one JSON object."""
     sp.add_argument("--json", action="store_true", help="print one JSON object")

@@ -22,9 +22,8 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
                          "figures, no report.html): for batches of programs")
 
 
-def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
-    """Plan, size, write, word (the figures unless ``figures`` or ``--no-figures`` says
-    not)."""
+def run(args: argparse.Namespace) -> Result:
+    """Plan, size, write, word (the figures unless ``--no-figures``)."""
     from ..config import load_scenario
     from ..output.program import ProgramSummary, write_program
     from ..program import sizing
@@ -42,7 +41,7 @@ def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
                              tuple(res.timeline()), sizing(res), res.rms_fit, report,
                              sc.robot_table.encoder_offset_deg)
     write_program(args.out, res, summary, sc.robot_mm, sc.program_mode, force=args.force,
-                  with_figures=figures and getattr(args, "figures", True), drive=drive, pvt=pvt)
+                  with_figures=args.figures, drive=drive, pvt=pvt)
     warnings = [f"dextar program: {v.text()}" for v in summary.sizing.violations]
     return Result(summary.as_json(), "\n".join(summary.lines(args.out, res.t.size)), warnings,
                   code=0 if summary.sizing.fits else 1)

@@ -8,13 +8,11 @@ from typing import Any
 
 from .base import (
     Result,
-    config_argument,
-    json_flag,
+    csv_command,
     law_line,
     law_payload,
     law_warnings,
     out_file,
-    units_argument,
     units_note,
     write_or_hand_back,
 )
@@ -25,11 +23,8 @@ REGISTRIES_HELP = True
 
 
 def add_arguments(sp: argparse.ArgumentParser) -> None:
-    """``[config]``, ``--out``, ``--json``."""
-    config_argument(sp)
-    json_flag(sp)
-    sp.add_argument("--out", required=True, help="CSV file (- for stdout)")
-    units_argument(sp)
+    """``[config]``, ``--out``, ``--json``, ``--units``."""
+    csv_command(sp)
 
 
 def run(args: argparse.Namespace) -> Result:
