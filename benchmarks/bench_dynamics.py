@@ -5,7 +5,10 @@ Run: taskset -c 0 python benchmarks/bench_dynamics.py
 Side by side, interleaved (each round times every variant once, best of 7 rounds with the
 median and the worst shown, so that the shared machine's swings hit them alike):
 
-* the fused kernel of ``inverse_dynamics`` (blocks of 8192 samples; 4096 and 16384 beside it),
+* ``inverse_dynamics`` as installed: the compiled kernel (``dextar/dynamics/_kernel.c``, built
+  by pip where a C compiler is), and the raw kernel call without the input checks,
+* the numpy kernel, what an install without a C compiler runs (blocks of 8192 samples; 4096
+  and 16384 beside it),
 * the kernel it replaced (the per-body evaluation ``_pose``/``_rates``/``_loads`` that
   ``joint_reactions`` and ``kinetic_energy`` still use, plus the stack into (n, 2)),
 * the memory floor: a copy of the three inputs into arrays already allocated,
@@ -22,8 +25,8 @@ import time
 
 import numpy as np
 
-from dextar.dynamics import Model, inverse_dynamics, paper_inertia
-from dextar.dynamics.exact import _lumped, _run, _torques
+from dextar.dynamics import Model, exact, inverse_dynamics, paper_inertia
+from dextar.dynamics.exact import _kernel_constants, _lumped, _run, _torques
 from dextar.geometry import DEXTAR_MM
 from dextar.laws import solve_optimal_law
 from dextar.output.mjcf import mujoco_state, to_mjcf
@@ -122,12 +125,26 @@ def main() -> None:
         for dst, src in zip(copies, (q, dq, ddq), strict=True):
             np.copyto(dst, src)
 
-    variants = {
-        "fused kernel (inverse_dynamics)": lambda: inverse_dynamics(model, q, dq, ddq),
-        "  the same, blocks of 4096": lambda: _torques(model, q, dq, ddq, gravity=True,
-                                                        friction=True, block=4096),
-        "  the same, blocks of 16384": lambda: _torques(model, q, dq, ddq, gravity=True,
-                                                         friction=True, block=16384),
+    def numpy_kernel(block=exact.FUSED_BLOCK):
+        exact.USE_COMPILED = False
+        try:
+            return _torques(model, q, dq, ddq, gravity=True, friction=True, block=block)
+        finally:
+            exact.USE_COMPILED = exact._compiled is not None
+
+    consts, raw_out = _kernel_constants(_lumped(model, True, True)), np.empty_like(q)
+    variants = {}
+    if exact._compiled is not None:
+        variants["inverse_dynamics (compiled kernel)"] = lambda: inverse_dynamics(model, q, dq,
+                                                                                  ddq)
+        variants["  the kernel call alone (no checks)"] = lambda: exact._compiled.torques(
+            consts, q, dq, ddq, raw_out)
+    else:
+        print("the compiled kernel is not built (no C compiler at install): numpy only")
+    variants |= {
+        "numpy kernel (no C compiler)": numpy_kernel,
+        "  the same, blocks of 4096": lambda: numpy_kernel(4096),
+        "  the same, blocks of 16384": lambda: numpy_kernel(16384),
         "previous kernel (per body)": lambda: previous_kernel(model, q, dq, ddq),
         "memory floor (copy the inputs)": floor,
     }
@@ -138,8 +155,10 @@ def main() -> None:
     ours = inverse_dynamics(model, q, dq, ddq)
     ref = previous_kernel(model, q, dq, ddq)
     scale = np.abs(ref).max()
-    print(f"fused vs previous kernel: max |difference| / max |tau| = "
+    print(f"inverse_dynamics vs previous kernel: max |difference| / max |tau| = "
           f"{np.abs(ours - ref).max() / scale:.1e}")
+    print(f"numpy kernel vs previous kernel: max |difference| / max |tau| = "
+          f"{np.abs(numpy_kernel() - ref).max() / scale:.1e}")
     if fast is not None:
         print(f"numba loop vs fused kernel: {np.abs(fast(q, dq, ddq) - ours).max() / scale:.1e}")
     times = {k: [] for k in variants}
@@ -152,11 +171,13 @@ def main() -> None:
     for name, t in times.items():
         t = np.array(t)
         print(f"  {name:<34} {t.min():7.1f}  ({np.median(t):6.1f}, {t.max():6.1f})")
-    ratio = np.array(times["previous kernel (per body)"]) / np.array(
-        times["fused kernel (inverse_dynamics)"])
-    print(f"  previous / fused, round by round: best {ratio.max():.2f}x, median "
-          f"{np.median(ratio):.2f}x")
-    print("floor: 40 ns/sample for the fused kernel")
+    first = next(iter(times))
+    for other in ("numpy kernel (no C compiler)", "previous kernel (per body)"):
+        if other != first:
+            ratio = np.array(times[other]) / np.array(times[first])
+            print(f"  {other.split(' (')[0]} / {first.split(' (')[0]}, round by round: best "
+                  f"{ratio.max():.2f}x, median {np.median(ratio):.2f}x")
+    print(f"floor: 40 ns/sample for inverse_dynamics: {min(times[first]):.1f} ns")
     try:
         import mujoco
     except ImportError:
@@ -176,7 +197,7 @@ def main() -> None:
         acc[i] = d.qacc[[0, 2]]
     mj = (time.perf_counter() - t0) / k * 1e9
     rel = np.abs(acc - ddq[:k]).max() / np.abs(ddq[:k]).max()
-    best = min(times["fused kernel (inverse_dynamics)"])
+    best = min(times[first])
     print(f"MuJoCo mj_forward:      {mj:7.1f} ns/sample on {k:.0e} samples (Python loop), "
           f"{mj / best:.0f}x ours")
     print(f"MuJoCo accelerations vs ours: max relative difference {rel:.1e}")

@@ -36,6 +36,15 @@ from ..kinematics import DEFAULT_SINGULARITY_TOL
 from .friction import friction_torque
 from .inertia import Inertia
 
+try:  # the fused kernel compiled (_kernel.c), built by pip where a C compiler is
+    from . import _kernel as _compiled
+except ImportError:  # pragma: no cover - installed without a C compiler: the numpy kernel
+    _compiled = None  # type: ignore[assignment]
+
+#: Whether :func:`inverse_dynamics` and its kin use the compiled kernel (where it was built):
+#: False gives the numpy kernel (the same torques to rounding; the tests compare the two).
+USE_COMPILED = _compiled is not None
+
 
 @dataclass(frozen=True)
 class Model:
@@ -519,7 +528,8 @@ def _fused_block(c: _Lumped, bufs: tuple[list[Array], list[Array]], q: Array, dq
 
 def _torques(model: Model, q: object, dq: object, ddq: object, *, gravity: bool,
              friction: bool, t: object = None, block: int = FUSED_BLOCK) -> Array:
-    """Motor torques (..., 2) by the fused kernel, checked like :func:`_run`."""
+    """Motor torques (..., 2) by the fused kernel (compiled where it was built, else numpy
+    in blocks of ``block`` samples), checked like :func:`_run`."""
     q0 = as_points(q, "q")
     shape = q0.shape[:-1]
     qf = q0.reshape(-1, 2)
@@ -531,11 +541,21 @@ def _torques(model: Model, q: object, dq: object, ddq: object, *, gravity: bool,
                              f"{n}, {len(dqf)}, {len(ddqf)}")
     c = _lumped(model, gravity, friction)
     r = model.robot
-    # _check_state runs (and names the sample) only on a block whose extremes come near its
+    # _check_state runs (and names the sample) only where the extremes come near the
     # limits: rods that do not meet (a negative discriminant), 1 / |det| near 1 / (tol L1 L2)
     sing_cap = 1.0 / (model.tol * r.L1 * r.L2) if model.tol > 0 else np.inf
     tt = None if t is None else np.asarray(t, dtype=float).reshape(-1)
     out = np.empty((n, 2))
+    if USE_COMPILED and _compiled is not None:
+        disc, worst = _compiled.torques(_kernel_constants(c), np.ascontiguousarray(qf),
+                                        np.ascontiguousarray(dqf), np.ascontiguousarray(ddqf),
+                                        out)
+        if disc < 0.0 or worst >= sing_cap * (1.0 - 1e-9):
+            for blk in blocks(n):
+                with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+                    pose = _pose(model, qf[blk, 0], qf[blk, 1], _Np)
+                _check_state(model, pose, qf, blk.start, tt)
+        return out.reshape(shape + (2,))
     bufs = _Buffers(min(block, max(n, 1)))
     for blk in blocks(n, block):
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # checked below
@@ -546,6 +566,19 @@ def _torques(model: Model, q: object, dq: object, ddq: object, *, gravity: bool,
                 pose = _pose(model, qf[blk, 0], qf[blk, 1], _Np)
             _check_state(model, pose, qf, blk.start, tt)
     return out.reshape(shape + (2,))
+
+
+def _kernel_constants(c: _Lumped) -> Array:
+    """The constants of the compiled kernel, in the order of its ``C_*`` indices."""
+    def pair(v: Any) -> tuple[float, float]:
+        a = np.broadcast_to(np.asarray(0.0 if v is None else v, dtype=float), (2, 1))
+        return float(a[0, 0]), float(a[1, 0])
+
+    fric = c.viscous is not None and c.coulomb is not None
+    return np.array([*pair(c.l), c.d, *pair(c.Lsq), *pair(c.iLsq), c.L2sq, c.ue0, c.cst,
+                     float(c.sign), *pair(c.J), c.MP, *pair(c.cK), *pair(c.Gax), *pair(c.Gay),
+                     c.MPgx, c.MPgy, *pair(c.viscous), *pair(c.coulomb), c.inv_vs,
+                     1.0 if fric else 0.0])
 
 
 def inverse_dynamics(model: Model, q: object, dq: object, ddq: object, *,

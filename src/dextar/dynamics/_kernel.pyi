@@ -1,0 +1,5 @@
+# The compiled fused torque kernel (_kernel.c), built by pip where a C compiler is.
+N_CONSTS: int
+
+def torques(consts: object, q: object, dq: object, ddq: object, out: object, /
+            ) -> tuple[float, float]: ...
