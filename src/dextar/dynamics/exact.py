@@ -39,7 +39,7 @@ from .inertia import Inertia
 try:  # the fused kernel compiled (_kernel.c), built by pip where a C compiler is
     from . import _kernel as _compiled
 except ImportError:  # pragma: no cover - installed without a C compiler: the numpy kernel
-    _compiled = None  # type: ignore[assignment]
+    _compiled = None  # type: ignore[assignment]  # the module or None, as USE_COMPILED says
 
 #: Whether :func:`inverse_dynamics` and its kin use the compiled kernel (where it was built):
 #: False gives the numpy kernel (the same torques to rounding; the tests compare the two).
