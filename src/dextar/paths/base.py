@@ -13,7 +13,7 @@ import math
 from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -21,11 +21,40 @@ from .._arrays import Array
 from ..errors import ParameterError
 from .expression import Expression
 
-if TYPE_CHECKING:
-    from scipy.interpolate import CubicHermiteSpline
+# scipy.interpolate is imported where a spline is first built (Spline): it costs a third of a
+# second to import (half a second with what it brings), and lines, arcs, expressions and the
+# blends of a program (closed forms and HermiteTable) never need it.
 
-# scipy.interpolate is imported where a table or a spline is first built: it costs a third of
-# a second to import, and lines and arcs (closed forms) never need it.
+
+class HermiteTable:
+    """The piecewise cubic Hermite interpolant of values ``y`` and slopes ``dydx`` at rising
+    knots ``x`` (each (n,), n >= 2), evaluated at any points (a value beyond the ends from the
+    end piece's cubic).
+
+    ``scipy.interpolate.CubicHermiteSpline(x, y, dydx)`` with the same coefficients and the
+    same sum of powers (the same values to the last bit); written here for
+    the half second scipy.interpolate takes to import, which a program's path paid for two
+    lookups.
+    """
+
+    def __init__(self, x: Array, y: Array, dydx: Array) -> None:
+        """The table of values ``y`` and slopes ``dydx`` at the knots ``x``."""
+        self.x = np.asarray(x, dtype=float)
+        y, m = np.asarray(y, dtype=float), np.asarray(dydx, dtype=float)
+        h = np.diff(self.x)
+        slope = np.diff(y) / h
+        t = (m[:-1] + m[1:] - 2.0 * slope) / h
+        # per piece: y + m dx + c2 dx^2 + c3 dx^3, dx from the piece's left knot
+        self.c = np.stack([t / h, (slope - m[:-1]) / h - t, m[:-1], y[:-1]])
+
+    def __call__(self, xi: object) -> Array:
+        """The interpolant at ``xi`` (any shape)."""
+        xi = np.asarray(xi, dtype=float)
+        i = np.clip(np.searchsorted(self.x, xi, side="right") - 1, 0, len(self.x) - 2)
+        dx = xi - self.x[i]
+        c3, c2, c1, c0 = self.c[:, i]
+        dx2 = dx * dx
+        return np.asarray(((c0 + c1 * dx) + c2 * dx2) + c3 * (dx2 * dx))
 
 
 def _cross(a: Array, b: Array) -> Array:
@@ -100,18 +129,14 @@ class Path(ABC):
         return np.asarray(self._forward(self._check_parameter(p)))
 
     @cached_property
-    def _forward(self) -> CubicHermiteSpline:
-        from scipy.interpolate import CubicHermiteSpline
-
+    def _forward(self) -> HermiteTable:
         nodes, s, v = self._table
-        return CubicHermiteSpline(nodes, s, v)
+        return HermiteTable(nodes, s, v)
 
     @cached_property
-    def _inverse(self) -> CubicHermiteSpline:
-        from scipy.interpolate import CubicHermiteSpline
-
+    def _inverse(self) -> HermiteTable:
         nodes, s, v = self._table
-        return CubicHermiteSpline(s, nodes, 1.0 / v)
+        return HermiteTable(s, nodes, 1.0 / v)
 
     def parameter_at(self, s: object) -> Array:
         """The parameter ``p(s)`` at arc length ``s`` (inverse of :meth:`arc_length`)."""
