@@ -7,11 +7,13 @@ traceback. ``--out -`` writes a CSV or JSON result to stdout (the messages then 
 from __future__ import annotations
 
 import argparse
+import atexit
 import importlib
 import json
 import os
 import signal
 import sys
+import threading
 import warnings
 from collections.abc import Sequence
 from types import ModuleType
@@ -124,6 +126,25 @@ def main(argv: Sequence[str] | None = None) -> int:
         _restore(previous)
 
 
+def entry() -> NoReturn:
+    """The console command ``dextar`` (and ``python -m dextar``): :func:`main`, then the
+    process ends at once. The exit handlers run and the output is flushed, as at any exit,
+    but the interpreter is not taken apart object by object: with numpy, scipy and
+    matplotlib loaded that takes 0.2 s, a tenth of ``dextar run``, for memory the operating
+    system frees at once. (Where a thread of a library still runs, the exit is the usual
+    one, which waits for it.)"""
+    code = main()
+    if any(t is not threading.main_thread() and not t.daemon for t in threading.enumerate()):
+        raise SystemExit(code)
+    atexit._run_exitfuncs()
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):  # a reader gone (dextar ... | head) or a closed stream
+            pass
+    os._exit(code)
+
+
 def _interrupted(command: str) -> int:
     sys.stderr.write(f"dextar {command}: interrupted\n")
     return 130
@@ -198,4 +219,4 @@ def _protect_negatives(argv: list[str]) -> list[str]:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    entry()

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from matplotlib.figure import Figure
 
-from dextar.output.figures import _one_palette, png_bytes, svg_bytes, tight_layout
+from dextar.output.figures import _one_palette, _packed, png_bytes, svg_bytes, tight_layout
 
 
 def test_frames_share_one_palette_and_keep_their_colours():
@@ -20,7 +20,9 @@ def test_frames_share_one_palette_and_keep_their_colours():
         f[9, 5 + 10 * k:15 + 10 * k] = (255, 200, 150)
         frames.append(f)
     frames[3][40:45, 40:45] = rng.integers(0, 256, (5, 5, 3), dtype=np.uint8)  # many colours
-    images = _one_palette(frames)
+    opaque = [np.concatenate([f, np.full(f.shape[:2] + (1,), 255, np.uint8)], -1)
+              for f in frames]  # as the canvas gives them
+    images = _one_palette(frames[0], [_packed(f) for f in opaque])
     assert len(images) == 6 and all(im.mode == "P" for im in images)
     assert len({bytes(im.getpalette()) for im in images}) == 1  # one palette
     for f, im in zip(frames, images, strict=True):
@@ -36,6 +38,14 @@ def test_frames_share_one_palette_and_keep_their_colours():
     got = ((patch[:, 0] - np.asarray(images[3].convert("RGB"))[40:45, 40:45].reshape(-1, 3))
            ** 2).sum(-1)
     assert np.array_equal(got, best)
+
+
+def test_pixels_are_packed_as_one_integer_a_colour():
+    rgba = np.random.default_rng(5).integers(0, 256, (7, 9, 4), dtype=np.uint8)
+    want = (rgba[..., 0].astype(np.int64) + (rgba[..., 1].astype(np.int64) << 8)
+            + (rgba[..., 2].astype(np.int64) << 16))
+    assert np.array_equal(_packed(rgba), want)  # the alpha byte left out
+    assert np.array_equal(_packed(rgba[:, ::2]), want[:, ::2])  # a view that is not contiguous
 
 
 def test_a_laid_out_figure_saves_the_same_bytes_without_its_layout_engine():

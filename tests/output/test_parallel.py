@@ -89,3 +89,48 @@ def test_an_interrupt_held_by_the_fork_ends_the_child(monkeypatch):
     with pytest.raises(KeyboardInterrupt):
         render({"a": (slow, 1.0), "b": (slow, 1.0)}, workers=2)
     assert {p.pid for p in multiprocessing.active_children()} <= before
+
+
+@fork_only
+def test_forked_work_runs_in_a_child_while_this_process_goes_on():
+    import time
+
+    from dextar.output.parallel import Forked
+
+    t0 = time.perf_counter()
+    with Forked(lambda: (time.sleep(0.5), os.getpid())[1]) as child:
+        here = time.perf_counter() - t0  # the block goes on at once
+        pid = child.result()
+    assert here < 0.4
+    assert pid != os.getpid()
+    with Forked(os.getpid, enabled=False) as inline:  # no child: the work runs at result()
+        assert inline.result() == os.getpid()
+
+
+@fork_only
+def test_forked_work_that_fails_in_the_child_is_redone_and_raised_here():
+    from dextar.output.parallel import Forked
+
+    calls = []
+
+    def bad():
+        calls.append(os.getpid())
+        raise ParameterError("validation failed at t = 0.5 s")
+
+    with Forked(bad) as child, pytest.raises(ParameterError, match="t = 0.5 s"):
+        child.result()
+    assert calls == [os.getpid()]  # (the child's own call is in the child's memory)
+
+
+@fork_only
+def test_leaving_the_block_early_ends_the_child():
+    import multiprocessing
+    import time
+
+    from dextar.output.parallel import Forked
+
+    before = {p.pid for p in multiprocessing.active_children()}
+    with pytest.raises(RuntimeError, match="this process failed"):
+        with Forked(lambda: time.sleep(30)):
+            raise RuntimeError("this process failed")
+    assert {p.pid for p in multiprocessing.active_children()} <= before

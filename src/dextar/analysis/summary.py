@@ -93,10 +93,12 @@ ASSUMPTIONS = [
 ]
 
 
-def run_summary(an: Analysis, checks: dict[str, Any], uniform: Trajectory) -> dict[str, Any]:
+def run_summary(an: Analysis, checks: dict[str, Any] | None, uniform: Trajectory
+                ) -> dict[str, Any]:
     """Everything a run computed and claims, JSON-ready: parameters, the law, torques,
-    powers, joint forces, the physics checks and, for the paper's example, its claims
-    (``uniform``: the uniform law sampled for the Fig. 3 claim)."""
+    powers, joint forces, the physics checks (:func:`validation`; None: to be set by the
+    caller, as ``dextar run`` does beside its figures) and, for the paper's example, its
+    claims (``uniform``: the uniform law sampled for the Fig. 3 claim)."""
     sc, law, tr = an.inputs, an.law, an.trajectory
     s: dict[str, Any] = {
         "dextar_version": __version__,

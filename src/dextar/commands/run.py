@@ -26,6 +26,7 @@ def run(args: argparse.Namespace) -> Result:
     from ..analysis import analyze, run_summary, validation
     from ..config import load_scenario
     from ..output.files import OutputDir
+    from ..output.parallel import Forked, can_fork
     from ..output.run import RUN_FILES, Progress, staged, write_run
 
     sc = load_scenario(args.config, model=args.model)
@@ -36,11 +37,12 @@ def run(args: argparse.Namespace) -> Result:
         an = stage(f"{sc.law_table.type} law, trajectory and torques",
                    lambda: analyze(inputs, sc.law()))
         uniform = stage("uniform law (Fig. 3)", lambda: inputs.trajectory(sc.law("uniform")))
-        checks = stage("validation (power balance, forward re-simulation)",
-                       lambda: validation(an))
-        s = run_summary(an, checks, inputs.trajectory(uniform.law, samples=201))
-        write_run(od, an, uniform, s, figures=sc.output.figures,
-                  animation_frames=sc.output.animation_frames, stage=stage, progress=prog)
+        # the physics checks (scipy's import and an integration: half a second) on the other
+        # core while this one loads matplotlib and draws
+        with Forked(lambda: validation(an), enabled=can_fork()) as checks:
+            s = run_summary(an, None, inputs.trajectory(uniform.law, samples=201))
+            write_run(od, an, uniform, s, validation=checks.result, figures=sc.output.figures,
+                      animation_frames=sc.output.animation_frames, stage=stage, progress=prog)
     law = s["law"]
     warnings = ([] if law["success"] else
                 [f"dextar run: warning: {law['type']} law status {law['status']}: "

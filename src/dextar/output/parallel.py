@@ -1,12 +1,13 @@
-"""Rendering on two cores: the figures of a command are independent of each other and
-matplotlib draws one at a time, so :func:`render` shares them between this process and one
-forked child.
+"""Work on two cores: the figures of a command are independent of each other and matplotlib
+draws one at a time, so :func:`render` shares them between this process and one forked child;
+:class:`Forked` runs one piece of work (a run's validation) in a child while this process goes
+on with the rest.
 
 A forked child starts at once with everything imported and computed (nothing is pickled on
-the way in); it only renders and sends the files' bytes back through a pipe. Without
-``fork`` (Windows, macOS), when the process may use one CPU only (``taskset``, a container's
-limit) or with ``workers=1``, the jobs run here in turn: the same files either way. A job
-that fails in the child runs again here, so its error is raised as if there were no child.
+the way in); it only computes and sends its result back through a pipe. Without ``fork``
+(Windows, macOS), when the process may use one CPU only (``taskset``, a container's limit) or
+with ``workers=1``, the work runs here in turn: the same results either way. Work that fails
+in the child runs again here, so its error is raised as if there were no child.
 """
 
 from __future__ import annotations
@@ -16,7 +17,8 @@ import os
 import signal
 import sys
 from collections.abc import Callable, Mapping
-from typing import Any, TypeVar
+from types import TracebackType
+from typing import Any, Generic, TypeVar
 
 R = TypeVar("R")
 
@@ -32,18 +34,22 @@ def cpus() -> int:
         return os.cpu_count() or 1
 
 
+def can_fork() -> bool:
+    """Whether work may go to a forked child: ``fork`` is safe here (Linux) and two CPUs are
+    allowed."""
+    return sys.platform.startswith("linux") and cpus() >= 2
+
+
 def render(jobs: Mapping[str, Job[R]], *, workers: int | None = None) -> dict[str, R]:
     """Run ``jobs`` (name -> (callable, cost)), shared between this process and one forked
-    child when two CPUs are free to use (``workers`` None: 2 where ``fork`` is safe and two
-    CPUs are allowed, else 1). Returns name -> result, in the jobs' order."""
+    child when two CPUs are free to use (``workers`` None: 2 where :func:`can_fork`, else 1).
+    Returns name -> result, in the jobs' order."""
     if workers is None:
-        workers = 2 if sys.platform.startswith("linux") and cpus() >= 2 else 1
+        workers = 2 if can_fork() else 1
     here, there = _split(jobs, 2 if workers >= 2 and len(jobs) >= 2 else 1)
-    results: dict[str, R] = {}
-    if there:
-        results.update(_forked(jobs, there, lambda: {n: jobs[n][0]() for n in here}))
-    else:
-        results.update({n: jobs[n][0]() for n in here})
+    with Forked(lambda: {n: jobs[n][0]() for n in there}, enabled=bool(there)) as child:
+        results = {n: jobs[n][0]() for n in here}
+        results.update(child.result())
     return {n: results[n] for n in jobs}
 
 
@@ -65,52 +71,86 @@ def _split(jobs: Mapping[str, Job[Any]], parts: int) -> tuple[list[str], list[st
     return sides
 
 
-def _forked(jobs: Mapping[str, Job[R]], names: list[str],
-            mine: Callable[[], dict[str, R]]) -> dict[str, R]:
-    """Run ``names`` in a forked child while ``mine`` runs here; the child's jobs run here
-    when it fails (the error then raised here) or dies."""
-    ctx = multiprocessing.get_context("fork")
-    for stream in (sys.stdout, sys.stderr):  # nothing buffered to be written twice
-        stream.flush()
-    receive, send = ctx.Pipe(duplex=False)
-    child = ctx.Process(target=_child, args=(jobs, names, send), daemon=True)
-    # no interrupt inside the fork (its handlers, logging's and ours, would swallow it):
-    # one that comes is held until the child exists, then raised here, where the child is
-    # ended with this process's work
-    held = signal.pthread_sigmask(signal.SIG_BLOCK, _INTERRUPTS)
-    masked = True
-    try:
-        child.start()
-        send.close()
-        masked = False
-        signal.pthread_sigmask(signal.SIG_SETMASK, held)
-        out = mine()
+class Forked(Generic[R]):
+    """``fn()`` computed in a forked child while this process goes on, as a context manager::
+
+        with Forked(check) as checked:
+            ...                    # this process's own work
+            value = checked.result()
+
+    :meth:`result` waits for the child's result; where the child fails or dies, or was not
+    forked (``enabled`` False), ``fn`` runs here, so that its error is raised here. Leaving the
+    block ends a child that is still running (this process failed or was interrupted)."""
+
+    def __init__(self, fn: Callable[[], R], *, enabled: bool = True) -> None:
+        """Fork on entering the block (only where ``enabled``)."""
+        self.fn = fn
+        self.enabled = enabled
+        self._child: Any = None
+        self._receive: Any = None
+
+    def __enter__(self) -> Forked[R]:
+        if not self.enabled:
+            return self
+        ctx = multiprocessing.get_context("fork")
+        for stream in (sys.stdout, sys.stderr):  # nothing buffered to be written twice
+            stream.flush()
+        self._receive, send = ctx.Pipe(duplex=False)
+        self._child = ctx.Process(target=_child, args=(self.fn, send), daemon=True)
+        # no interrupt inside the fork (its handlers, logging's and ours, would swallow it):
+        # one that comes is held until the child exists, then raised here, where the child
+        # is ended with this process's work (the block's exit)
+        held = signal.pthread_sigmask(signal.SIG_BLOCK, _INTERRUPTS)
         try:
-            ok, theirs = receive.recv()
-        except EOFError:  # the child died without a word
-            ok, theirs = False, None
-        child.join()  # (it exits once its word is sent)
-        if not ok:
-            theirs = {n: jobs[n][0]() for n in names}
-        out.update(theirs)
-        return out
-    finally:
-        if masked:  # the fork itself failed
+            try:
+                self._child.start()
+            finally:
+                send.close()
+            signal.pthread_sigmask(signal.SIG_SETMASK, held)  # a held interrupt comes here
+        except BaseException:
             signal.pthread_sigmask(signal.SIG_SETMASK, held)
-        receive.close()
-        if child.pid is not None:
-            if child.is_alive():  # this process failed or was interrupted: the child's
-                child.terminate()  # work is moot
+            self._close()  # (the block is not entered: its exit would not end the child)
+            raise
+        return self
+
+    def result(self) -> R:
+        """The child's result (waited for), or ``fn()`` computed here."""
+        if self._child is None:
+            return self.fn()
+        try:
+            ok, value = self._receive.recv()
+        except EOFError:  # the child died without a word
+            ok, value = False, None
+        self._child.join()  # (it exits once its word is sent)
+        if not ok:
+            return self.fn()
+        result: R = value
+        return result
+
+    def __exit__(self, kind: type[BaseException] | None, exc: BaseException | None,
+                 tb: TracebackType | None) -> None:
+        self._close()
+
+    def _close(self) -> None:
+        """End the child if it still runs (its work is moot: this process failed or was
+        interrupted) and let its pipe go."""
+        if self._receive is not None:
+            self._receive.close()
+            self._receive = None
+        child, self._child = self._child, None
+        if child is not None and child.pid is not None:
+            if child.is_alive():
+                child.terminate()
             child.join()
 
 
-def _child(jobs: Mapping[str, Job[Any]], names: list[str], send: Any) -> None:
-    """The child's work: its jobs' results, or word that it failed (the parent redoes them)."""
+def _child(fn: Callable[[], Any], send: Any) -> None:
+    """The child's work: ``fn``'s result, or word that it failed (the parent redoes it)."""
     signal.signal(signal.SIGTERM, signal.SIG_DFL)  # ended by the parent: quietly
     signal.pthread_sigmask(signal.SIG_UNBLOCK, _INTERRUPTS)  # held by the fork
-    result: tuple[bool, dict[str, Any] | None]
+    result: tuple[bool, Any]
     try:
-        result = (True, {n: jobs[n][0]() for n in names})
+        result = (True, fn())
     except BaseException:  # anything, interrupts included: the parent decides
         result = (False, None)
     try:

@@ -21,7 +21,7 @@ from ..geometry import FiveBar
 from ..kinematics import workspace_map
 from ..program import MoveTiming, ProgramResult, RmsFit, Sizing
 from ..program.drive import DriveUnits, PvtPoints
-from .figures import plot_workspace, png_bytes, svg_bytes, tight_layout, warm_up
+from .figures import new_figure, plot_workspace, png_bytes, svg_bytes, tight_layout, warm_up
 from .files import OutputDir
 from .html_page import figures, grid, page
 from .tables import csv_text
@@ -186,7 +186,7 @@ def _figures(res: ProgramResult, summary: ProgramSummary, robot_mm: FiveBar, mod
         return png_bytes(fig), svg_bytes(fig)
 
     jobs: dict[str, Job[tuple[bytes, bytes]]] = {n: (partial(files, n), 1.0) for n in makers}
-    warm_up()
+    warm_up(mathtext=False)  # (no mathtext in a program's figures)
     return render(jobs)
 
 
@@ -222,7 +222,7 @@ def moves_figure(res: ProgramResult, robot_mm: FiveBar, mode: str) -> Figure:
 
 def motion_figure(res: ProgramResult) -> Figure:
     """Joint angles, speeds and torques against time, move boundaries dotted, limits dashed."""
-    fig = Figure(figsize=(7.0, 8.0))
+    fig = new_figure((7.0, 8.0))
     axes = fig.subplots(3, 1, sharex=True)
     t = res.t
     labels = ("motor A", "motor D")
@@ -258,7 +258,7 @@ def motion_figure(res: ProgramResult) -> Figure:
 def operating_points_figure(res: ProgramResult, sizing: Sizing) -> Figure:
     """Each motor's (speed, torque) operating points against its torque-speed envelope, with
     the peak and the RMS points."""
-    fig = Figure(figsize=(9.0, 4.0))
+    fig = new_figure((9.0, 4.0))
     axes = fig.subplots(1, 2)
     m = res.motors
     for i, ax in enumerate(axes):
