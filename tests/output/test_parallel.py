@@ -6,14 +6,18 @@ import sys
 import pytest
 
 from dextar.errors import ParameterError
-from dextar.output.parallel import _split, render
+from dextar.output.parallel import render
 
 fork_only = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="fork on Linux")
 
 
 def _jobs():
     # each job says where it ran: the shared run must use two processes and agree otherwise
-    return {f"j{k}": (lambda k=k: (k * k, os.getpid()), float(k % 3 + 1)) for k in range(7)}
+    # (each takes 50 ms, so that the child, started a few ms later, finds jobs left)
+    import time
+
+    return {f"j{k}": (lambda k=k: (time.sleep(0.05), (k * k, os.getpid()))[1],
+                      float(k % 3 + 1)) for k in range(7)}
 
 
 @fork_only
@@ -26,14 +30,25 @@ def test_two_processes_give_what_one_gives_in_the_jobs_order():
     assert len({pid for _, pid in two.values()}) == 2  # shared with a child
 
 
-def test_split_balances_the_costs_and_keeps_every_job():
-    jobs = {n: (lambda: None, c) for n, c in zip("abcdef", (5.0, 1.0, 1.0, 2.0, 2.0, 1.0),
-                                                   strict=True)}
-    here, there = _split(jobs, 2)
-    assert sorted(here + there) == sorted(jobs)
-    loads = [sum(jobs[n][1] for n in side) for side in (here, there)]
-    assert loads == [6.0, 6.0]
-    assert _split(jobs, 1) == (list(jobs), [])
+@fork_only
+def test_the_processes_share_the_jobs_as_they_come_free():
+    """Jobs taken from one queue, the costliest first: a job slower than its cost says (here
+    the first, 0.6 s against costs that call the others as slow) keeps its process while the
+    other takes the rest, so the run takes about the longest job, not the sum of a fixed
+    half."""
+    import time
+
+    def sleep(s):
+        return lambda: (time.sleep(s), os.getpid())[1]
+
+    jobs = {"slow": (sleep(0.6), 3.0), **{f"j{k}": (sleep(0.1), 2.0) for k in range(5)}}
+    t0 = time.perf_counter()
+    out = render(jobs, workers=2)
+    took = time.perf_counter() - t0
+    assert list(out) == list(jobs)
+    assert len(set(out.values())) == 2  # both processes worked
+    assert sum(pid == out["slow"] for pid in out.values()) <= 2  # the slow one's process
+    assert took < 1.0  # the sum is 1.1 s, a split by cost (3 + 2 | 2 + 2 + 2) 0.8 s
 
 
 @fork_only
@@ -44,8 +59,13 @@ def test_a_job_failing_in_the_child_raises_its_error_here():
         calls.append(os.getpid())
         raise ParameterError("job 'bad' cannot be drawn")
 
-    jobs = {"big": (lambda: 0, 10.0), "bad": (bad, 5.0)}  # "bad" is the child's
-    assert _split(jobs, 2) == (["big"], ["bad"])
+    def slow():
+        import time
+
+        time.sleep(0.3)  # this process is busy with it while the child takes "bad"
+        return 0
+
+    jobs = {"slow": (slow, 10.0), "bad": (bad, 5.0)}
     with pytest.raises(ParameterError, match="job 'bad' cannot be drawn"):
         render(jobs, workers=2)
     assert calls == [os.getpid()]  # the child's failure is redone (and raised) here
@@ -53,14 +73,20 @@ def test_a_job_failing_in_the_child_raises_its_error_here():
 
 @fork_only
 def test_a_child_that_dies_is_replaced_by_this_process():
+    import time
+
     def dies():
         if os.getpid() != parent:
             os._exit(3)  # a child killed mid-job
         return "drawn here"
 
+    def slow():
+        time.sleep(0.3)  # this process is busy with it while the child takes "dies"
+        return 1
+
     parent = os.getpid()
-    jobs = {"big": (lambda: 1, 10.0), "dies": (dies, 5.0)}  # "dies" is the child's
-    assert render(jobs, workers=2) == {"big": 1, "dies": "drawn here"}
+    jobs = {"slow": (slow, 10.0), "dies": (dies, 5.0)}
+    assert render(jobs, workers=2) == {"slow": 1, "dies": "drawn here"}
 
 
 @fork_only

@@ -43,32 +43,38 @@ def can_fork() -> bool:
 def render(jobs: Mapping[str, Job[R]], *, workers: int | None = None) -> dict[str, R]:
     """Run ``jobs`` (name -> (callable, cost)), shared between this process and one forked
     child when two CPUs are free to use (``workers`` None: 2 where :func:`can_fork`, else 1).
-    Returns name -> result, in the jobs' order."""
+    Returns name -> result, in the jobs' order.
+
+    The two processes take the jobs from one queue, the costliest first, each the next one
+    when it is free: a job slower than its cost said (a busy machine, a first use of a font)
+    delays the one process it runs on, not the split. A job the child took and did not
+    finish (it failed or died) runs here, so its error is raised here."""
     if workers is None:
         workers = 2 if can_fork() else 1
-    here, there = _split(jobs, 2 if workers >= 2 and len(jobs) >= 2 else 1)
-    with Forked(lambda: {n: jobs[n][0]() for n in there}, enabled=bool(there)) as child:
-        results = {n: jobs[n][0]() for n in here}
+    if workers < 2 or len(jobs) < 2:
+        return {n: jobs[n][0]() for n in jobs}
+    order = sorted(jobs, key=lambda n: -jobs[n][1])
+    taken = multiprocessing.get_context("fork").Value("i", 0)  # the queue's head, shared
+
+    def take() -> dict[str, R]:
+        done: dict[str, R] = {}
+        while True:
+            with taken.get_lock():
+                k = taken.value
+                taken.value = k + 1
+            if k >= len(order):
+                return done
+            done[order[k]] = jobs[order[k]][0]()
+
+    with Forked(take) as child:
+        results = take()
         results.update(child.result())
+    results.update({n: jobs[n][0]() for n in order if n not in results})  # the child's lost
     return {n: results[n] for n in jobs}
 
 
 #: The signals held while forking.
 _INTERRUPTS = {signal.SIGINT, signal.SIGTERM}
-
-
-def _split(jobs: Mapping[str, Job[Any]], parts: int) -> tuple[list[str], list[str]]:
-    """The jobs of this process and of the child: the costliest first, each to the lighter
-    side (the child's side gets no more than this one's)."""
-    if parts == 1:
-        return list(jobs), []
-    sides: tuple[list[str], list[str]] = ([], [])
-    load = [0.0, 0.0]
-    for name in sorted(jobs, key=lambda n: -jobs[n][1]):
-        k = 0 if load[0] <= load[1] else 1
-        sides[k].append(name)
-        load[k] += jobs[name][1]
-    return sides
 
 
 class Forked(Generic[R]):

@@ -185,7 +185,9 @@ def _figures(res: ProgramResult, summary: ProgramSummary, robot_mm: FiveBar, mod
         fig = makers[name]()
         return png_bytes(fig), svg_bytes(fig)
 
-    jobs: dict[str, Job[tuple[bytes, bytes]]] = {n: (partial(files, n), 1.0) for n in makers}
+    costs = {"moves": 1.0, "motion": 1.3, "operating_points": 1.1}  # measured: the order taken
+    jobs: dict[str, Job[tuple[bytes, bytes]]] = {n: (partial(files, n), costs[n])
+                                                 for n in makers}
     warm_up(mathtext=False)  # (no mathtext in a program's figures)
     return render(jobs)
 
