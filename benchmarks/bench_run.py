@@ -4,8 +4,9 @@ under 2 s on the 2-core machine), with every file it writes; and where the time 
 Run: python benchmarks/bench_run.py [--runs N]
 
 * whole process, as many runs as asked (best, median and worst), on every CPU the process
-  may use (the figures and the animation are drawn on two cores when two are allowed) and
-  pinned to one CPU (drawn in turn: the same files);
+  may use (the validation, the figures and the animation on two cores when two are allowed)
+  and pinned to one CPU (in turn: the same files), each round beside a reference of fixed
+  work (``_process.py``: the machine's speed at the time);
 * the run's own steps (``summary.json``'s ``timing_s``) of the last unpinned run;
 * step by step in this process, one core: imports, the numerics, each figure (built and
   laid out, PNG, SVG), the animation, the report.
@@ -19,42 +20,16 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import subprocess
 import sys
-import tempfile
 import time
-from pathlib import Path
+
+from _process import report, timed_rounds
 
 FLOOR = 2.0
-ENV = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
 
 
-def whole(runs: int, cpus: set[int] | None) -> tuple[list[float], dict[str, float]]:
-    """Wall times of ``dextar run`` (new processes, after one untimed run) and its steps."""
-    times: list[float] = []
-    steps: dict[str, float] = {}
-
-    def pin() -> None:
-        if cpus is not None:
-            os.sched_setaffinity(0, cpus)
-
-    for k in range(runs + 1):
-        with tempfile.TemporaryDirectory() as tmp:
-            out = Path(tmp) / "out"
-            t0 = time.perf_counter()
-            subprocess.run([sys.executable, "-m", "dextar", "run", "--out", str(out),
-                            "--quiet"], check=True, env=ENV, preexec_fn=pin)
-            if k:
-                times.append(time.perf_counter() - t0)
-            steps = json.loads((out / "summary.json").read_text())["timing_s"]
-            n_files = len(list(out.iterdir()))
-    print(f"  ({n_files} files each run)")
-    return times, steps
-
-
-def spread(t: list[float]) -> str:
-    s = sorted(t)
-    return f"best {s[0]:5.2f} s, median {s[len(s) // 2]:5.2f} s, worst {s[-1]:5.2f} s"
+def run_argv(out) -> list[str]:
+    return [sys.executable, "-m", "dextar", "run", "--out", str(out), "--quiet"]
 
 
 def steps_here() -> None:
@@ -110,12 +85,13 @@ def main() -> None:
     args = ap.parse_args()
     print(f"load average before: {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
     cpus = sorted(os.sched_getaffinity(0))
-    two, steps = whole(args.runs, None)
-    print(f"dextar run, {len(cpus)} CPUs: {spread(two)} over {args.runs} runs (floor {FLOOR} s)")
-    one, _ = whole(args.runs, {cpus[0]})
-    print(f"dextar run, pinned to one CPU: {spread(one)}")
+    two, ref, last = timed_rounds(run_argv, args.runs)
+    print(f"  ({len(list(last.iterdir()))} files each run)")
+    print(report(f"dextar run, {len(cpus)} CPUs", two, ref, FLOOR))
+    one, ref1, _ = timed_rounds(run_argv, args.runs, {cpus[0]})
+    print(report("dextar run, pinned to one CPU", one, ref1, None))
     print("the run's own steps (last run on every CPU):")
-    for name, sec in steps.items():
+    for name, sec in json.loads((last / "summary.json").read_text())["timing_s"].items():
         print(f"  {name:<52} {sec:6.3f} s")
     print("step by step in this process (one core):")
     steps_here()

@@ -132,7 +132,8 @@ def entry() -> NoReturn:
     but the interpreter is not taken apart object by object: with numpy, scipy and
     matplotlib loaded that takes 0.2 s, a tenth of ``dextar run``, for memory the operating
     system frees at once. (Where a thread of a library still runs, the exit is the usual
-    one, which waits for it.)"""
+    one, which waits for it.) Output that cannot be written (a full disk) is an error, exit
+    status 2; a reader that went away (``dextar ... | head``) is not."""
     code = main()
     if any(t is not threading.main_thread() and not t.daemon for t in threading.enumerate()):
         raise SystemExit(code)
@@ -140,8 +141,17 @@ def entry() -> NoReturn:
     for stream in (sys.stdout, sys.stderr):
         try:
             stream.flush()
-        except (OSError, ValueError):  # a reader gone (dextar ... | head) or a closed stream
+        except (BrokenPipeError, ValueError):  # the reader is gone; a closed stream
             pass
+        except OSError as exc:
+            if stream is sys.stdout:
+                try:
+                    sys.stderr.write(f"dextar: error: the output could not be written: "
+                                     f"{exc.strerror or exc}\n")
+                    sys.stderr.flush()
+                except (OSError, ValueError):
+                    pass
+            code = 2
     os._exit(code)
 
 

@@ -1,12 +1,15 @@
 """The console command's exit (dextar.cli.entry): the process ends without taking the
 interpreter apart, after the exit handlers and with every byte of output written."""
 
+import os
 import subprocess
 import sys
 import textwrap
 
+import pytest
 
-def _entry(argv, before=""):
+
+def _entry(argv, before="", **kw):
     code = textwrap.dedent(f"""
         import sys
         {before}
@@ -15,8 +18,8 @@ def _entry(argv, before=""):
         entry()
         print("not reached")
         """)
-    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                          timeout=60)
+    return subprocess.run([sys.executable, "-c", code], text=True, timeout=60,
+                          **({"capture_output": True} | kw))
 
 
 def test_the_exit_status_the_output_and_the_exit_handlers():
@@ -40,3 +43,16 @@ def test_a_thread_of_a_library_still_running_is_waited_for():
                "(time.sleep(0.5), print('thread done', flush=True))).start()")
     assert r.returncode == 0, r.stderr
     assert "thread done" in r.stdout
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="no /dev/full here")
+def test_output_that_cannot_be_written_is_an_error():
+    """A full disk when the output is flushed at the end (buffered, as when stdout is a file):
+    one line on stderr and exit status 2, not a silent 0."""
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONUNBUFFERED"}
+    with open("/dev/full", "w") as full:
+        r = _entry(["ik", "0", "120"], capture_output=False, stdout=full,
+                   stderr=subprocess.PIPE, env=env)
+    assert r.returncode == 2
+    assert r.stderr.strip().splitlines() == [
+        "dextar: error: the output could not be written: No space left on device"]

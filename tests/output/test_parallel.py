@@ -124,10 +124,11 @@ def test_forked_work_runs_in_a_child_while_this_process_goes_on():
     from dextar.output.parallel import Forked
 
     t0 = time.perf_counter()
-    with Forked(lambda: (time.sleep(0.5), os.getpid())[1]) as child:
+    with Forked(lambda: (time.sleep(1.0), os.getpid())[1], enabled=True) as child:
         here = time.perf_counter() - t0  # the block goes on at once
         pid = child.result()
-    assert here < 0.4
+        assert child.result() == pid  # computed once
+    assert here < 0.6
     assert pid != os.getpid()
     with Forked(os.getpid, enabled=False) as inline:  # no child: the work runs at result()
         assert inline.result() == os.getpid()
@@ -160,3 +161,45 @@ def test_leaving_the_block_early_ends_the_child():
         with Forked(lambda: time.sleep(30)):
             raise RuntimeError("this process failed")
     assert {p.pid for p in multiprocessing.active_children()} <= before
+
+
+@fork_only
+def test_what_the_child_finished_before_a_job_failed_is_kept():
+    """The child stops at a failing job (here its second: every job fails in the child
+    after its first); that job and the rest run here, where an error would be raised, and
+    the job the child finished is neither lost nor run twice."""
+    import time
+
+    ran = []  # each process's own list: the jobs it ran
+
+    def job(k):
+        def run():
+            time.sleep(0.05)
+            if os.getpid() != parent and ran:
+                raise ParameterError(f"job {k} failed in the child")
+            ran.append(k)
+            return (k, os.getpid())
+        return run
+
+    parent = os.getpid()
+    jobs = {f"j{k}": (job(k), 10.0 - k) for k in range(8)}
+    out = render(jobs, workers=2)
+    assert [v[0] for v in out.values()] == list(range(8))
+    theirs = [k for k, pid in out.values() if pid != parent]
+    assert len(theirs) == 1  # the one the child finished, kept
+    assert sorted(ran) == sorted(set(range(8)) - set(theirs))  # the rest, each once here
+
+
+@fork_only
+def test_no_fork_to_be_had_runs_the_work_here(monkeypatch):
+    from multiprocessing.process import BaseProcess
+
+    from dextar.output.parallel import Forked
+
+    def cannot(self):
+        raise OSError(11, "Resource temporarily unavailable")
+
+    monkeypatch.setattr(BaseProcess, "start", cannot)
+    with Forked(os.getpid, enabled=True) as f:
+        assert f.result() == os.getpid()
+    assert render({"a": (lambda: 1, 1.0), "b": (lambda: 2, 2.0)}, workers=2) == {"a": 1, "b": 2}

@@ -26,3 +26,11 @@ def test_hermite_table_is_scipys_cubic_hermite_spline(n):
     bent[n // 2] += 1e-6
     assert np.abs(HermiteTable(x, y, bent)(xi) - ref).max() > 1e-12
     assert HermiteTable(x, y, m)(xi.reshape(-1, 1)).shape == (len(xi), 1)
+
+
+def test_knots_that_do_not_rise_are_refused():
+    from dextar.errors import ParameterError
+
+    for x in ([0.0, 1.0, 1.0, 2.0], [0.0, 2.0, 1.0], [0.0], [0.0, float("nan")]):
+        with pytest.raises(ParameterError, match="rising knots"):
+            HermiteTable(np.array(x), np.zeros(len(x)), np.zeros(len(x)))

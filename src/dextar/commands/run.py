@@ -5,6 +5,8 @@ report."""
 from __future__ import annotations
 
 import argparse
+import time
+from typing import Any
 
 from .base import Result, config_argument, into_directory, shown
 
@@ -26,7 +28,7 @@ def run(args: argparse.Namespace) -> Result:
     from ..analysis import analyze, run_summary, validation
     from ..config import load_scenario
     from ..output.files import OutputDir
-    from ..output.parallel import Forked, can_fork
+    from ..output.parallel import Forked
     from ..output.run import RUN_FILES, Progress, staged, write_run
 
     sc = load_scenario(args.config, model=args.model)
@@ -37,9 +39,14 @@ def run(args: argparse.Namespace) -> Result:
         an = stage(f"{sc.law_table.type} law, trajectory and torques",
                    lambda: analyze(inputs, sc.law()))
         uniform = stage("uniform law (Fig. 3)", lambda: inputs.trajectory(sc.law("uniform")))
+
+        def checked() -> tuple[dict[str, Any], float]:
+            t0 = time.perf_counter()
+            return validation(an), time.perf_counter() - t0
+
         # the physics checks (scipy's import and an integration: half a second) on the other
         # core while this one loads matplotlib and draws
-        with Forked(lambda: validation(an), enabled=can_fork()) as checks:
+        with Forked(checked) as checks:
             s = run_summary(an, None, inputs.trajectory(uniform.law, samples=201))
             write_run(od, an, uniform, s, validation=checks.result, figures=sc.output.figures,
                       animation_frames=sc.output.animation_frames, stage=stage, progress=prog)

@@ -244,15 +244,20 @@ def _loads(model: Model, p: Pose, v: Rates, w1: Any, w2: Any, a1: Any, a2: Any, 
 def _check_state(model: Model, pose: Pose, q: Array, offset: int,
                  t: Array | None) -> None:
     r = model.robot
+    same = ~(pose.del2 > 0.0)  # elbows B and C at one point: P anywhere on a circle
     bad_fk = pose.wsq < -1e-12 * (r.L2 * r.L2) * pose.del2
     dist = np.abs(pose.det) / (r.L1 * r.L2)
     bad_sing = dist < model.tol
-    for bad, kind in ((bad_fk, "fk"), (bad_sing, "sing")):
+    for bad, kind in ((same, "same"), (bad_fk, "fk"), (bad_sing, "sing")):
         if np.any(bad):
             j = int(np.flatnonzero(bad)[0])
             i = offset + j
             when = f"at t = {t[i]:.6g} (sample {i})" if t is not None else f"at sample {i}"
             qd = np.degrees(q[i])
+            if kind == "same":
+                raise AssemblyError(f"the elbows B and C coincide {when}: q = ({qd[0]:.6g}, "
+                                    f"{qd[1]:.6g}) deg; the end-effector's position is not "
+                                    "determined")
             if kind == "fk":
                 raise AssemblyError(f"distal rods cannot meet {when}: q = ({qd[0]:.6g}, "
                                     f"{qd[1]:.6g}) deg")
@@ -542,15 +547,16 @@ def _torques(model: Model, q: object, dq: object, ddq: object, *, gravity: bool,
     c = _lumped(model, gravity, friction)
     r = model.robot
     # _check_state runs (and names the sample) only where the extremes come near the
-    # limits: rods that do not meet (a negative discriminant), 1 / |det| near 1 / (tol L1 L2)
-    sing_cap = 1.0 / (model.tol * r.L1 * r.L2) if model.tol > 0 else np.inf
+    # limits: rods that do not meet (a negative discriminant), 1 / |det| near 1 / (tol L1 L2),
+    # or are NaN (elbows that coincide): the comparisons are written to be false for a NaN
+    sing_cap = (1.0 / (model.tol * r.L1 * r.L2) if model.tol > 0 else np.inf) * (1.0 - 1e-9)
     tt = None if t is None else np.asarray(t, dtype=float).reshape(-1)
     out = np.empty((n, 2))
     if USE_COMPILED and _compiled is not None:
         disc, worst = _compiled.torques(_kernel_constants(c), np.ascontiguousarray(qf),
                                         np.ascontiguousarray(dqf), np.ascontiguousarray(ddqf),
                                         out)
-        if disc < 0.0 or worst >= sing_cap * (1.0 - 1e-9):
+        if not (disc >= 0.0 and worst < sing_cap):
             for blk in blocks(n):
                 with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
                     pose = _pose(model, qf[blk, 0], qf[blk, 1], _Np)
@@ -561,7 +567,7 @@ def _torques(model: Model, q: object, dq: object, ddq: object, *, gravity: bool,
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # checked below
             disc, worst = _fused_block(c, bufs.views(blk.stop - blk.start), qf[blk], dqf[blk],
                                        ddqf[blk], out[blk])
-        if disc < 0.0 or worst >= sing_cap * (1.0 - 1e-9):
+        if not (disc >= 0.0 and worst < sing_cap):
             with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
                 pose = _pose(model, qf[blk, 0], qf[blk, 1], _Np)
             _check_state(model, pose, qf, blk.start, tt)

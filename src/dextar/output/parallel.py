@@ -47,28 +47,40 @@ def render(jobs: Mapping[str, Job[R]], *, workers: int | None = None) -> dict[st
 
     The two processes take the jobs from one queue, the costliest first, each the next one
     when it is free: a job slower than its cost said (a busy machine, a first use of a font)
-    delays the one process it runs on, not the split. A job the child took and did not
-    finish (it failed or died) runs here, so its error is raised here."""
+    delays the one process it runs on, not the split. The child stops at a job that fails;
+    that job and any it did not finish (it died) run here, so that an error is raised here;
+    what it finished is kept."""
     if workers is None:
         workers = 2 if can_fork() else 1
-    if workers < 2 or len(jobs) < 2:
+    if workers < 2 or len(jobs) < 2 or len(jobs) > 255:
         return {n: jobs[n][0]() for n in jobs}
     order = sorted(jobs, key=lambda n: -jobs[n][1])
-    taken = multiprocessing.get_context("fork").Value("i", 0)  # the queue's head, shared
+    try:  # the queue: a pipe of job numbers, one byte each, read a byte at a time by both
+        head, tail = os.pipe()
+    except OSError:  # no file descriptor left: in turn
+        return {n: jobs[n][0]() for n in jobs}
+    try:
+        os.write(tail, bytes(range(len(order))))
+        os.close(tail)
 
-    def take() -> dict[str, R]:
-        done: dict[str, R] = {}
-        while True:
-            with taken.get_lock():
-                k = taken.value
-                taken.value = k + 1
-            if k >= len(order):
-                return done
-            done[order[k]] = jobs[order[k]][0]()
+        def take(child: bool) -> dict[str, R]:
+            done: dict[str, R] = {}
+            while k := os.read(head, 1):
+                name = order[k[0]]
+                if not child:
+                    done[name] = jobs[name][0]()
+                    continue
+                try:
+                    done[name] = jobs[name][0]()
+                except Exception:  # raised again here, where it runs once more
+                    break
+            return done
 
-    with Forked(take) as child:
-        results = take()
-        results.update(child.result())
+        with Forked(lambda: take(True)) as other:
+            results = take(False)
+            results.update(other.result())  # (where the child failed, take() finds none left)
+    finally:
+        os.close(head)
     results.update({n: jobs[n][0]() for n in order if n not in results})  # the child's lost
     return {n: results[n] for n in jobs}
 
@@ -85,15 +97,17 @@ class Forked(Generic[R]):
             value = checked.result()
 
     :meth:`result` waits for the child's result; where the child fails or dies, or was not
-    forked (``enabled`` False), ``fn`` runs here, so that its error is raised here. Leaving the
-    block ends a child that is still running (this process failed or was interrupted)."""
+    forked (``enabled`` False; None: where :func:`can_fork`; no fork to be had), ``fn``
+    runs here, so that its error is raised here. Leaving the block ends a child that is
+    still running (this process failed or was interrupted)."""
 
-    def __init__(self, fn: Callable[[], R], *, enabled: bool = True) -> None:
+    def __init__(self, fn: Callable[[], R], *, enabled: bool | None = None) -> None:
         """Fork on entering the block (only where ``enabled``)."""
         self.fn = fn
-        self.enabled = enabled
+        self.enabled = can_fork() if enabled is None else enabled
         self._child: Any = None
         self._receive: Any = None
+        self._result: tuple[R] | None = None
 
     def __enter__(self) -> Forked[R]:
         if not self.enabled:
@@ -101,7 +115,10 @@ class Forked(Generic[R]):
         ctx = multiprocessing.get_context("fork")
         for stream in (sys.stdout, sys.stderr):  # nothing buffered to be written twice
             stream.flush()
-        self._receive, send = ctx.Pipe(duplex=False)
+        try:
+            self._receive, send = ctx.Pipe(duplex=False)
+        except OSError:  # no file descriptor left: the work runs here
+            return self
         self._child = ctx.Process(target=_child, args=(self.fn, send), daemon=True)
         # no interrupt inside the fork (its handlers, logging's and ours, would swallow it):
         # one that comes is held until the child exists, then raised here, where the child
@@ -110,6 +127,8 @@ class Forked(Generic[R]):
         try:
             try:
                 self._child.start()
+            except OSError:  # no fork to be had (no memory, too many processes): here
+                self._child = None
             finally:
                 send.close()
             signal.pthread_sigmask(signal.SIG_SETMASK, held)  # a held interrupt comes here
@@ -120,7 +139,13 @@ class Forked(Generic[R]):
         return self
 
     def result(self) -> R:
-        """The child's result (waited for), or ``fn()`` computed here."""
+        """The child's result (waited for), or ``fn()`` computed here; the same on every
+        call."""
+        if self._result is None:
+            self._result = (self._compute(),)
+        return self._result[0]
+
+    def _compute(self) -> R:
         if self._child is None:
             return self.fn()
         try:
@@ -151,17 +176,23 @@ class Forked(Generic[R]):
 
 
 def _child(fn: Callable[[], Any], send: Any) -> None:
-    """The child's work: ``fn``'s result, or word that it failed (the parent redoes it)."""
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)  # ended by the parent: quietly
-    signal.pthread_sigmask(signal.SIG_UNBLOCK, _INTERRUPTS)  # held by the fork
+    """The child's work: ``fn``'s result, or word that it failed (the parent redoes it).
+    Ended by the parent (SIGTERM) quietly; an interrupt at the terminal (SIGINT, sent to the
+    whole group) is the parent's to handle, which then ends the child."""
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     result: tuple[bool, Any]
     try:
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, _INTERRUPTS)  # held by the fork
         result = (True, fn())
-    except BaseException:  # anything, interrupts included: the parent decides
+    except BaseException:  # anything: the parent decides
         result = (False, None)
     try:
         send.send(result)
-    except OSError:  # the parent is gone
-        pass
+    except BaseException:  # a result that does not pickle, or the parent gone
+        try:
+            send.send((False, None))
+        except BaseException:
+            pass
     finally:
         send.close()

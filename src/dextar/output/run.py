@@ -80,22 +80,24 @@ def default_figures(an: Analysis) -> tuple[str, ...]:
 
 
 def write_run(od: OutputDir, an: Analysis, uniform: Trajectory, summary: dict[str, Any], *,
-              validation: Callable[[], dict[str, Any]] | None = None,
+              validation: Callable[[], tuple[dict[str, Any], float]] | None = None,
               figures: tuple[str, ...] | None, animation_frames: int, stage: Stage,
               progress: Progress) -> None:
     """Write a run's files into ``od``: ``trajectory.csv``, the figures (PNG and SVG; None:
     :func:`default_figures`), the animation, ``report.html`` and, last, ``summary.json``
     (with the files and timings). ``validation`` gives the physics checks, the summary's
-    ``validation``, once the figures are drawn (``dextar run`` computes them meanwhile on the
-    other core: :class:`~dextar.output.parallel.Forked`)."""
+    ``validation``, and the seconds they took, once the figures are drawn (``dextar run``
+    computes them meanwhile on the other core: :class:`~dextar.output.parallel.Forked`; the
+    timings give their own seconds, not the wait)."""
     if figures is None:
         figures = default_figures(an)
     stage("trajectory.csv", lambda: od.write_text("trajectory.csv", csv_text(run_columns(an))))
     files = stage("figures and animation.gif",
                   lambda: _figures(an, uniform, figures, animation_frames))
     if validation is not None:
-        summary["validation"] = stage("validation (power balance, forward re-simulation)",
-                                      validation)
+        name = "validation (power balance, forward re-simulation)"
+        summary["validation"], seconds = stage(name, validation)
+        progress.timings[name] = round(seconds, 4)
     for name, data in files.items():
         od.write_bytes(name, data)
     pngs = {n[:-4]: files[n] for n in files if n.endswith(".png")}

@@ -42,6 +42,9 @@ class HermiteTable:
         self.x = np.asarray(x, dtype=float)
         y, m = np.asarray(y, dtype=float), np.asarray(dydx, dtype=float)
         h = np.diff(self.x)
+        if not (len(self.x) >= 2 and (h > 0).all() and y.shape == m.shape == self.x.shape):
+            raise ParameterError("a Hermite table needs rising knots (at least two) and a value "
+                                 "and a slope at each")
         slope = np.diff(y) / h
         t = (m[:-1] + m[1:] - 2.0 * slope) / h
         # per piece: y + m dx + c2 dx^2 + c3 dx^3, dx from the piece's left knot
