@@ -91,8 +91,9 @@ def write_run(od: OutputDir, an: Analysis, uniform: Trajectory, summary: dict[st
     timings give their own seconds, not the wait)."""
     if figures is None:
         figures = default_figures(an)
-    files = stage("trajectory.csv, figures and animation.gif",
-                  lambda: _files(an, uniform, figures, animation_frames))
+    stage("trajectory.csv", lambda: od.write_text("trajectory.csv", csv_text(run_columns(an))))
+    files = stage("figures and animation.gif",
+                  lambda: _figures(an, uniform, figures, animation_frames))
     if validation is not None:
         name = "validation (power balance, forward re-simulation)"
         summary["validation"], seconds = stage(name, validation)
@@ -108,17 +109,16 @@ def write_run(od: OutputDir, an: Analysis, uniform: Trajectory, summary: dict[st
     od.write_text("summary.json", json.dumps(summary, indent=2, allow_nan=False) + "\n")
 
 
-#: What each file costs to make, relative to the others (measured in a run): the order in
+#: What each figure costs to draw, relative to the others (measured in a run): the order in
 #: which the two processes take them (:func:`~dextar.output.parallel.render`).
 _COSTS = {"fig3": 1.0, "fig4": 1.1, "fig5": 0.95, "fig6": 1.2, "fig7": 1.0, "fig8": 1.1,
-          "fig9": 1.5, "workspace": 1.1, "animation": 1.6, "trajectory.csv": 0.15}
+          "fig9": 1.5, "workspace": 1.1, "animation": 1.6}
 
 
-def _files(an: Analysis, uniform: Any, wanted: tuple[str, ...], animation_frames: int
-           ) -> dict[str, bytes]:
-    """``trajectory.csv``, the figures in ``wanted`` (PNG, and SVG but for the workspace)
-    and the animation, by file name, made on two cores where there are two
-    (:mod:`dextar.output.parallel`)."""
+def _figures(an: Analysis, uniform: Any, wanted: tuple[str, ...], animation_frames: int
+             ) -> dict[str, bytes]:
+    """The figures in ``wanted`` (PNG, and SVG but for the workspace) and the animation, by
+    file name, drawn on two cores where there are two (:mod:`dextar.output.parallel`)."""
     from . import figures as fg
     from .parallel import Job, render
 
@@ -141,9 +141,6 @@ def _files(an: Analysis, uniform: Any, wanted: tuple[str, ...], animation_frames
     if "animation" in wanted:
         jobs["animation"] = (lambda: {"animation.gif": fg.animation_gif(an, animation_frames)},
                              _COSTS["animation"])
-    jobs["trajectory.csv"] = (
-        lambda: {"trajectory.csv": csv_text(run_columns(an)).encode("utf-8")},
-        _COSTS["trajectory.csv"])
     fg.warm_up()
     return {k: v for part in render(jobs).values() for k, v in part.items()}
 
