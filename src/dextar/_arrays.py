@@ -12,12 +12,14 @@ from .errors import ParameterError
 Array: TypeAlias = np.ndarray[Any, Any]
 
 
-def as_points(values: object, name: str) -> Array:
-    """Float array of shape (..., 2), finite; raises naming ``name`` and the first bad index."""
+def as_points(values: object, name: str, *, finite: bool = True) -> Array:
+    """Float array of shape (..., 2), finite (unless ``finite`` is False: the caller checks,
+    with :func:`check_finite`); raises naming ``name`` and the first bad index."""
     arr = np.asarray(values, dtype=float)
     if arr.ndim == 0 or arr.shape[-1] != 2:
         raise ParameterError(f"{name} must have shape (..., 2), got {arr.shape}")
-    check_finite(arr, name)
+    if finite:
+        check_finite(arr, name)
     return arr
 
 

@@ -19,7 +19,7 @@ from dextar.dynamics import (
     inverse_dynamics,
 )
 from dextar.dynamics.exact import _torques
-from dextar.errors import SingularityError
+from dextar.errors import ParameterError, SingularityError
 from dextar.geometry import FiveBar
 
 from .conftest import ROBOT
@@ -230,3 +230,30 @@ def test_compiled_and_numpy_kernels_agree(robot, assembly, friction, monkeypatch
     other = Model(robot, ine.with_(rotor=(0.01 * (1 + 1e-8), 0.015)), assembly=assembly, tol=0.0)
     monkeypatch.setattr(exact, "USE_COMPILED", True)
     assert np.abs(inverse_dynamics(other, q, dq, ddq) - plain).max() > 1e-12 * scale
+
+
+@pytest.mark.parametrize("bad", ["q", "dq", "ddq"])
+@pytest.mark.parametrize("value", [np.nan, np.inf, -np.inf])
+def test_a_value_that_is_not_finite_is_named_by_input_and_index(bad, value, kernel):
+    """The compiled kernel checks its inputs as it reads them; the error names the input and
+    the sample's index in the caller's shape, as the numpy kernel's check does."""
+    model = Model(ROBOT, inertia(gravity=(0.0, -1.0)))
+    q, dq, ddq = states(ROBOT, 600, 9)
+    args = {"q": q.reshape(20, 30, 2), "dq": dq.reshape(20, 30, 2), "ddq": ddq.reshape(20, 30, 2)}
+    args[bad] = args[bad].copy()
+    args[bad][17, 4, 1] = value
+    with pytest.raises(ParameterError, match=rf"^{bad} has a non-finite value at index \(17, 4, 1\)"):
+        inverse_dynamics(model, args["q"], args["dq"], args["ddq"])
+
+
+def test_an_old_build_of_the_compiled_kernel_is_not_used():
+    """A build of another interface version (an edit of _kernel.c whose build failed leaves
+    the old one in place) is set aside at import: the numpy kernel runs, no crash."""
+    from types import SimpleNamespace
+
+    assert not exact._usable(None)
+    assert not exact._usable(SimpleNamespace(torques=None))  # a build before versions
+    assert not exact._usable(SimpleNamespace(VERSION=exact.KERNEL_VERSION - 1))
+    assert exact._usable(SimpleNamespace(VERSION=exact.KERNEL_VERSION))
+    if exact._compiled is not None:
+        assert exact._usable(exact._compiled)

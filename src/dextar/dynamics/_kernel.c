@@ -6,12 +6,14 @@
  * Built by `pip install` when a C compiler is there (an optional extension: without one,
  * dextar uses the numpy kernel and gives the same torques to rounding).
  *
- * torques(consts, q, dq, ddq, out) -> (disc, worst)
+ * torques(consts, q, dq, ddq, out) -> (disc, worst, finite)
  *   consts: the model's constants (float64, N_CONSTS, the order of the C_* indices below);
  *   q, dq, ddq: C-contiguous float64 buffers of n * 2 values (n samples, (phi, psi));
  *   out: a writable C-contiguous float64 buffer of n * 2 values, the motor torques.
  *   Returns the smallest (h / |B - C|^2)^2 (negative where the rods cannot meet) and the
- *   largest 1 / |det A| over the samples, for the checks that name a bad sample.
+ *   largest 1 / |det A| over the samples, for the checks that name a bad sample, and
+ *   whether every input is finite (the inputs are checked here, where they are read, and
+ *   named by the caller only when one is not).
  *
  * The motor angles' cosines and sines come from a polynomial on the angle reduced to
  * [-pi/4, pi/4] (Cody-Waite reduction with pi/2 in three parts, Taylor series to the 17th
@@ -32,6 +34,10 @@
 #if (defined(FLT_EVAL_METHOD) && FLT_EVAL_METHOD != 0) || defined(__FAST_MATH__)
 #error "dextar's compiled kernel needs double evaluation without -ffast-math"
 #endif
+
+/* The kernel's interface version: exact.py uses a build of this version only (an older
+ * build left in place, after an edit whose build failed, is not used). */
+#define KERNEL_VERSION 2
 
 enum {
     C_L1, C_L2, C_D, C_LSQ1, C_LSQ2, C_ILSQ1, C_ILSQ2, C_L2SQ, C_UE0, C_CST, C_SIGN,
@@ -185,17 +191,29 @@ static void coulomb(const double *k, const double *dq, double *out, Py_ssize_t n
     }
 }
 
-static void all_samples(const double *k, const double *q, const double *dq, const double *ddq,
-                        double *out, Py_ssize_t n, double *disc_min, double *worst_max)
+/* whether the values x[0..n) are all finite (a loop the compiler vectorises) */
+static int all_finite(const double *x, Py_ssize_t n)
+{
+    int bad = 0;
+    for (Py_ssize_t i = 0; i < n; i++)
+        bad |= !(fabs(x[i]) <= DBL_MAX);
+    return !bad;
+}
+
+static int all_samples(const double *k, const double *q, const double *dq, const double *ddq,
+                       double *out, Py_ssize_t n, double *disc_min, double *worst_max)
 {
     double disc[BLOCK], worst[BLOCK];
     double dmin = INFINITY, wmax = 0.0;
     int nan = 0;  /* a NaN among them (elbows that coincide) is told, not skipped */
+    int inputs_finite = 1;
     for (Py_ssize_t start = 0; start < n; start += BLOCK) {
         Py_ssize_t m = n - start < BLOCK ? n - start : BLOCK;
         const double *qb = q + 2 * start, *dqb = dq + 2 * start, *ddqb = ddq + 2 * start;
         double *ob = out + 2 * start;
         int large = 0;
+        inputs_finite &= all_finite(qb, 2 * m) & all_finite(dqb, 2 * m)
+                         & all_finite(ddqb, 2 * m);
         block(k, qb, dqb, ddqb, ob, m, disc, worst);
         for (Py_ssize_t i = 0; i < 2 * m; i++)
             large |= !(fabs(qb[i]) <= REDUCTION_LIMIT);
@@ -213,6 +231,7 @@ static void all_samples(const double *k, const double *q, const double *dq, cons
     }
     *disc_min = nan ? NAN : dmin;
     *worst_max = nan ? NAN : wmax;
+    return inputs_finite;
 }
 
 static int get_buffer(PyObject *obj, Py_buffer *view, int writable, const char *name)
@@ -256,10 +275,11 @@ static PyObject *torques(PyObject *self, PyObject *args)
         double *out = views[4].buf;
         Py_ssize_t n = len / 16;
         double disc, worst;
+        int ok;
         Py_BEGIN_ALLOW_THREADS
-        all_samples(k, q, dq, ddq, out, n, &disc, &worst);
+        ok = all_samples(k, q, dq, ddq, out, n, &disc, &worst);
         Py_END_ALLOW_THREADS
-        result = Py_BuildValue("(dd)", disc, worst);
+        result = Py_BuildValue("(ddO)", disc, worst, ok ? Py_True : Py_False);
     }
 done:
     while (got > 0)
@@ -269,7 +289,7 @@ done:
 
 static PyMethodDef methods[] = {
     {"torques", torques, METH_VARARGS,
-     "torques(consts, q, dq, ddq, out) -> (disc, worst): the fused torque kernel."},
+     "torques(consts, q, dq, ddq, out) -> (disc, worst, finite): the fused torque kernel."},
     {NULL, NULL, 0, NULL}
 };
 
@@ -303,7 +323,8 @@ PyMODINIT_FUNC PyInit__kernel(void)
         return NULL;
     }
     PyObject *m = PyModule_Create(&module);
-    if (m != NULL && PyModule_AddIntConstant(m, "N_CONSTS", N_CONSTS) < 0) {
+    if (m != NULL && (PyModule_AddIntConstant(m, "N_CONSTS", N_CONSTS) < 0
+                      || PyModule_AddIntConstant(m, "VERSION", KERNEL_VERSION) < 0)) {
         Py_DECREF(m);
         return NULL;
     }

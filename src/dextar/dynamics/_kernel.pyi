@@ -1,5 +1,6 @@
 # The compiled fused torque kernel (_kernel.c), built by pip where a C compiler is.
 N_CONSTS: int
+VERSION: int
 
 def torques(consts: object, q: object, dq: object, ddq: object, out: object, /
-            ) -> tuple[float, float]: ...
+            ) -> tuple[float, float, bool]: ...

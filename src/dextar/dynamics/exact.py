@@ -29,7 +29,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from .._arrays import Array, as_points, blocks, cos_sin
+from .._arrays import Array, as_points, blocks, check_finite, cos_sin
 from ..errors import AssemblyError, ParameterError, SingularityError
 from ..geometry import FiveBar, parse_assembly_mode
 from ..kinematics import DEFAULT_SINGULARITY_TOL
@@ -40,6 +40,19 @@ try:  # the fused kernel compiled (_kernel.c), built by pip where a C compiler i
     from . import _kernel as _compiled
 except ImportError:  # pragma: no cover - installed without a C compiler: the numpy kernel
     _compiled = None  # type: ignore[assignment]  # the module or None, as USE_COMPILED says
+
+#: The compiled kernel's interface this module calls (``KERNEL_VERSION`` in _kernel.c): a
+#: build of another version (an old one left in place) is not used.
+KERNEL_VERSION = 2
+
+
+def _usable(module: object) -> bool:
+    """Whether ``module`` is a build of the compiled kernel of this interface version."""
+    return module is not None and getattr(module, "VERSION", None) == KERNEL_VERSION
+
+
+if not _usable(_compiled):
+    _compiled = None  # type: ignore[assignment]  # an old build: the numpy kernel instead
 
 #: Whether :func:`inverse_dynamics` and its kin use the compiled kernel (where it was built):
 #: False gives the numpy kernel (the same torques to rounding; the tests compare the two).
@@ -535,11 +548,11 @@ def _torques(model: Model, q: object, dq: object, ddq: object, *, gravity: bool,
              friction: bool, t: object = None, block: int = FUSED_BLOCK) -> Array:
     """Motor torques (..., 2) by the fused kernel (compiled where it was built, else numpy
     in blocks of ``block`` samples), checked like :func:`_run`."""
-    q0 = as_points(q, "q")
-    shape = q0.shape[:-1]
-    qf = q0.reshape(-1, 2)
-    dqf = as_points(dq, "dq").reshape(-1, 2)
-    ddqf = as_points(ddq, "ddq").reshape(-1, 2)
+    compiled = USE_COMPILED and _compiled is not None  # (it checks the inputs as it reads)
+    inputs = [as_points(x, name, finite=not compiled)
+              for x, name in ((q, "q"), (dq, "dq"), (ddq, "ddq"))]
+    shape = inputs[0].shape[:-1]
+    qf, dqf, ddqf = (x.reshape(-1, 2) for x in inputs)
     n = len(qf)
     if not (len(dqf) == len(ddqf) == n):
         raise ParameterError(f"q, dq, ddq must have the same number of samples, got "
@@ -552,10 +565,13 @@ def _torques(model: Model, q: object, dq: object, ddq: object, *, gravity: bool,
     sing_cap = (1.0 / (model.tol * r.L1 * r.L2) if model.tol > 0 else np.inf) * (1.0 - 1e-9)
     tt = None if t is None else np.asarray(t, dtype=float).reshape(-1)
     out = np.empty((n, 2))
-    if USE_COMPILED and _compiled is not None:
-        disc, worst = _compiled.torques(_kernel_constants(c), np.ascontiguousarray(qf),
-                                        np.ascontiguousarray(dqf), np.ascontiguousarray(ddqf),
-                                        out)
+    if compiled and _compiled is not None:
+        disc, worst, finite = _compiled.torques(
+            _kernel_constants(c), np.ascontiguousarray(qf), np.ascontiguousarray(dqf),
+            np.ascontiguousarray(ddqf), out)
+        if not finite:  # named here
+            for x, name in zip(inputs, ("q", "dq", "ddq"), strict=True):
+                check_finite(x, name)
         if not (disc >= 0.0 and worst < sing_cap):
             for blk in blocks(n):
                 with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
