@@ -22,7 +22,7 @@ def test_frames_share_one_palette_and_keep_their_colours():
     frames[3][40:45, 40:45] = rng.integers(0, 256, (5, 5, 3), dtype=np.uint8)  # many colours
     opaque = [np.concatenate([f, np.full(f.shape[:2] + (1,), 255, np.uint8)], -1)
               for f in frames]  # as the canvas gives them
-    images = _one_palette(frames[0], [_packed(f) for f in opaque])
+    images = _one_palette([_packed(f) for f in opaque])
     assert len(images) == 6 and all(im.mode == "P" for im in images)
     assert len({bytes(im.getpalette()) for im in images}) == 1  # one palette
     for f, im in zip(frames, images, strict=True):

@@ -548,8 +548,8 @@ def _torques(model: Model, q: object, dq: object, ddq: object, *, gravity: bool,
              friction: bool, t: object = None, block: int = FUSED_BLOCK) -> Array:
     """Motor torques (..., 2) by the fused kernel (compiled where it was built, else numpy
     in blocks of ``block`` samples), checked like :func:`_run`."""
-    compiled = USE_COMPILED and _compiled is not None  # (it checks the inputs as it reads)
-    inputs = [as_points(x, name, finite=not compiled)
+    kernel = _compiled if USE_COMPILED else None  # (it checks the inputs as it reads)
+    inputs = [as_points(x, name, finite=kernel is None)
               for x, name in ((q, "q"), (dq, "dq"), (ddq, "ddq"))]
     shape = inputs[0].shape[:-1]
     qf, dqf, ddqf = (x.reshape(-1, 2) for x in inputs)
@@ -565,28 +565,28 @@ def _torques(model: Model, q: object, dq: object, ddq: object, *, gravity: bool,
     sing_cap = (1.0 / (model.tol * r.L1 * r.L2) if model.tol > 0 else np.inf) * (1.0 - 1e-9)
     tt = None if t is None else np.asarray(t, dtype=float).reshape(-1)
     out = np.empty((n, 2))
-    if compiled and _compiled is not None:
-        disc, worst, finite = _compiled.torques(
+
+    def check(disc: float, worst: float, blk: slice) -> None:
+        if not (disc >= 0.0 and worst < sing_cap):
+            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+                pose = _pose(model, qf[blk, 0], qf[blk, 1], _Np)
+            _check_state(model, pose, qf, blk.start, tt)
+
+    if kernel is not None:
+        disc, worst, finite = kernel.torques(
             _kernel_constants(c), np.ascontiguousarray(qf), np.ascontiguousarray(dqf),
             np.ascontiguousarray(ddqf), out)
         if not finite:  # named here
             for x, name in zip(inputs, ("q", "dq", "ddq"), strict=True):
                 check_finite(x, name)
-        if not (disc >= 0.0 and worst < sing_cap):
-            for blk in blocks(n):
-                with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-                    pose = _pose(model, qf[blk, 0], qf[blk, 1], _Np)
-                _check_state(model, pose, qf, blk.start, tt)
+        check(disc, worst, slice(0, n))
         return out.reshape(shape + (2,))
     bufs = _Buffers(min(block, max(n, 1)))
     for blk in blocks(n, block):
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # checked below
             disc, worst = _fused_block(c, bufs.views(blk.stop - blk.start), qf[blk], dqf[blk],
                                        ddqf[blk], out[blk])
-        if not (disc >= 0.0 and worst < sing_cap):
-            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-                pose = _pose(model, qf[blk, 0], qf[blk, 1], _Np)
-            _check_state(model, pose, qf, blk.start, tt)
+        check(disc, worst, blk)
     return out.reshape(shape + (2,))
 
 

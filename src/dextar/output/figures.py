@@ -216,7 +216,7 @@ def animation_gif(an: Analysis, frames: int = 41) -> bytes:
     still = canvas.copy_from_bbox(fig.bbox)  # type: ignore[no-untyped-call]  # the same
     times_s = tr.t * an.inputs.units.time_s
     index, durations = _real_time_frames(times_s - times_s[0], frames)
-    packed, first = [], None
+    packed = []
     for i in index:
         canvas.restore_region(still)  # type: ignore[no-untyped-call]  # the same
         arm.set_data([r.A[0], B[i, 0], tr.P[i, 0], C[i, 0], r.D[0]],
@@ -224,12 +224,9 @@ def animation_gif(an: Analysis, frames: int = 41) -> bytes:
         label.set_text(f"t = {tr.t[i]:.3f} {an.inputs.units.names['time']}")
         ax.draw_artist(arm)
         ax.draw_artist(label)
-        rgba = np.asarray(canvas.buffer_rgba())  # type: ignore[no-untyped-call]  # the same
-        if first is None:
-            first = rgba[..., :3].copy()
-        packed.append(_packed(rgba))
-    assert first is not None, "an animation has a frame at least"
-    images = _one_palette(first, packed)
+        rgba = canvas.buffer_rgba()  # type: ignore[no-untyped-call]  # the same
+        packed.append(_packed(np.asarray(rgba)))
+    images = _one_palette(packed)
     buf = io.BytesIO()
     images[0].save(buf, format="GIF", save_all=True, append_images=images[1:],
                    duration=durations, loop=0)
@@ -271,10 +268,10 @@ def _packed(rgba: Array) -> Array:
     return np.asarray(np.ascontiguousarray(rgba).view("<u4")[..., 0] & 0xFFFFFF)
 
 
-def _one_palette(first: Array, packed: list[Array]) -> list[Any]:
-    """Frames, each an array (h, w) of its pixels' colours packed as ``R + G 2^8 + B 2^16``,
-    as palette images sharing the adaptive (median-cut) palette of the first frame (``first``,
-    its RGB pixels (h, w, 3)), each pixel in its nearest palette colour.
+def _one_palette(packed: list[Array]) -> list[Any]:
+    """Frames, each an array (h, w) of its pixels' colours packed as ``R + G 2^8 + B 2^16``
+    (:func:`_packed`), as palette images sharing the adaptive (median-cut) palette of the
+    first frame, each pixel in its nearest palette colour.
 
     The frames differ from the first only where the arm and the time are drawn, so the
     colours are collected from the first frame and the pixels that change. (PIL's own
@@ -283,12 +280,14 @@ def _one_palette(first: Array, packed: list[Array]) -> list[Any]:
     """
     from PIL import Image
 
+    shifts = np.array([0, 8, 16])
+    first = ((packed[0][..., None] >> shifts) & 255).astype(np.uint8)  # its RGB pixels
     im0 = Image.fromarray(first).convert("P", palette=Image.Palette.ADAPTIVE)
     palette = np.asarray(im0.getpalette(), np.int64).reshape(-1, 3)
     changed = [p != packed[0] for p in packed]
     colours = np.unique(np.concatenate([packed[0].ravel(), *(p[c] for p, c in
                                                              zip(packed, changed, strict=True))]))
-    rgb = (colours[:, None].astype(np.int64) >> np.array([0, 8, 16])) & 255
+    rgb = (colours[:, None].astype(np.int64) >> shifts) & 255
     nearest = ((rgb[:, None, :] - palette[None, :, :]) ** 2).sum(axis=-1).argmin(axis=1)
     index = nearest.astype(np.uint8)
     base = index[np.searchsorted(colours, packed[0])]

@@ -67,16 +67,16 @@ def render(jobs: Mapping[str, Job[R]], *, workers: int | None = None) -> dict[st
             done: dict[str, R] = {}
             while k := os.read(head, 1):
                 name = order[k[0]]
-                if not child:
-                    done[name] = jobs[name][0]()
-                    continue
                 try:
                     done[name] = jobs[name][0]()
-                except Exception:  # raised again here, where it runs once more
-                    break
+                except Exception:
+                    if not child:
+                        raise
+                    break  # (raised again here, where it runs once more)
             return done
 
-        with Forked(lambda: take(True)) as other:
+        # (workers says to fork: the decision is not made again)
+        with Forked(lambda: take(True), enabled=True) as other:
             results = take(False)
             results.update(other.result())  # (where the child failed, take() finds none left)
     finally:
