@@ -1,4 +1,5 @@
-"""IK and FK throughput on 1e6 points, one core (floor: 60 ns/point each).
+"""IK and FK throughput on 1e6 points, one core (floor: 60 ns/point each): the best of 7 runs,
+the median and the worst shown.
 
 Run: python benchmarks/bench_kinematics.py
 """
@@ -12,13 +13,20 @@ import numpy as np
 import dextar as dx
 
 
-def best_of(fn, repeat: int = 5) -> float:
-    best = np.inf
+def times_of(fn, repeat: int = 7) -> np.ndarray:
+    out = []
     for _ in range(repeat):
         t0 = time.perf_counter()
         fn()
-        best = min(best, time.perf_counter() - t0)
-    return best
+        out.append(time.perf_counter() - t0)
+    return np.array(out)
+
+
+def line(name: str, t: np.ndarray, n: int) -> str:
+    ns = t / n * 1e9
+    return (f"{name}: {ns.min():7.1f} ns/point best (median {np.median(ns):.1f}, worst "
+            f"{ns.max():.1f}; {n:.0e} points, floor 60: "
+            f"{'met' if ns.min() <= 60 else 'NOT met'})")
 
 
 def main() -> None:
@@ -30,11 +38,11 @@ def main() -> None:
     rad = rng.uniform(80.0, 125.0, n)
     P = np.stack([rad * np.cos(ang), rad * np.sin(ang)], axis=-1)
     q = dx.inverse_kinematics(robot, P, "+-")
-    t_ik = best_of(lambda: dx.inverse_kinematics(robot, P, "+-"))
-    t_fk = best_of(lambda: dx.direct_kinematics(robot, q, "up"))
+    t_ik = times_of(lambda: dx.inverse_kinematics(robot, P, "+-"))
+    t_fk = times_of(lambda: dx.direct_kinematics(robot, q, "up"))
     err = np.abs(dx.direct_kinematics(robot, q, "up") - P).max()
-    print(f"IK: {t_ik / n * 1e9:7.1f} ns/point  ({n:.0e} points, floor 60)")
-    print(f"FK: {t_fk / n * 1e9:7.1f} ns/point  ({n:.0e} points, floor 60)")
+    print(line("IK", t_ik, n))
+    print(line("FK", t_fk, n))
     print(f"max |fk(ik(P)) - P| = {err:.2e} mm")
 
 

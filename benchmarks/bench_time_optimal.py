@@ -19,8 +19,10 @@ does not do) and in parts:
 
 "solver" is rows + setup + passes + the law: the part toppra's time is comparable with. The
 rounds interleave ours and toppra's (ratios taken round by round: the machine's speed drifts);
-best of the rounds, the median and the worst shown. Floor: ours end to end within 0.3 of
-toppra's time at 400 and 2000 segments and no slower at 100; durations within 1e-4.
+best of the rounds, the median and the worst shown. Floor (issue 23): our solver at or under
+0.3x toppra's solver time at 400 and 2000 segments and no slower than toppra at 100, both as
+the median of the rounds' ratios; durations within 1e-4. End to end (with the coefficients
+toppra is given and the check it does not do) is printed beside it, not a floor.
 """
 
 from __future__ import annotations
@@ -149,6 +151,7 @@ def main() -> None:
     acc: dict[str, float] = defaultdict(float)
     instrument(acc)
     timed = Timed(along, acc)
+    verdicts = []
     for n in GRIDS:
         try:
             theirs = toppra_solver(along, n)
@@ -190,8 +193,12 @@ def main() -> None:
         print(f"  ours/toppra: end to end {min(ours_t) / min(tp_t):.2f} best/best, "
               f"{np.median(r_all):.2f} median of the rounds' ratios; solver "
               f"{min(solver) / min(tp_t):.2f} best/best, {np.median(r_solver):.2f} median")
-    print("floor: ours end to end <= 0.3 of toppra at 400 and 2000 segments, <= 1 at 100; "
-          "durations within 1e-4")
+        bound = 1.0 if n < 400 else 0.3
+        ok = np.median(r_solver) <= bound and rel <= 1e-4
+        verdicts.append(f"{n} segments {np.median(r_solver):.2f}x (<= {bound:g}x: "
+                        f"{'met' if ok else 'NOT met'})")
+    print("floor: our solver / toppra's solver (median of the rounds' ratios), durations "
+          "within 1e-4: " + "; ".join(verdicts))
 
 
 if __name__ == "__main__":
