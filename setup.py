@@ -1,9 +1,15 @@
-"""The compiled part of dextar: the fused torque kernel (src/dextar/dynamics/_kernel.c), which
-dextar.dynamics.exact uses where it was built. Everything else is in pyproject.toml.
+"""The compiled parts of dextar, each used where it was built; everything else is in
+pyproject.toml:
 
-The extension is optional: an install without a C compiler goes on, and dextar uses the numpy
-kernel (the same torques to rounding, three times slower: benchmarks/bench_dynamics.py). No
-contraction into fused multiply-adds: the same torques on every instruction set.
+* the fused torque kernel (src/dextar/dynamics/_kernel.c) of dextar.dynamics.exact: without
+  it the numpy kernel, the same torques to rounding, 1.5-3 times slower
+  (benchmarks/bench_dynamics.py);
+* the time-optimal law's reachability analysis (src/dextar/laws/_reach.c) of
+  dextar.laws.time_optimal: without it the Python passes, the same law to the last bit,
+  slower (benchmarks/bench_time_optimal.py).
+
+The extensions are optional: an install without a C compiler goes on without them. No
+contraction into fused multiply-adds: the same results on every instruction set.
 """
 
 import sys
@@ -13,4 +19,6 @@ from setuptools import Extension, setup
 FLAGS = [] if sys.platform == "win32" else ["-O3", "-ffp-contract=off", "-fno-math-errno"]
 
 setup(ext_modules=[Extension("dextar.dynamics._kernel", ["src/dextar/dynamics/_kernel.c"],
+                             optional=True, extra_compile_args=FLAGS),
+                   Extension("dextar.laws._reach", ["src/dextar/laws/_reach.c"],
                              optional=True, extra_compile_args=FLAGS)])

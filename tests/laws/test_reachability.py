@@ -1,13 +1,21 @@
 """The time-optimal solver's passes against linear programmes solved by scipy, on random
 stages, among them stages that need a least speed (the branch where rest is not reachable
-next is otherwise rare: no example or test path has it)."""
+next is otherwise rare: no example or test path has it); the compiled passes against the
+Python ones."""
+
+import shutil
+import sysconfig
 
 import numpy as np
 import pytest
 from scipy.optimize import linprog
 
+import dextar as dx
 from dextar.errors import InfeasibleError
-from dextar.laws.time_optimal import _controllable, _fastest, _stages
+from dextar.laws import time_optimal
+from dextar.laws.time_optimal import _controllable, _fastest, _passes, _stages
+
+ROBOT_M = dx.DEXTAR_MM.scaled(1e-3)
 
 
 def _random_stages(rng, n, floors, top=0.3):
@@ -84,3 +92,80 @@ def test_passes_agree_with_linear_programmes_also_where_a_least_speed_is_needed(
         assert x[k + 1] == pytest.approx(x[k] + 2 * ds[k] * best[1], rel=1e-9, abs=1e-12) \
             or k == n - 1
     assert x[0] == x[-1] == 0.0
+
+
+def _speeds(Gu, Gx, h, ds):
+    """The squared speeds, or the stage at which no motion passes."""
+    try:
+        return _passes(Gu, Gx, h, ds, lambda k: InfeasibleError(f"stage {k}"))
+    except InfeasibleError as e:
+        return str(e)
+
+
+@pytest.mark.skipif(time_optimal._compiled is None,
+                    reason="the compiled passes were not built (no C compiler at install)")
+def test_compiled_and_python_passes_give_the_same_speeds_to_the_last_bit(monkeypatch):
+    """Random stages (least speeds met and not met, so the backward pass's and the forward
+    pass's failures occur) and the rows of a real path with gravity, friction and a
+    torque-speed envelope: the same squared speeds bit for bit, or the same failing
+    stage."""
+    import dextar.dynamics as dyn
+    from dextar.laws.constraints import motor_constraints
+    from dextar.motors import MotorLimits
+    from dextar.paths import Arc
+
+    cases = []
+    for seed in range(60):
+        rng = np.random.default_rng(seed)
+        n = int(rng.integers(15, 80))
+        lo = int(rng.integers(5, n - 6))
+        cases.append(_random_stages(rng, n, np.arange(lo, lo + 5),
+                                    top=float(rng.choice([0.3, 1.0, 4.0]))))
+    inertia = dyn.Inertia.uniform(ROBOT_M, proximal_mass=0.03, distal_mass=0.02,
+                                  effector_mass=0.1, gravity=(0.0, -9.81),
+                                  viscous=(0.01, 0.01), coulomb=(0.02, 0.02))
+    robot = dyn.Model(ROBOT_M, inertia)
+    along = dyn.RobotAlongPath(robot, Arc(0.12, 0.0, np.pi))
+    co = along.coefficients(np.linspace(0.0, along.length, 301))
+    cons = motor_constraints(MotorLimits((0.6, 0.6), max_speed=(9.0, 9.0),
+                                         knee_speed=(3.0, 3.0)))
+    x0 = np.full(301, 0.5)
+    cases.append((*time_optimal._rows(co, np.diff(co.s), cons, x0), np.diff(co.s)))
+    outcomes = set()
+    for Gu, Gx, h, ds in cases:
+        monkeypatch.setattr(time_optimal, "USE_COMPILED", True)
+        compiled = _speeds(Gu, Gx, h, ds)
+        monkeypatch.setattr(time_optimal, "USE_COMPILED", False)
+        python = _speeds(Gu, Gx, h, ds)
+        assert type(compiled) is type(python)
+        if isinstance(python, str):
+            assert compiled == python
+            outcomes.add("fails")
+        else:
+            assert np.array_equal(compiled, python)
+            outcomes.add("speeds")
+    assert outcomes == {"fails", "speeds"}  # both kinds of case occur
+
+
+def test_the_compiled_passes_are_built_where_a_compiler_is():
+    """pip builds them where a C compiler is (as on CI): a failed build would otherwise pass
+    unseen, every test then running the Python passes."""
+    compiler = (sysconfig.get_config_var("CC") or "cc").split()[0]
+    if shutil.which(compiler) is None:
+        pytest.skip(f"no C compiler ({compiler}) on this machine")
+    assert time_optimal._compiled is not None, (
+        "dextar.laws._reach was not built: reinstall (pip install -e .) and read the "
+        "compiler's output")
+    assert time_optimal._compiled.VERSION == time_optimal.REACH_VERSION
+    assert time_optimal.USE_COMPILED
+
+
+def test_an_old_build_of_the_compiled_passes_is_not_used():
+    """A build of another interface version (an edit of _reach.c whose build failed leaves
+    the old one in place) is set aside at import: the Python passes run."""
+    from types import SimpleNamespace
+
+    assert not time_optimal._usable(None)
+    assert not time_optimal._usable(SimpleNamespace(reach=None))
+    assert not time_optimal._usable(SimpleNamespace(VERSION=time_optimal.REACH_VERSION + 1))
+    assert time_optimal._usable(SimpleNamespace(VERSION=time_optimal.REACH_VERSION))

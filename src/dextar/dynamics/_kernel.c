@@ -15,6 +15,15 @@
  *   whether every input is finite (the inputs are checked here, where they are read, and
  *   named by the caller only when one is not).
  *
+ * task_torques(consts, legs, P, dP, ddP, dq, ddq, out) -> (bad, disc, worst, finite)
+ *   the same torques from the end-effector's motion in one pass: the inverse kinematics in
+ *   the working mode, legs = (s1, s2, L1, L2) its signs and the distal rods' lengths (the
+ *   motor angles' cosines and sines from the elbows,
+ *   no angle needed), the joint rates and accelerations (written to dq and ddq), then the
+ *   torque kernel; bad is the first sample out of reach of a leg (-1: none), finite says
+ *   whether every input and every rate is finite. Where either says so the caller runs the
+ *   stages in turn, which name the sample.
+ *
  * The motor angles' cosines and sines come from a polynomial on the angle reduced to
  * [-pi/4, pi/4] (Cody-Waite reduction with pi/2 in three parts, Taylor series to the 17th
  * and 16th degree: the truncation is under 1e-18), within an ulp or two of libm's cos and
@@ -37,7 +46,7 @@
 
 /* The kernel's interface version: exact.py uses a build of this version only (an older
  * build left in place, after an edit whose build failed, is not used). */
-#define KERNEL_VERSION 2
+#define KERNEL_VERSION 3
 
 enum {
     C_L1, C_L2, C_D, C_LSQ1, C_LSQ2, C_ILSQ1, C_ILSQ2, C_L2SQ, C_UE0, C_CST, C_SIGN,
@@ -234,6 +243,96 @@ static int all_samples(const double *k, const double *q, const double *dq, const
     return inputs_finite;
 }
 
+/* One leg's inverse kinematics as dextar.kinematics.positions._leg_solve: the elbow's
+ * direction from the pivot (ex, ey), unnormalised, for u = P - pivot; whether P is out of
+ * reach. */
+static inline int leg(double ux, double uy, double l, double L, double sign, double *ex,
+                      double *ey)
+{
+    double rho2 = ux * ux + uy * uy;
+    double kk = 0.5 * (rho2 + (l * l - L * L));
+    double w2 = (l * l) * rho2 - kk * kk;
+    int bad = !(w2 >= -1e-12 * (l * l) * rho2) | (rho2 <= 1e-24 * ((l + L) * (l + L)));
+    double w = sqrt(w2 > 0.0 ? w2 : 0.0) * -sign;  /* s = +1: the perp term negated */
+    *ex = kk * ux - w * uy;
+    *ey = kk * uy + w * ux;
+    return bad;
+}
+
+/* A block of samples from the end-effector's motion: per sample the motor angles' cosines
+ * and sines (the elbows' directions normalised), the rates as
+ * dextar.kinematics.velocity.joint_rates gives them, then the torques. */
+WIDE static void task_block(const double *restrict k, const double *restrict legs,
+                            const double *restrict P, const double *restrict dP,
+                            const double *restrict ddP, double *restrict dq,
+                            double *restrict ddq, double *restrict out, Py_ssize_t n,
+                            double *restrict disc, double *restrict worst, int *restrict bad)
+{
+    double l1 = k[C_L1], l2 = k[C_L2], half = 0.5 * k[C_D];
+    double sg1 = legs[0], sg2 = legs[1], L1 = legs[2], L2 = legs[3];
+    for (Py_ssize_t i = 0; i < n; i++) {
+        double px = P[2 * i], py = P[2 * i + 1];
+        double e1x, e1y, e2x, e2y;
+        int b = leg(px - half, py, l1, L1, sg1, &e1x, &e1y);
+        b |= leg(px + half, py, l2, L2, sg2, &e2x, &e2y);
+        bad[i] = b;
+        double n1 = 1.0 / sqrt(e1x * e1x + e1y * e1y), n2 = 1.0 / sqrt(e2x * e2x + e2y * e2y);
+        double c1 = e1x * n1, s1 = e1y * n1, c2 = e2x * n2, s2 = e2y * n2;
+        /* the frame: u = P - B, v = P - C, b = l (c x u) */
+        double ux = px - (half + l1 * c1), uy = py - l1 * s1;
+        double vx = px - (-half + l2 * c2), vy = py - l2 * s2;
+        double b1 = l1 * (c1 * uy - s1 * ux), b2 = l2 * (c2 * vy - s2 * vx);
+        double dx = dP[2 * i], dy = dP[2 * i + 1];
+        double w1 = (ux * dx + uy * dy) / b1, w2 = (vx * dx + vy * dy) / b2;
+        /* the velocity-product term: Pdot - Bdot, Bdot = l w (-s, c) */
+        double ex1 = dx + l1 * w1 * s1, ey1 = dy - l1 * w1 * c1;
+        double ex2 = dx + l2 * w2 * s2, ey2 = dy - l2 * w2 * c2;
+        double bias1 = -(ex1 * ex1 + ey1 * ey1) - l1 * w1 * w1 * (ux * c1 + uy * s1);
+        double bias2 = -(ex2 * ex2 + ey2 * ey2) - l2 * w2 * w2 * (vx * c2 + vy * s2);
+        double ax = ddP[2 * i], ay = ddP[2 * i + 1];
+        dq[2 * i] = w1;
+        dq[2 * i + 1] = w2;
+        ddq[2 * i] = (ux * ax + uy * ay - bias1) / b1;
+        ddq[2 * i + 1] = (vx * ax + vy * ay - bias2) / b2;
+        sample(k, c1, s1, c2, s2, dq + 2 * i, ddq + 2 * i, out + 2 * i, disc + i, worst + i);
+    }
+}
+
+static Py_ssize_t all_task_samples(const double *k, const double *legs, const double *P,
+                                   const double *dP, const double *ddP, double *dq,
+                                   double *ddq, double *out, Py_ssize_t n, double *disc_min,
+                                   double *worst_max, int *finite)
+{
+    double disc[BLOCK], worst[BLOCK];
+    int bad[BLOCK];
+    double dmin = INFINITY, wmax = 0.0;
+    int nan = 0, all = 1;
+    Py_ssize_t first_bad = -1;
+    for (Py_ssize_t start = 0; start < n; start += BLOCK) {
+        Py_ssize_t m = n - start < BLOCK ? n - start : BLOCK;
+        Py_ssize_t o = 2 * start;
+        all &= all_finite(P + o, 2 * m) & all_finite(dP + o, 2 * m) & all_finite(ddP + o, 2 * m);
+        task_block(k, legs, P + o, dP + o, ddP + o, dq + o, ddq + o, out + o, m, disc,
+                   worst, bad);
+        all &= all_finite(dq + o, 2 * m) & all_finite(ddq + o, 2 * m);
+        if (k[C_FRICTION] != 0.0)
+            coulomb(k, dq + o, out + o, m);
+        for (Py_ssize_t i = 0; i < m; i++) {
+            if (bad[i] && first_bad < 0)
+                first_bad = start + i;
+            if (disc[i] < dmin)
+                dmin = disc[i];
+            if (worst[i] > wmax)
+                wmax = worst[i];
+            nan |= disc[i] != disc[i] || worst[i] != worst[i];
+        }
+    }
+    *disc_min = nan ? NAN : dmin;
+    *worst_max = nan ? NAN : wmax;
+    *finite = all;
+    return first_bad;
+}
+
 static int get_buffer(PyObject *obj, Py_buffer *view, int writable, const char *name)
 {
     int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (writable ? PyBUF_WRITABLE : 0);
@@ -287,9 +386,58 @@ done:
     return result;
 }
 
+static PyObject *task_torques(PyObject *self, PyObject *args)
+{
+    PyObject *objs[7];
+    static const char *names[7] = {"consts", "P", "dP", "ddP", "dq", "ddq", "out"};
+    Py_buffer views[7];
+    double legs[4];
+    int got = 0;
+    PyObject *result = NULL;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "O(dddd)OOOOOO", &objs[0], &legs[0], &legs[1], &legs[2],
+                          &legs[3], &objs[1], &objs[2], &objs[3], &objs[4], &objs[5], &objs[6]))
+        return NULL;
+    for (; got < 7; got++)
+        if (get_buffer(objs[got], &views[got], got >= 4, names[got]) < 0)
+            goto done;
+    if (views[0].len != N_CONSTS * 8) {
+        PyErr_Format(PyExc_ValueError, "consts must hold %d values", (int)N_CONSTS);
+        goto done;
+    }
+    Py_ssize_t len = views[1].len;
+    int same = len % 16 == 0;
+    for (int j = 2; j < 7; j++)
+        same &= views[j].len == len;
+    if (!same) {
+        PyErr_SetString(PyExc_ValueError,
+                        "P, dP, ddP, dq, ddq and out must hold n * 2 values each");
+        goto done;
+    }
+    {
+        const double *k = views[0].buf;
+        Py_ssize_t n = len / 16, bad;
+        double disc, worst;
+        int finite;
+        Py_BEGIN_ALLOW_THREADS
+        bad = all_task_samples(k, legs, views[1].buf, views[2].buf, views[3].buf,
+                               views[4].buf, views[5].buf, views[6].buf, n, &disc, &worst,
+                               &finite);
+        Py_END_ALLOW_THREADS
+        result = Py_BuildValue("(nddO)", bad, disc, worst, finite ? Py_True : Py_False);
+    }
+done:
+    while (got > 0)
+        PyBuffer_Release(&views[--got]);
+    return result;
+}
+
 static PyMethodDef methods[] = {
     {"torques", torques, METH_VARARGS,
      "torques(consts, q, dq, ddq, out) -> (disc, worst, finite): the fused torque kernel."},
+    {"task_torques", task_torques, METH_VARARGS,
+     "task_torques(consts, legs, P, dP, ddP, dq, ddq, out) -> (bad, disc, worst, finite): "
+     "the torques from the end-effector's motion."},
     {NULL, NULL, 0, NULL}
 };
 

@@ -9,12 +9,13 @@ ratios of a law through the exact model with gravity and friction.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from functools import cached_property
 
 import numpy as np
 
 from .._arrays import Array
 from ..geometry import assembly_mode_name
-from ..kinematics import assembly_mode, direct_kinematics, inverse_kinematics, joint_rates
+from ..kinematics import assembly_mode, direct_kinematics, inverse_kinematics
 from ..laws import Law, UniformLaw
 from ..laws.constraints import JointSamples, PathCoefficients
 from ..laws.time_optimal import TimeOptimalLaw, solve_time_optimal_law
@@ -22,7 +23,7 @@ from ..motors import MotorLimits
 from ..paths import Path
 from ..trajectory import JointLine, path_motion, sample_trajectory
 from ..units import Units
-from .exact import Model, inverse_dynamics, path_dynamics
+from .exact import Model, inverse_dynamics, path_dynamics, task_inverse_dynamics
 
 
 @dataclass(frozen=True)
@@ -66,13 +67,21 @@ class RobotAlongPath:
         """``law`` at ``times`` through the exact model (the path was checked by
         :meth:`coefficients`; the angles are not unwrapped: the model needs only their sines
         and cosines)."""
+        t = np.asarray(times, float)
+        P, dP, ddP = path_motion(self.path, law, t)[6:]
+        dq, ddq, tau = task_inverse_dynamics(self._model(self._assembly), self.mode, P, dP,
+                                             ddP)
+        return JointSamples(tau, dq, ddq, t)
+
+    @cached_property
+    def _assembly(self) -> str:
+        """The assembly mode of the path's poses, named by its start's (a checked path
+        crosses no parallel singularity: every pose of it is in the same one)."""
         robot = self.model.robot
-        P, dP, ddP = path_motion(self.path, law, np.asarray(times, float))[6:]
-        q = inverse_kinematics(robot, P, self.mode)
-        dq, ddq = joint_rates(robot, q, P, dP, ddP, tol=0.0)
-        assembly = assembly_mode_name(int(assembly_mode(robot, q[:1], P[:1])[0]))
-        return JointSamples(inverse_dynamics(self._model(assembly), q, dq, ddq), dq, ddq,
-                            np.asarray(times, float))
+        P = self.path.position(np.array([self.path.p0]))
+        return assembly_mode_name(int(assembly_mode(robot, inverse_kinematics(robot, P,
+                                                                              self.mode),
+                                                    P)[0]))
 
 
 def time_optimal_law(model: Model, path: Path, *,

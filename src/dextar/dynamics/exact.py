@@ -31,8 +31,8 @@ import numpy as np
 
 from .._arrays import Array, as_points, blocks, check_finite, cos_sin
 from ..errors import AssemblyError, ParameterError, SingularityError
-from ..geometry import FiveBar, parse_assembly_mode
-from ..kinematics import DEFAULT_SINGULARITY_TOL
+from ..geometry import FiveBar, parse_assembly_mode, parse_working_mode
+from ..kinematics import DEFAULT_SINGULARITY_TOL, inverse_kinematics, joint_rates
 from .friction import friction_torque
 from .inertia import Inertia
 
@@ -43,7 +43,7 @@ except ImportError:  # pragma: no cover - installed without a C compiler: the nu
 
 #: The compiled kernel's interface this module calls (``KERNEL_VERSION`` in _kernel.c): a
 #: build of another version (an old one left in place) is not used.
-KERNEL_VERSION = 2
+KERNEL_VERSION = 3
 
 
 def _usable(module: object) -> bool:
@@ -558,16 +558,12 @@ def _torques(model: Model, q: object, dq: object, ddq: object, *, gravity: bool,
         raise ParameterError(f"q, dq, ddq must have the same number of samples, got "
                              f"{n}, {len(dqf)}, {len(ddqf)}")
     c = _lumped(model, gravity, friction)
-    r = model.robot
-    # _check_state runs (and names the sample) only where the extremes come near the
-    # limits: rods that do not meet (a negative discriminant), 1 / |det| near 1 / (tol L1 L2),
-    # or are NaN (elbows that coincide): the comparisons are written to be false for a NaN
-    sing_cap = (1.0 / (model.tol * r.L1 * r.L2) if model.tol > 0 else np.inf) * (1.0 - 1e-9)
+    sing_cap = _singularity_cap(model)
     tt = None if t is None else np.asarray(t, dtype=float).reshape(-1)
     out = np.empty((n, 2))
 
     def check(disc: float, worst: float, blk: slice) -> None:
-        if not (disc >= 0.0 and worst < sing_cap):
+        if not _clear(disc, worst, sing_cap):
             with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
                 pose = _pose(model, qf[blk, 0], qf[blk, 1], _Np)
             _check_state(model, pose, qf, blk.start, tt)
@@ -590,11 +586,28 @@ def _torques(model: Model, q: object, dq: object, ddq: object, *, gravity: bool,
     return out.reshape(shape + (2,))
 
 
+def _singularity_cap(model: Model) -> float:
+    """The largest ``1 / |det A|`` the kernels' extremes may reach before the named checks
+    run (:func:`_clear`): a hair inside ``1 / (tol L1 L2)``."""
+    r = model.robot
+    return (1.0 / (model.tol * r.L1 * r.L2) if model.tol > 0 else np.inf) * (1.0 - 1e-9)
+
+
+def _clear(disc: float, worst: float, sing_cap: float) -> bool:
+    """Whether a kernel's extremes leave no sample to name: rods that meet (a discriminant
+    not negative) and ``1 / |det|`` below the cap; false for a NaN (elbows that coincide),
+    as the comparisons are written."""
+    return disc >= 0.0 and worst < sing_cap
+
+
 def _kernel_constants(c: _Lumped) -> Array:
     """The constants of the compiled kernel, in the order of its ``C_*`` indices."""
-    def pair(v: Any) -> tuple[float, float]:
-        a = np.broadcast_to(np.asarray(0.0 if v is None else v, dtype=float), (2, 1))
-        return float(a[0, 0]), float(a[1, 0])
+    def pair(v: Any) -> tuple[float, float]:  # None, a float or a leg's (2, 1) pair
+        if v is None:
+            return 0.0, 0.0
+        if isinstance(v, np.ndarray):
+            return float(v[0, 0]), float(v[1, 0])
+        return float(v), float(v)
 
     fric = c.viscous is not None and c.coulomb is not None
     return np.array([*pair(c.l), c.d, *pair(c.Lsq), *pair(c.iLsq), c.L2sq, c.ue0, c.cst,
@@ -626,6 +639,46 @@ def inverse_dynamics(model: Model, q: object, dq: object, ddq: object, *,
     return _torques(model, q, dq, ddq, gravity=True, friction=True, t=t)
 
 
+def task_inverse_dynamics(model: Model, mode: str, points: object, dpoints: object,
+                          ddpoints: object) -> tuple[Array, Array, Array]:
+    """The joint rates, accelerations and motor torques of an end-effector motion.
+
+    The same, to rounding, as :func:`dextar.kinematics.inverse_kinematics` in working mode
+    ``mode``, :func:`dextar.kinematics.joint_rates` (serial singularities not refused) and
+    :func:`inverse_dynamics` in turn, in one pass of the compiled kernel where it was built
+    (the motor angles' cosines and sines from the elbows, no angle computed). Where it was
+    not, or where a sample is out of reach, not finite or too near a parallel singularity,
+    those three run in turn and name the sample.
+
+    Parameters
+    ----------
+    points, dpoints, ddpoints : array_like, shape (n, 2)
+        The end-effector's positions, velocities and accelerations.
+
+    Returns
+    -------
+    dq, ddq, tau : ndarray, shape (n, 2)
+    """
+    P, dP, ddP = (as_points(x, name, finite=False).reshape(-1, 2) for x, name in
+                  ((points, "points"), (dpoints, "dpoints"), (ddpoints, "ddpoints")))
+    if not (len(P) == len(dP) == len(ddP)):
+        raise ParameterError(f"points, dpoints, ddpoints must have the same number of "
+                             f"samples, got {len(P)}, {len(dP)}, {len(ddP)}")
+    if USE_COMPILED:
+        r = model.robot
+        s1, s2 = parse_working_mode(mode)
+        dq, ddq, tau = np.empty(P.shape), np.empty(P.shape), np.empty(P.shape)
+        Pc, dPc, ddPc = (np.ascontiguousarray(x) for x in (P, dP, ddP))
+        bad, disc, worst, finite = _compiled.task_torques(
+            _kernel_constants(_lumped(model, True, True)), (float(s1), float(s2), r.L1, r.L2),
+            Pc, dPc, ddPc, dq, ddq, tau)
+        if bad < 0 and finite and _clear(disc, worst, _singularity_cap(model)):
+            return dq, ddq, tau
+    q = inverse_kinematics(model.robot, P, mode)
+    dq, ddq = joint_rates(model.robot, q, P, dP, ddP, tol=0.0)
+    return dq, ddq, inverse_dynamics(model, q, dq, ddq)
+
+
 def mass_matrix(model: Model, q: object) -> Array:
     """The inertia matrix ``M(q)``, shape (..., 2, 2), symmetric positive definite (the pose
     computed once per sample, the two columns from unit accelerations)."""
@@ -647,28 +700,17 @@ def mass_matrix(model: Model, q: object) -> Array:
 
 def path_dynamics(model: Model, q: Array, dq_ds: Array, ddq_ds: Array
                   ) -> tuple[Array, Array, Array]:
-    """The dynamics along a path ``q(s)`` in one pass over the poses: ``a = M(q) q'``,
-    ``b = M(q) q'' + c(q, q')`` and the gravity torques ``g(q)``, each (n, 2), so that
-    ``tau = a sddot + b sdot^2 + g`` (friction aside) for ``q' = dq_ds``, ``q'' = ddq_ds``
-    (each (n, 2))."""
+    """The dynamics along a path ``q(s)``: ``a = M(q) q'``, ``b = M(q) q'' + c(q, q')`` and
+    the gravity torques ``g(q)``, each (n, 2), so that ``tau = a sddot + b sdot^2 + g``
+    (friction aside) for ``q' = dq_ds``, ``q'' = ddq_ds`` (each (n, 2)): three passes of the
+    fused torque kernel (compiled where it was built), checked as :func:`inverse_dynamics`
+    is."""
     qf, w, v = (as_points(x, name) for x, name in ((q, "q"), (dq_ds, "dq_ds"),
                                                   (ddq_ds, "ddq_ds")))
-    out = np.empty((3, len(qf), 2))
-    for blk in blocks(len(qf)):
-        zero = np.zeros(blk.stop - blk.start)
-        w1, w2, v1, v2 = w[blk, 0], w[blk, 1], v[blk, 0], v[blk, 1]
-        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            pose = _pose(model, qf[blk, 0], qf[blk, 1], _Np)
-            still = _rates(model, pose, zero, zero)
-            a = _loads(model, pose, still, zero, zero, w1, w2, gravity=False, friction=False)
-            b = _loads(model, pose, _rates(model, pose, w1, w2), w1, w2, v1, v2,
-                       gravity=False, friction=False)
-            g = _loads(model, pose, still, zero, zero, zero, zero, gravity=True,
-                       friction=False)
-        _check_state(model, pose, qf, blk.start, None)
-        for k, loads in enumerate((a, b, g)):
-            out[k, blk, 0], out[k, blk, 1] = loads.tau1, loads.tau2
-    return out[0], out[1], out[2]
+    zero = np.zeros_like(w)
+    return (_torques(model, qf, zero, w, gravity=False, friction=False),
+            _torques(model, qf, w, v, gravity=False, friction=False),
+            _torques(model, qf, zero, zero, gravity=True, friction=False))
 
 
 def bias_forces(model: Model, q: object, dq: object) -> Array:

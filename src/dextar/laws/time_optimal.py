@@ -57,6 +57,28 @@ from .constraints import (
     speed_cap,
 )
 
+try:  # the reachability analysis compiled (_reach.c), built by pip where a C compiler is
+    from . import _reach as _compiled
+except ImportError:  # pragma: no cover - installed without a C compiler: the Python passes
+    _compiled = None  # type: ignore[assignment]  # the module or None, as USE_COMPILED says
+
+#: The compiled passes' interface this module calls (``REACH_VERSION`` in _reach.c): a build
+#: of another version (an old one left in place) is not used.
+REACH_VERSION = 1
+
+
+def _usable(module: object) -> bool:
+    """Whether ``module`` is a build of the compiled passes of this interface version."""
+    return module is not None and getattr(module, "VERSION", None) == REACH_VERSION
+
+
+if not _usable(_compiled):
+    _compiled = None  # type: ignore[assignment]  # an old build: the Python passes instead
+
+#: Whether the reachability analysis runs compiled (where it was built): False gives the
+#: Python passes (the same squared speeds to the last bit; the tests compare the two).
+USE_COMPILED = _compiled is not None
+
 #: Greatest number of solves (friction tangent updates and limit margins).
 MAX_SOLVES = 8
 #: The friction tangent has settled when no speed along the path moves by more than this
@@ -349,12 +371,29 @@ def _reachability(co: PathCoefficients, ds: Array, constraints: Sequence[Constra
     """Squared speeds ``x`` at the grid points of the fastest admissible motion: the
     controllable sets from rest at the end backward, then the largest acceleration from rest
     at the start forward."""
-    st = _stages(*_rows(co, ds, constraints, x0), ds)
+    Gu, Gx, h = _rows(co, ds, constraints, x0)
     tmax = np.asarray(_torque_limit(constraints), float)  # for the words of an error
 
     def unreachable(k: int) -> InfeasibleError:
         return _unreachable(co, k, tmax, units)
 
+    return _passes(Gu, Gx, h, ds, unreachable)
+
+
+def _passes(Gu: Array, Gx: Array, h: Array, ds: Array,
+            unreachable: Callable[[int], InfeasibleError]) -> Array:
+    """The squared speeds (N + 1,) from the stages' rows ``Gu u + Gx x <= h`` (N, m) and
+    lengths ``ds`` (N,): the elimination and both passes, compiled where they were built
+    (:data:`USE_COMPILED`), else in Python; ``unreachable(k)`` is the error where no motion
+    passes stage ``k``."""
+    if USE_COMPILED:
+        x = np.empty(len(ds) + 1)
+        Gu, Gx, h, ds = (np.ascontiguousarray(a, dtype=float) for a in (Gu, Gx, h, ds))
+        k = _compiled.reach(Gu, Gx, h, ds, x)
+        if k >= 0:
+            raise unreachable(k)
+        return x
+    st = _stages(Gu, Gx, h, ds)
     K_lo, K_hi = _controllable(st, unreachable)
     return _fastest(st, K_lo, K_hi, unreachable)
 

@@ -79,8 +79,10 @@ class Path(ABC):
     def _check_parameter(self, p: object) -> Array:
         p = np.asarray(p, dtype=float)
         span = self.p1 - self.p0
-        bad = ~np.isfinite(p) | (p < self.p0 - 1e-9 * span) | (p > self.p1 + 1e-9 * span)
-        if bad.any():
+        lo, hi = self.p0 - 1e-9 * span, self.p1 + 1e-9 * span
+        # the extremes first (a NaN among the values makes them NaN: not within)
+        if p.size and not (p.min() >= lo and p.max() <= hi):
+            bad = ~np.isfinite(p) | (p < lo) | (p > hi)
             v = p.reshape(-1)[np.flatnonzero(bad.reshape(-1))[0]]
             raise ParameterError(f"path parameter p = {v:.6g} outside [{self.p0:.6g}, "
                                  f"{self.p1:.6g}]")
@@ -192,9 +194,17 @@ class Arc(Path):
         p = self._check_parameter(p)
         R, sg = self.radius, (-1.0 if self.clockwise else 1.0)
         c, s = np.cos(sg * p), np.sin(sg * p)
-        r = np.stack([self.center[0] + R * c, self.center[1] + R * s], axis=-1)
-        return (r, np.stack([-sg * R * s, sg * R * c], -1), np.stack([-R * c, -R * s], -1),
-                np.stack([sg * R * s, -sg * R * c], -1))
+        Rc, Rs = R * c, R * s
+        out = np.empty((4, *p.shape, 2))  # the position and its derivatives, in place
+        np.add(self.center[0], Rc, out=out[0, ..., 0])
+        np.add(self.center[1], Rs, out=out[0, ..., 1])
+        np.multiply(-sg * R, s, out=out[1, ..., 0])
+        np.multiply(sg * R, c, out=out[1, ..., 1])
+        np.negative(Rc, out=out[2, ..., 0])
+        np.negative(Rs, out=out[2, ..., 1])
+        np.multiply(sg * R, s, out=out[3, ..., 0])
+        np.multiply(-sg * R, c, out=out[3, ..., 1])
+        return out[0], out[1], out[2], out[3]
 
     @property
     def length(self) -> float:

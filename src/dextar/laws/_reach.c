@@ -1,0 +1,308 @@
+/* The time-optimal law's reachability analysis compiled: the stages' elimination and both
+ * passes of dextar.laws.time_optimal (_stages, _static_interval, _controllable, _fastest) in
+ * one call, with the same formulas in the same order of operations, so that the squared
+ * speeds are the same to the last bit (the tests compare the two on random stages and on
+ * the examples' paths).
+ *
+ * Built by `pip install` when a C compiler is there (an optional extension: without one,
+ * dextar runs the Python passes and gives the same law).
+ *
+ * reach(Gu, Gx, h, ds, x) -> k
+ *   Gu, Gx, h: C-contiguous float64 buffers of n * m values, the rows Gu u + Gx x <= h of
+ *   the n stages (m rows each, stage by stage); ds: n float64 values, the stages' lengths;
+ *   x: a writable float64 buffer of n + 1 values, the squared speeds at the grid points.
+ *   Returns -1 when x is written, else the stage k at which no motion passes (the caller
+ *   names its point): the controllable set at k is empty (backward pass) or the largest
+ *   acceleration at k cannot reach the next controllable set (forward pass).
+ *
+ * Compiled without contraction into fused multiply-adds (-ffp-contract=off): each product
+ * and sum rounds as it does in NumPy and in Python's floats.
+ */
+
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+
+#if (defined(FLT_EVAL_METHOD) && FLT_EVAL_METHOD != 0) || defined(__FAST_MATH__)
+#error "dextar's compiled reachability needs double evaluation without -ffast-math"
+#endif
+
+/* The interface version: time_optimal.py uses a build of this version only. */
+#define REACH_VERSION 1
+
+/* the kinds of a row once solved for u */
+enum { ROW_X_ONLY, ROW_UPPER, ROW_LOWER, ROW_NONE };
+
+/* NumPy's min and max reductions: a NaN, once met, is the result */
+static inline double np_min(double acc, double v)
+{
+    return (acc != acc || v != v) ? NAN : (v < acc ? v : acc);
+}
+
+static inline double np_max(double acc, double v)
+{
+    return (acc != acc || v != v) ? NAN : (v > acc ? v : acc);
+}
+
+/* One stage solved for u, as _stages does it: each row's kind and u <= / >= alpha x + beta,
+ * the interval of x every row and pair of rows allows on its own (lo = inf: empty). */
+static void stage(const double *gu, const double *gx, const double *h, double ds,
+                  Py_ssize_t m, int *kind, double *alpha, double *beta, double *lo_out,
+                  double *hi_out)
+{
+    double two_ds = 2 * ds;
+    int empty = 0;
+    double lo = -INFINITY, hi = INFINITY;
+    for (Py_ssize_t j = 0; j < m; j++) {
+        double tiny = 1e-12 * (fabs(gu[j]) + two_ds * fabs(gx[j]));
+        if (gu[j] > tiny)
+            kind[j] = ROW_UPPER;
+        else if (gu[j] < -tiny)
+            kind[j] = ROW_LOWER;
+        else if (fabs(gu[j]) <= tiny)
+            kind[j] = ROW_X_ONLY;
+        else
+            kind[j] = ROW_NONE;  /* NaN */
+        if (kind[j] == ROW_UPPER || kind[j] == ROW_LOWER) {
+            alpha[j] = -gx[j] / gu[j];
+            beta[j] = h[j] / gu[j];
+        } else {
+            alpha[j] = 0.0;
+            beta[j] = 0.0;
+        }
+    }
+    /* every lower row below every upper row: (al - au) x <= bu - bl */
+    double phi = INFINITY, plo = -INFINITY;
+    for (Py_ssize_t i = 0; i < m; i++) {
+        if (kind[i] != ROW_UPPER)
+            continue;
+        for (Py_ssize_t j = 0; j < m; j++) {
+            if (kind[j] != ROW_LOWER)
+                continue;
+            double c = alpha[j] - alpha[i];
+            double d = beta[i] - beta[j];
+            double r = d / c;
+            if (c > 0)
+                phi = np_min(phi, r);
+            else if (c < 0)
+                plo = np_max(plo, r);
+            empty |= (c == 0) & (d < 0);
+        }
+    }
+    /* the rows in x alone */
+    double xhi = INFINITY, xlo = -INFINITY;
+    for (Py_ssize_t j = 0; j < m; j++) {
+        if (kind[j] != ROW_X_ONLY)
+            continue;
+        double rx = h[j] / gx[j];
+        if (gx[j] > 0)
+            xhi = np_min(xhi, rx);
+        else if (gx[j] < 0)
+            xlo = np_max(xlo, rx);
+        empty |= (gx[j] == 0) & (h[j] < 0);
+    }
+    /* np.minimum and np.maximum of the two: a NaN in either is the result */
+    hi = (phi != phi || xhi != xhi) ? NAN : (xhi < phi ? xhi : phi);
+    lo = (plo != plo || xlo != xlo) ? NAN : (xlo > plo ? xlo : plo);
+    if (empty)
+        lo = INFINITY;
+    else
+        lo = (lo >= 0.0 || lo != lo) ? lo : 0.0;
+    *lo_out = lo;
+    *hi_out = hi;
+}
+
+/* The backward pass (_controllable): the controllable interval [K_lo, K_hi] at each point
+ * from rest at the end; returns the stage where it is empty, or -1. */
+static Py_ssize_t controllable(Py_ssize_t n, Py_ssize_t m, const double *ds, const int *kind,
+                               const double *alpha, const double *beta, const double *x_lo,
+                               const double *x_hi, double *K_lo, double *K_hi)
+{
+    const double big = 1e300;  /* an unbounded hi stays finite, so that 0 * hi is 0 */
+    K_lo[n] = 0.0;
+    K_hi[n] = 0.0;
+    for (Py_ssize_t k = n - 1; k >= 0; k--) {
+        double lo = K_lo[k + 1], hi = K_hi[k + 1];
+        if (hi > big)
+            hi = big;
+        double inv2 = 1.0 / (2 * ds[k]);
+        double xl = x_lo[k], xh = x_hi[k];
+        const int *kd = kind + k * m;
+        const double *a = alpha + k * m, *b = beta + k * m;
+        for (Py_ssize_t j = 0; j < m; j++) {
+            if (!isfinite(b[j]))
+                continue;  /* (no limit; or none at all: the static interval says it) */
+            if (kd[j] == ROW_LOWER) {
+                /* u >= al x + bl and u <= (hi - x) / (2 ds): cl x <= hi / (2 ds) - bl */
+                double cl = a[j] + inv2;
+                double mm = inv2 / cl, q = -b[j] / cl;
+                double v = mm * hi + q;
+                if (cl > 0) {
+                    if (v < xh)
+                        xh = v;
+                } else if (cl < 0) {
+                    if (v > xl)
+                        xl = v;
+                }
+            } else if (kd[j] == ROW_UPPER) {
+                /* u >= (lo - x) / (2 ds) and u <= au x + bu: cu x <= bu - lo / (2 ds) */
+                double cu = -inv2 - a[j];
+                double mm = -inv2 / cu, q = b[j] / cu;
+                double v = mm * lo + q;
+                if (cu > 0) {
+                    if (v < xh)
+                        xh = v;
+                } else if (cu < 0) {
+                    if (v > xl)
+                        xl = v;
+                }
+            }
+        }
+        if (xl > xh + 1e-12 * (1.0 + fabs(xh)))
+            return k;
+        double v = xh < xl ? xh : xl;
+        K_lo[k] = v > 0.0 ? v : 0.0;
+        K_hi[k] = xh > 0.0 ? xh : 0.0;
+    }
+    if (K_lo[0] > 1e-12 * (1.0 + K_hi[0]))
+        return 0;
+    return -1;
+}
+
+/* The forward pass (_fastest): from rest, the largest acceleration every row allows that
+ * keeps the next point controllable; returns the stage where none does, or -1. */
+static Py_ssize_t fastest(Py_ssize_t n, Py_ssize_t m, const double *ds, const int *kind,
+                          const double *alpha, const double *beta, const double *K_lo,
+                          const double *K_hi, double *x)
+{
+    x[0] = 0.0;
+    for (Py_ssize_t k = 0; k < n; k++) {
+        double xk = x[k];
+        double half = 1.0 / (2 * ds[k]), two_ds = 2 * ds[k];
+        double u_hi = (K_hi[k + 1] - xk) * half;
+        double u_lo = (K_lo[k + 1] - xk) * half;
+        const int *kd = kind + k * m;
+        const double *au = alpha + k * m, *bu = beta + k * m;
+        for (Py_ssize_t j = 0; j < m; j++) {
+            if (kd[j] == ROW_UPPER && isfinite(bu[j])) {
+                double v = au[j] * xk + bu[j];
+                if (v < u_hi)
+                    u_hi = v;
+            }
+        }
+        if (u_lo > u_hi + 1e-9 * (1.0 + fabs(u_hi)))
+            return k;
+        double v = xk + two_ds * u_hi;
+        if (v < K_lo[k + 1])
+            v = K_lo[k + 1];
+        x[k + 1] = K_hi[k + 1] < v ? K_hi[k + 1] : v;
+    }
+    x[n] = 0.0;
+    return -1;
+}
+
+static Py_ssize_t solve(Py_ssize_t n, Py_ssize_t m, const double *Gu, const double *Gx,
+                        const double *h, const double *ds, double *x, int *failed)
+{
+    /* one block: the rows' kinds, alpha and beta (n * m each), x_lo, x_hi, K_lo, K_hi */
+    size_t nm = (size_t)n * (size_t)m;
+    int *kind = malloc(nm * sizeof(int) + 1);
+    double *work = malloc((2 * nm + 4 * (size_t)(n + 1)) * sizeof(double));
+    if (kind == NULL || work == NULL) {
+        free(kind);
+        free(work);
+        *failed = 1;
+        return -1;
+    }
+    double *alpha = work, *beta = work + nm, *x_lo = work + 2 * nm;
+    double *x_hi = x_lo + (n + 1), *K_lo = x_hi + (n + 1), *K_hi = K_lo + (n + 1);
+    for (Py_ssize_t k = 0; k < n; k++)
+        stage(Gu + k * m, Gx + k * m, h + k * m, ds[k], m, kind + k * m, alpha + k * m,
+              beta + k * m, x_lo + k, x_hi + k);
+    Py_ssize_t bad = controllable(n, m, ds, kind, alpha, beta, x_lo, x_hi, K_lo, K_hi);
+    if (bad < 0)
+        bad = fastest(n, m, ds, kind, alpha, beta, K_lo, K_hi, x);
+    free(kind);
+    free(work);
+    *failed = 0;
+    return bad;
+}
+
+static int get_buffer(PyObject *obj, Py_buffer *view, int writable, const char *name)
+{
+    int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (writable ? PyBUF_WRITABLE : 0);
+    if (PyObject_GetBuffer(obj, view, flags) < 0)
+        return -1;
+    if (view->itemsize != 8 || view->format == NULL || strcmp(view->format, "d") != 0) {
+        PyErr_Format(PyExc_TypeError, "%s must hold float64 values", name);
+        PyBuffer_Release(view);
+        return -1;
+    }
+    return 0;
+}
+
+static PyObject *reach(PyObject *self, PyObject *args)
+{
+    PyObject *objs[5];
+    static const char *names[5] = {"Gu", "Gx", "h", "ds", "x"};
+    Py_buffer views[5];
+    int got = 0;
+    PyObject *result = NULL;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OOOOO", &objs[0], &objs[1], &objs[2], &objs[3], &objs[4]))
+        return NULL;
+    for (; got < 5; got++)
+        if (get_buffer(objs[got], &views[got], got == 4, names[got]) < 0)
+            goto done;
+    {
+        Py_ssize_t n = views[3].len / 8;
+        Py_ssize_t len = views[0].len / 8;
+        if (n < 1 || len % n != 0 || views[1].len != views[0].len
+                || views[2].len != views[0].len || views[4].len != (n + 1) * 8) {
+            PyErr_SetString(PyExc_ValueError,
+                            "Gu, Gx, h must hold n * m values, ds n and x n + 1");
+            goto done;
+        }
+        Py_ssize_t m = len / n, bad;
+        int failed;
+        Py_BEGIN_ALLOW_THREADS
+        bad = solve(n, m, views[0].buf, views[1].buf, views[2].buf, views[3].buf,
+                    views[4].buf, &failed);
+        Py_END_ALLOW_THREADS
+        if (failed)
+            PyErr_NoMemory();
+        else
+            result = PyLong_FromSsize_t(bad);
+    }
+done:
+    while (got > 0)
+        PyBuffer_Release(&views[--got]);
+    return result;
+}
+
+static PyMethodDef methods[] = {
+    {"reach", reach, METH_VARARGS,
+     "reach(Gu, Gx, h, ds, x) -> k: the squared speeds into x (k = -1), or the stage k "
+     "no motion passes."},
+    {NULL, NULL, 0, NULL}
+};
+
+static struct PyModuleDef module = {
+    PyModuleDef_HEAD_INIT, "_reach",
+    "The time-optimal law's reachability analysis, compiled.", -1, methods,
+    NULL, NULL, NULL, NULL
+};
+
+PyMODINIT_FUNC PyInit__reach(void)
+{
+    PyObject *mod = PyModule_Create(&module);
+    if (mod == NULL)
+        return NULL;
+    if (PyModule_AddIntConstant(mod, "VERSION", REACH_VERSION) < 0) {
+        Py_DECREF(mod);
+        return NULL;
+    }
+    return mod;
+}
