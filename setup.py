@@ -18,7 +18,9 @@ from setuptools import Extension, setup
 
 FLAGS = [] if sys.platform == "win32" else ["-O3", "-ffp-contract=off", "-fno-math-errno"]
 
+SHARED = ["src/dextar/_buffers.h"]
+
 setup(ext_modules=[Extension("dextar.dynamics._kernel", ["src/dextar/dynamics/_kernel.c"],
-                             optional=True, extra_compile_args=FLAGS),
+                             depends=SHARED, optional=True, extra_compile_args=FLAGS),
                    Extension("dextar.laws._reach", ["src/dextar/laws/_reach.c"],
-                             optional=True, extra_compile_args=FLAGS)])
+                             depends=SHARED, optional=True, extra_compile_args=FLAGS)])

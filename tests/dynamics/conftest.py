@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 import dextar as dx
-from dextar.dynamics import Model, paper_inertia
+from dextar.dynamics import Model, exact, paper_inertia
 from dextar.laws import solve_optimal_law
 from dextar.paths import Arc
 from dextar.trajectory import sample_trajectory
@@ -37,3 +37,15 @@ def random_joint_motion(rng, t):
     dq = np.sum(amp * 2 * np.pi * freq * np.cos(arg), axis=1)
     ddq = -np.sum(amp * (2 * np.pi * freq) ** 2 * np.sin(arg), axis=1)
     return q, dq, ddq
+
+
+@pytest.fixture(params=["compiled", "numpy"])
+def kernel(request, monkeypatch):
+    """A test taking it runs with the compiled kernel and with the numpy one."""
+    if request.param == "compiled":
+        if exact._compiled is None:
+            pytest.skip("the compiled kernel was not built (no C compiler at install)")
+        monkeypatch.setattr(exact, "USE_COMPILED", True)
+    else:
+        monkeypatch.setattr(exact, "USE_COMPILED", False)
+    return request.param

@@ -3,9 +3,6 @@ numpy, against a straightforward evaluation of Kane's equations, body by body, w
 independently of the kernel's identities (equimomental rods, the legs side by side, det and
 u . e in closed form), and the two kernels against each other."""
 
-import shutil
-import sysconfig
-
 import numpy as np
 import pytest
 
@@ -22,21 +19,10 @@ from dextar.dynamics.exact import _torques
 from dextar.errors import ParameterError, SingularityError
 from dextar.geometry import FiveBar
 
+from ..compiled import skip_without_a_compiler
 from .conftest import ROBOT
 
 ASYMMETRIC = FiveBar(l1=0.8, l2=0.95, L1=1.1, L2=0.9, d=0.6)
-
-
-@pytest.fixture(params=["compiled", "numpy"])
-def kernel(request, monkeypatch):
-    """Each test below runs with the compiled kernel and with the numpy one."""
-    if request.param == "compiled":
-        if exact._compiled is None:
-            pytest.skip("the compiled kernel was not built (no C compiler at install)")
-        monkeypatch.setattr(exact, "USE_COMPILED", True)
-    else:
-        monkeypatch.setattr(exact, "USE_COMPILED", False)
-    return request.param
 
 
 def inertia(**kw):
@@ -191,9 +177,7 @@ def test_singular_sample_in_a_late_block_is_named(kernel):
 def test_the_compiled_kernel_is_built_where_a_compiler_is():
     """pip builds the kernel where a C compiler is (as on CI): a failed build would otherwise
     pass unseen, every test then running the numpy kernel."""
-    compiler = (sysconfig.get_config_var("CC") or "cc").split()[0]
-    if shutil.which(compiler) is None:
-        pytest.skip(f"no C compiler ({compiler}) on this machine")
+    skip_without_a_compiler()
     assert exact._compiled is not None, (
         "dextar.dynamics._kernel was not built: reinstall (pip install -e .) and read the "
         "compiler's output")
@@ -251,9 +235,12 @@ def test_an_old_build_of_the_compiled_kernel_is_not_used():
     the old one in place) is set aside at import: the numpy kernel runs, no crash."""
     from types import SimpleNamespace
 
-    assert not exact._usable(None)
-    assert not exact._usable(SimpleNamespace(torques=None))  # a build before versions
-    assert not exact._usable(SimpleNamespace(VERSION=exact.KERNEL_VERSION - 1))
-    assert exact._usable(SimpleNamespace(VERSION=exact.KERNEL_VERSION))
+    from dextar._compiled import usable
+
+    version = exact.KERNEL_VERSION
+    assert not usable(None, version)
+    assert not usable(SimpleNamespace(torques=None), version)  # a build before versions
+    assert not usable(SimpleNamespace(VERSION=version - 1), version)
+    assert usable(SimpleNamespace(VERSION=version), version)
     if exact._compiled is not None:
-        assert exact._usable(exact._compiled)
+        assert usable(exact._compiled, version)

@@ -20,9 +20,10 @@
  *   the working mode, legs = (s1, s2, L1, L2) its signs and the distal rods' lengths (the
  *   motor angles' cosines and sines from the elbows,
  *   no angle needed), the joint rates and accelerations (written to dq and ddq), then the
- *   torque kernel; bad is the first sample out of reach of a leg (-1: none), finite says
- *   whether every input and every rate is finite. Where either says so the caller runs the
- *   stages in turn, which name the sample.
+ *   torque kernel; bad is the first sample out of reach of a leg or at a serial
+ *   singularity to rounding (|B - A| x |P - B| at most 1e-12 l L: the rates there are
+ *   rounding noise) (-1: none), finite says whether every input and every rate is finite.
+ *   Where either says so the caller runs the stages in turn, which name the sample.
  *
  * The motor angles' cosines and sines come from a polynomial on the angle reduced to
  * [-pi/4, pi/4] (Cody-Waite reduction with pi/2 in three parts, Taylor series to the 17th
@@ -32,8 +33,7 @@
  * results do not depend on the machine's instruction set.
  */
 
-#define PY_SSIZE_T_CLEAN
-#include <Python.h>
+#include "../_buffers.h"
 #include <float.h>
 #include <math.h>
 
@@ -46,7 +46,7 @@
 
 /* The kernel's interface version: exact.py uses a build of this version only (an older
  * build left in place, after an edit whose build failed, is not used). */
-#define KERNEL_VERSION 3
+#define KERNEL_VERSION 4
 
 enum {
     C_L1, C_L2, C_D, C_LSQ1, C_LSQ2, C_ILSQ1, C_ILSQ2, C_L2SQ, C_UE0, C_CST, C_SIGN,
@@ -275,13 +275,14 @@ WIDE static void task_block(const double *restrict k, const double *restrict leg
         double e1x, e1y, e2x, e2y;
         int b = leg(px - half, py, l1, L1, sg1, &e1x, &e1y);
         b |= leg(px + half, py, l2, L2, sg2, &e2x, &e2y);
-        bad[i] = b;
         double n1 = 1.0 / sqrt(e1x * e1x + e1y * e1y), n2 = 1.0 / sqrt(e2x * e2x + e2y * e2y);
         double c1 = e1x * n1, s1 = e1y * n1, c2 = e2x * n2, s2 = e2y * n2;
         /* the frame: u = P - B, v = P - C, b = l (c x u) */
         double ux = px - (half + l1 * c1), uy = py - l1 * s1;
         double vx = px - (-half + l2 * c2), vy = py - l2 * s2;
         double b1 = l1 * (c1 * uy - s1 * ux), b2 = l2 * (c2 * vy - s2 * vx);
+        b |= !(fabs(b1) > 1e-12 * (l1 * L1)) | !(fabs(b2) > 1e-12 * (l2 * L2));
+        bad[i] = b;
         double dx = dP[2 * i], dy = dP[2 * i + 1];
         double w1 = (ux * dx + uy * dy) / b1, w2 = (vx * dx + vy * dy) / b2;
         /* the velocity-product term: Pdot - Bdot, Bdot = l w (-s, c) */
@@ -333,32 +334,17 @@ static Py_ssize_t all_task_samples(const double *k, const double *legs, const do
     return first_bad;
 }
 
-static int get_buffer(PyObject *obj, Py_buffer *view, int writable, const char *name)
-{
-    int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (writable ? PyBUF_WRITABLE : 0);
-    if (PyObject_GetBuffer(obj, view, flags) < 0)
-        return -1;
-    if (view->itemsize != 8 || view->format == NULL || strcmp(view->format, "d") != 0) {
-        PyErr_Format(PyExc_TypeError, "%s must hold float64 values", name);
-        PyBuffer_Release(view);
-        return -1;
-    }
-    return 0;
-}
-
 static PyObject *torques(PyObject *self, PyObject *args)
 {
     PyObject *objs[5];
     static const char *names[5] = {"consts", "q", "dq", "ddq", "out"};
     Py_buffer views[5];
-    int got = 0;
     PyObject *result = NULL;
     (void)self;
     if (!PyArg_ParseTuple(args, "OOOOO", &objs[0], &objs[1], &objs[2], &objs[3], &objs[4]))
         return NULL;
-    for (; got < 5; got++)
-        if (get_buffer(objs[got], &views[got], got == 4, names[got]) < 0)
-            goto done;
+    if (get_buffers(objs, views, 5, 4, names) < 0)
+        return NULL;
     if (views[0].len != N_CONSTS * 8) {
         PyErr_Format(PyExc_ValueError, "consts must hold %d values", (int)N_CONSTS);
         goto done;
@@ -381,8 +367,7 @@ static PyObject *torques(PyObject *self, PyObject *args)
         result = Py_BuildValue("(ddO)", disc, worst, ok ? Py_True : Py_False);
     }
 done:
-    while (got > 0)
-        PyBuffer_Release(&views[--got]);
+    release_buffers(views, 5);
     return result;
 }
 
@@ -392,15 +377,13 @@ static PyObject *task_torques(PyObject *self, PyObject *args)
     static const char *names[7] = {"consts", "P", "dP", "ddP", "dq", "ddq", "out"};
     Py_buffer views[7];
     double legs[4];
-    int got = 0;
     PyObject *result = NULL;
     (void)self;
     if (!PyArg_ParseTuple(args, "O(dddd)OOOOOO", &objs[0], &legs[0], &legs[1], &legs[2],
                           &legs[3], &objs[1], &objs[2], &objs[3], &objs[4], &objs[5], &objs[6]))
         return NULL;
-    for (; got < 7; got++)
-        if (get_buffer(objs[got], &views[got], got >= 4, names[got]) < 0)
-            goto done;
+    if (get_buffers(objs, views, 7, 4, names) < 0)
+        return NULL;
     if (views[0].len != N_CONSTS * 8) {
         PyErr_Format(PyExc_ValueError, "consts must hold %d values", (int)N_CONSTS);
         goto done;
@@ -427,8 +410,7 @@ static PyObject *task_torques(PyObject *self, PyObject *args)
         result = Py_BuildValue("(nddO)", bad, disc, worst, finite ? Py_True : Py_False);
     }
 done:
-    while (got > 0)
-        PyBuffer_Release(&views[--got]);
+    release_buffers(views, 7);
     return result;
 }
 

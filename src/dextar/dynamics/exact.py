@@ -30,6 +30,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from .._arrays import Array, as_points, blocks, check_finite, cos_sin
+from .._compiled import usable
 from ..errors import AssemblyError, ParameterError, SingularityError
 from ..geometry import FiveBar, parse_assembly_mode, parse_working_mode
 from ..kinematics import DEFAULT_SINGULARITY_TOL, inverse_kinematics, joint_rates
@@ -43,15 +44,8 @@ except ImportError:  # pragma: no cover - installed without a C compiler: the nu
 
 #: The compiled kernel's interface this module calls (``KERNEL_VERSION`` in _kernel.c): a
 #: build of another version (an old one left in place) is not used.
-KERNEL_VERSION = 3
-
-
-def _usable(module: object) -> bool:
-    """Whether ``module`` is a build of the compiled kernel of this interface version."""
-    return module is not None and getattr(module, "VERSION", None) == KERNEL_VERSION
-
-
-if not _usable(_compiled):
+KERNEL_VERSION = 4
+if not usable(_compiled, KERNEL_VERSION):
     _compiled = None  # type: ignore[assignment]  # an old build: the numpy kernel instead
 
 #: Whether :func:`inverse_dynamics` and its kin use the compiled kernel (where it was built):
@@ -647,33 +641,35 @@ def task_inverse_dynamics(model: Model, mode: str, points: object, dpoints: obje
     ``mode``, :func:`dextar.kinematics.joint_rates` (serial singularities not refused) and
     :func:`inverse_dynamics` in turn, in one pass of the compiled kernel where it was built
     (the motor angles' cosines and sines from the elbows, no angle computed). Where it was
-    not, or where a sample is out of reach, not finite or too near a parallel singularity,
-    those three run in turn and name the sample.
+    not, or where a sample is out of reach, at a serial singularity to rounding, not finite
+    or too near a parallel singularity, those three run in turn: the same results and the
+    same errors, naming the sample.
 
     Parameters
     ----------
-    points, dpoints, ddpoints : array_like, shape (n, 2)
+    points, dpoints, ddpoints : array_like, shape (..., 2), the same shape
         The end-effector's positions, velocities and accelerations.
 
     Returns
     -------
-    dq, ddq, tau : ndarray, shape (n, 2)
+    dq, ddq, tau : ndarray, shape (..., 2)
     """
-    P, dP, ddP = (as_points(x, name, finite=False).reshape(-1, 2) for x, name in
-                  ((points, "points"), (dpoints, "dpoints"), (ddpoints, "ddpoints")))
-    if not (len(P) == len(dP) == len(ddP)):
-        raise ParameterError(f"points, dpoints, ddpoints must have the same number of "
-                             f"samples, got {len(P)}, {len(dP)}, {len(ddP)}")
+    P = as_points(points, "points")
+    dP, ddP = (as_points(x, name, finite=False) for x, name in
+               ((dpoints, "dpoints"), (ddpoints, "ddpoints")))
+    if not (P.shape == dP.shape == ddP.shape):
+        raise ParameterError(f"points, dpoints, ddpoints must have the same shape, got "
+                             f"{P.shape}, {dP.shape}, {ddP.shape}")
     if USE_COMPILED:
         r = model.robot
         s1, s2 = parse_working_mode(mode)
-        dq, ddq, tau = np.empty(P.shape), np.empty(P.shape), np.empty(P.shape)
-        Pc, dPc, ddPc = (np.ascontiguousarray(x) for x in (P, dP, ddP))
+        Pc, dPc, ddPc = (np.ascontiguousarray(x.reshape(-1, 2)) for x in (P, dP, ddP))
+        dq, ddq, tau = np.empty(Pc.shape), np.empty(Pc.shape), np.empty(Pc.shape)
         bad, disc, worst, finite = _compiled.task_torques(
             _kernel_constants(_lumped(model, True, True)), (float(s1), float(s2), r.L1, r.L2),
             Pc, dPc, ddPc, dq, ddq, tau)
         if bad < 0 and finite and _clear(disc, worst, _singularity_cap(model)):
-            return dq, ddq, tau
+            return dq.reshape(P.shape), ddq.reshape(P.shape), tau.reshape(P.shape)
     q = inverse_kinematics(model.robot, P, mode)
     dq, ddq = joint_rates(model.robot, q, P, dP, ddP, tol=0.0)
     return dq, ddq, inverse_dynamics(model, q, dq, ddq)

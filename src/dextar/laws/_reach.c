@@ -13,14 +13,15 @@
  *   x: a writable float64 buffer of n + 1 values, the squared speeds at the grid points.
  *   Returns -1 when x is written, else the stage k at which no motion passes (the caller
  *   names its point): the controllable set at k is empty (backward pass) or the largest
- *   acceleration at k cannot reach the next controllable set (forward pass).
+ *   acceleration at k cannot reach the next controllable set (forward pass). The caller
+ *   gives finite Gu and Gx and no NaN in h (time_optimal._passes checks them: NumPy's
+ *   reductions and these loops would treat a NaN otherwise); n >= 1, m >= 1.
  *
  * Compiled without contraction into fused multiply-adds (-ffp-contract=off): each product
  * and sum rounds as it does in NumPy and in Python's floats.
  */
 
-#define PY_SSIZE_T_CLEAN
-#include <Python.h>
+#include "../_buffers.h"
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -230,36 +231,21 @@ static Py_ssize_t solve(Py_ssize_t n, Py_ssize_t m, const double *Gu, const doub
     return bad;
 }
 
-static int get_buffer(PyObject *obj, Py_buffer *view, int writable, const char *name)
-{
-    int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (writable ? PyBUF_WRITABLE : 0);
-    if (PyObject_GetBuffer(obj, view, flags) < 0)
-        return -1;
-    if (view->itemsize != 8 || view->format == NULL || strcmp(view->format, "d") != 0) {
-        PyErr_Format(PyExc_TypeError, "%s must hold float64 values", name);
-        PyBuffer_Release(view);
-        return -1;
-    }
-    return 0;
-}
-
 static PyObject *reach(PyObject *self, PyObject *args)
 {
     PyObject *objs[5];
     static const char *names[5] = {"Gu", "Gx", "h", "ds", "x"};
     Py_buffer views[5];
-    int got = 0;
     PyObject *result = NULL;
     (void)self;
     if (!PyArg_ParseTuple(args, "OOOOO", &objs[0], &objs[1], &objs[2], &objs[3], &objs[4]))
         return NULL;
-    for (; got < 5; got++)
-        if (get_buffer(objs[got], &views[got], got == 4, names[got]) < 0)
-            goto done;
+    if (get_buffers(objs, views, 5, 4, names) < 0)
+        return NULL;
     {
         Py_ssize_t n = views[3].len / 8;
         Py_ssize_t len = views[0].len / 8;
-        if (n < 1 || len % n != 0 || views[1].len != views[0].len
+        if (n < 1 || len < n || len % n != 0 || views[1].len != views[0].len
                 || views[2].len != views[0].len || views[4].len != (n + 1) * 8) {
             PyErr_SetString(PyExc_ValueError,
                             "Gu, Gx, h must hold n * m values, ds n and x n + 1");
@@ -277,8 +263,7 @@ static PyObject *reach(PyObject *self, PyObject *args)
             result = PyLong_FromSsize_t(bad);
     }
 done:
-    while (got > 0)
-        PyBuffer_Release(&views[--got]);
+    release_buffers(views, 5);
     return result;
 }
 

@@ -42,6 +42,7 @@ from typing import Any
 import numpy as np
 
 from .._arrays import Array
+from .._compiled import usable
 from ..errors import InfeasibleError, ParameterError
 from ..motors import MotorLimits
 from ..units import Units
@@ -65,14 +66,7 @@ except ImportError:  # pragma: no cover - installed without a C compiler: the Py
 #: The compiled passes' interface this module calls (``REACH_VERSION`` in _reach.c): a build
 #: of another version (an old one left in place) is not used.
 REACH_VERSION = 1
-
-
-def _usable(module: object) -> bool:
-    """Whether ``module`` is a build of the compiled passes of this interface version."""
-    return module is not None and getattr(module, "VERSION", None) == REACH_VERSION
-
-
-if not _usable(_compiled):
+if not usable(_compiled, REACH_VERSION):
     _compiled = None  # type: ignore[assignment]  # an old build: the Python passes instead
 
 #: Whether the reachability analysis runs compiled (where it was built): False gives the
@@ -385,10 +379,24 @@ def _passes(Gu: Array, Gx: Array, h: Array, ds: Array,
     """The squared speeds (N + 1,) from the stages' rows ``Gu u + Gx x <= h`` (N, m) and
     lengths ``ds`` (N,): the elimination and both passes, compiled where they were built
     (:data:`USE_COMPILED`), else in Python; ``unreachable(k)`` is the error where no motion
-    passes stage ``k``."""
+    passes stage ``k``. A row no motion meets (``h = -inf``) empties its stage; a row that is
+    not a number is a constraint's error, named."""
+    Gu, Gx, h, ds = (np.asarray(a, dtype=float) for a in (Gu, Gx, h, ds))
+    if Gu.ndim != 2 or Gu.shape[1] == 0 or not (Gx.shape == h.shape == Gu.shape) \
+            or ds.shape != Gu.shape[:1]:
+        raise ParameterError(f"stage rows of shapes {Gu.shape}, {Gx.shape}, {h.shape} and "
+                             f"lengths {ds.shape} do not match")
+    odd = ~(np.isfinite(Gu) & np.isfinite(Gx)) | np.isnan(h)
+    if odd.any():
+        k = int(np.flatnonzero(odd.any(axis=1))[0])
+        raise ParameterError(f"a limit's row at stage {k} of the time-optimal law is not "
+                             "finite (a constraint object's rows)")
+    never = (h == -np.inf).any(axis=1)
+    if never.any():  # (the backward pass meets the last of them first)
+        raise unreachable(int(np.flatnonzero(never)[-1]))
     if USE_COMPILED:
         x = np.empty(len(ds) + 1)
-        Gu, Gx, h, ds = (np.ascontiguousarray(a, dtype=float) for a in (Gu, Gx, h, ds))
+        Gu, Gx, h, ds = (np.ascontiguousarray(a) for a in (Gu, Gx, h, ds))
         k = _compiled.reach(Gu, Gx, h, ds, x)
         if k >= 0:
             raise unreachable(k)

@@ -195,16 +195,17 @@ class Arc(Path):
         R, sg = self.radius, (-1.0 if self.clockwise else 1.0)
         c, s = np.cos(sg * p), np.sin(sg * p)
         Rc, Rs = R * c, R * s
-        out = np.empty((4, *p.shape, 2))  # the position and its derivatives, in place
-        np.add(self.center[0], Rc, out=out[0, ..., 0])
-        np.add(self.center[1], Rs, out=out[0, ..., 1])
-        np.multiply(-sg * R, s, out=out[1, ..., 0])
-        np.multiply(sg * R, c, out=out[1, ..., 1])
-        np.negative(Rc, out=out[2, ..., 0])
-        np.negative(Rs, out=out[2, ..., 1])
-        np.multiply(sg * R, s, out=out[3, ..., 0])
-        np.multiply(-sg * R, c, out=out[3, ..., 1])
-        return out[0], out[1], out[2], out[3]
+        # the position and its derivatives written in place (each its own array)
+        r, r1, r2, r3 = (np.empty((*p.shape, 2)) for _ in range(4))
+        np.add(self.center[0], Rc, out=r[..., 0])
+        np.add(self.center[1], Rs, out=r[..., 1])
+        np.multiply(-sg * R, s, out=r1[..., 0])
+        np.multiply(sg * R, c, out=r1[..., 1])
+        np.negative(Rc, out=r2[..., 0])
+        np.negative(Rs, out=r2[..., 1])
+        np.multiply(sg * R, s, out=r3[..., 0])
+        np.multiply(-sg * R, c, out=r3[..., 1])
+        return r, r1, r2, r3
 
     @property
     def length(self) -> float:
