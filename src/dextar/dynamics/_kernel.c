@@ -209,12 +209,35 @@ static int all_finite(const double *x, Py_ssize_t n)
     return !bad;
 }
 
+/* The samples' extremes for the caller's checks: the smallest discriminant, the largest
+ * 1 / |det|, and whether a NaN was among them (elbows that coincide: told, not skipped). */
+typedef struct {
+    double dmin, wmax;
+    int nan;
+} Extremes;
+
+static void extremes_of(Extremes *e, const double *disc, const double *worst, Py_ssize_t m)
+{
+    for (Py_ssize_t i = 0; i < m; i++) {
+        if (disc[i] < e->dmin)
+            e->dmin = disc[i];
+        if (worst[i] > e->wmax)
+            e->wmax = worst[i];
+        e->nan |= disc[i] != disc[i] || worst[i] != worst[i];
+    }
+}
+
+static void extremes_out(const Extremes *e, double *disc_min, double *worst_max)
+{
+    *disc_min = e->nan ? NAN : e->dmin;
+    *worst_max = e->nan ? NAN : e->wmax;
+}
+
 static int all_samples(const double *k, const double *q, const double *dq, const double *ddq,
                        double *out, Py_ssize_t n, double *disc_min, double *worst_max)
 {
     double disc[BLOCK], worst[BLOCK];
-    double dmin = INFINITY, wmax = 0.0;
-    int nan = 0;  /* a NaN among them (elbows that coincide) is told, not skipped */
+    Extremes e = {INFINITY, 0.0, 0};
     int inputs_finite = 1;
     for (Py_ssize_t start = 0; start < n; start += BLOCK) {
         Py_ssize_t m = n - start < BLOCK ? n - start : BLOCK;
@@ -230,16 +253,9 @@ static int all_samples(const double *k, const double *q, const double *dq, const
             large_angles(k, qb, dqb, ddqb, ob, m, disc, worst);
         if (k[C_FRICTION] != 0.0)
             coulomb(k, dqb, ob, m);
-        for (Py_ssize_t i = 0; i < m; i++) {
-            if (disc[i] < dmin)
-                dmin = disc[i];
-            if (worst[i] > wmax)
-                wmax = worst[i];
-            nan |= disc[i] != disc[i] || worst[i] != worst[i];
-        }
+        extremes_of(&e, disc, worst, m);
     }
-    *disc_min = nan ? NAN : dmin;
-    *worst_max = nan ? NAN : wmax;
+    extremes_out(&e, disc_min, worst_max);
     return inputs_finite;
 }
 
@@ -306,8 +322,8 @@ static Py_ssize_t all_task_samples(const double *k, const double *legs, const do
 {
     double disc[BLOCK], worst[BLOCK];
     int bad[BLOCK];
-    double dmin = INFINITY, wmax = 0.0;
-    int nan = 0, all = 1;
+    Extremes e = {INFINITY, 0.0, 0};
+    int all = 1;
     Py_ssize_t first_bad = -1;
     for (Py_ssize_t start = 0; start < n; start += BLOCK) {
         Py_ssize_t m = n - start < BLOCK ? n - start : BLOCK;
@@ -318,18 +334,12 @@ static Py_ssize_t all_task_samples(const double *k, const double *legs, const do
         all &= all_finite(dq + o, 2 * m) & all_finite(ddq + o, 2 * m);
         if (k[C_FRICTION] != 0.0)
             coulomb(k, dq + o, out + o, m);
-        for (Py_ssize_t i = 0; i < m; i++) {
-            if (bad[i] && first_bad < 0)
+        for (Py_ssize_t i = 0; i < m && first_bad < 0; i++)
+            if (bad[i])
                 first_bad = start + i;
-            if (disc[i] < dmin)
-                dmin = disc[i];
-            if (worst[i] > wmax)
-                wmax = worst[i];
-            nan |= disc[i] != disc[i] || worst[i] != worst[i];
-        }
+        extremes_of(&e, disc, worst, m);
     }
-    *disc_min = nan ? NAN : dmin;
-    *worst_max = nan ? NAN : wmax;
+    extremes_out(&e, disc_min, worst_max);
     *finite = all;
     return first_bad;
 }

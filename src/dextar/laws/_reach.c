@@ -34,49 +34,36 @@
 #define REACH_VERSION 1
 
 /* the kinds of a row once solved for u */
-enum { ROW_X_ONLY, ROW_UPPER, ROW_LOWER, ROW_NONE };
-
-/* NumPy's min and max reductions: a NaN, once met, is the result */
-static inline double np_min(double acc, double v)
-{
-    return (acc != acc || v != v) ? NAN : (v < acc ? v : acc);
-}
-
-static inline double np_max(double acc, double v)
-{
-    return (acc != acc || v != v) ? NAN : (v > acc ? v : acc);
-}
+enum { ROW_X_ONLY, ROW_UPPER, ROW_LOWER };
 
 /* One stage solved for u, as _stages does it: each row's kind and u <= / >= alpha x + beta,
- * the interval of x every row and pair of rows allows on its own (lo = inf: empty). */
+ * the interval of x every row and pair of rows allows on its own (lo = inf: empty). No NaN
+ * arises from the finite Gu, Gx and the h without NaN or -inf that _passes lets through, so
+ * plain minima and maxima are NumPy's reductions here. */
 static void stage(const double *gu, const double *gx, const double *h, double ds,
                   Py_ssize_t m, int *kind, double *alpha, double *beta, double *lo_out,
                   double *hi_out)
 {
     double two_ds = 2 * ds;
     int empty = 0;
-    double lo = -INFINITY, hi = INFINITY;
     for (Py_ssize_t j = 0; j < m; j++) {
         double tiny = 1e-12 * (fabs(gu[j]) + two_ds * fabs(gx[j]));
-        if (gu[j] > tiny)
-            kind[j] = ROW_UPPER;
-        else if (gu[j] < -tiny)
-            kind[j] = ROW_LOWER;
-        else if (fabs(gu[j]) <= tiny)
-            kind[j] = ROW_X_ONLY;
-        else
-            kind[j] = ROW_NONE;  /* NaN */
-        if (kind[j] == ROW_UPPER || kind[j] == ROW_LOWER) {
-            alpha[j] = -gx[j] / gu[j];
-            beta[j] = h[j] / gu[j];
-        } else {
-            alpha[j] = 0.0;
-            beta[j] = 0.0;
-        }
+        kind[j] = gu[j] > tiny ? ROW_UPPER : gu[j] < -tiny ? ROW_LOWER : ROW_X_ONLY;
+        alpha[j] = kind[j] == ROW_X_ONLY ? 0.0 : -gx[j] / gu[j];
+        beta[j] = kind[j] == ROW_X_ONLY ? 0.0 : h[j] / gu[j];
     }
-    /* every lower row below every upper row: (al - au) x <= bu - bl */
-    double phi = INFINITY, plo = -INFINITY;
+    /* every lower row below every upper row, (al - au) x <= bu - bl; the rows in x alone */
+    double hi = INFINITY, lo = -INFINITY;
     for (Py_ssize_t i = 0; i < m; i++) {
+        if (kind[i] == ROW_X_ONLY) {
+            double rx = h[i] / gx[i];
+            if (gx[i] > 0 && rx < hi)
+                hi = rx;
+            else if (gx[i] < 0 && rx > lo)
+                lo = rx;
+            empty |= (gx[i] == 0) & (h[i] < 0);
+            continue;
+        }
         if (kind[i] != ROW_UPPER)
             continue;
         for (Py_ssize_t j = 0; j < m; j++) {
@@ -85,34 +72,27 @@ static void stage(const double *gu, const double *gx, const double *h, double ds
             double c = alpha[j] - alpha[i];
             double d = beta[i] - beta[j];
             double r = d / c;
-            if (c > 0)
-                phi = np_min(phi, r);
-            else if (c < 0)
-                plo = np_max(plo, r);
+            if (c > 0 && r < hi)
+                hi = r;
+            else if (c < 0 && r > lo)
+                lo = r;
             empty |= (c == 0) & (d < 0);
         }
     }
-    /* the rows in x alone */
-    double xhi = INFINITY, xlo = -INFINITY;
-    for (Py_ssize_t j = 0; j < m; j++) {
-        if (kind[j] != ROW_X_ONLY)
-            continue;
-        double rx = h[j] / gx[j];
-        if (gx[j] > 0)
-            xhi = np_min(xhi, rx);
-        else if (gx[j] < 0)
-            xlo = np_max(xlo, rx);
-        empty |= (gx[j] == 0) & (h[j] < 0);
-    }
-    /* np.minimum and np.maximum of the two: a NaN in either is the result */
-    hi = (phi != phi || xhi != xhi) ? NAN : (xhi < phi ? xhi : phi);
-    lo = (plo != plo || xlo != xlo) ? NAN : (xlo > plo ? xlo : plo);
-    if (empty)
-        lo = INFINITY;
-    else
-        lo = (lo >= 0.0 || lo != lo) ? lo : 0.0;
-    *lo_out = lo;
+    *lo_out = empty ? INFINITY : (lo >= 0.0 ? lo : 0.0);
     *hi_out = hi;
+}
+
+/* A bound c x <= v c on x: x <= v where c > 0, x >= v where c < 0. */
+static inline void bound(double c, double v, double *xl, double *xh)
+{
+    if (c > 0) {
+        if (v < *xh)
+            *xh = v;
+    } else if (c < 0) {
+        if (v > *xl)
+            *xl = v;
+    }
 }
 
 /* The backward pass (_controllable): the controllable interval [K_lo, K_hi] at each point
@@ -138,27 +118,11 @@ static Py_ssize_t controllable(Py_ssize_t n, Py_ssize_t m, const double *ds, con
             if (kd[j] == ROW_LOWER) {
                 /* u >= al x + bl and u <= (hi - x) / (2 ds): cl x <= hi / (2 ds) - bl */
                 double cl = a[j] + inv2;
-                double mm = inv2 / cl, q = -b[j] / cl;
-                double v = mm * hi + q;
-                if (cl > 0) {
-                    if (v < xh)
-                        xh = v;
-                } else if (cl < 0) {
-                    if (v > xl)
-                        xl = v;
-                }
+                bound(cl, inv2 / cl * hi + -b[j] / cl, &xl, &xh);
             } else if (kd[j] == ROW_UPPER) {
                 /* u >= (lo - x) / (2 ds) and u <= au x + bu: cu x <= bu - lo / (2 ds) */
                 double cu = -inv2 - a[j];
-                double mm = -inv2 / cu, q = b[j] / cu;
-                double v = mm * lo + q;
-                if (cu > 0) {
-                    if (v < xh)
-                        xh = v;
-                } else if (cu < 0) {
-                    if (v > xl)
-                        xl = v;
-                }
+                bound(cu, -inv2 / cu * lo + b[j] / cu, &xl, &xh);
             }
         }
         if (xl > xh + 1e-12 * (1.0 + fabs(xh)))
