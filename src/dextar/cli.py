@@ -8,15 +8,13 @@ from __future__ import annotations
 
 import argparse
 import atexit
-import importlib
 import json
 import os
 import signal
 import sys
 import threading
 import warnings
-from collections.abc import Sequence
-from types import ModuleType
+from collections.abc import Mapping, Sequence
 from typing import Any, NoReturn
 
 from . import __version__
@@ -54,7 +52,7 @@ def registries_help() -> str:
     from .paths import PATH_TYPES
     from .program import MOVE_TYPES
 
-    def listing(reg: dict[str, Any]) -> str:
+    def listing(reg: Mapping[str, Any]) -> str:
         return "\n".join(f"  {k:<14} {v.help}" for k, v in reg.items())
 
     return (f"config tables: {', '.join(f'[{t}]' for t in TABLES)}\n"
@@ -62,27 +60,22 @@ def registries_help() -> str:
             f"[[move]] type:\n{listing(MOVE_TYPES)}")
 
 
-def _command(name: str) -> ModuleType:
-    return importlib.import_module(f".commands.{name}", __package__)
-
-
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:
-    """The argument parser of every command (with ``only``, a command's name: every command
-    is listed, and only that one's arguments are added: what parsing its command line
-    needs, at a tenth of the cost)."""
+    """The argument parser of every registered command (with ``only``, a command's name:
+    every command is listed, and only that one's arguments are added: what parsing its
+    command line needs, at a tenth of the cost)."""
     p = _Parser(prog="dextar", description="Five-bar (DexTAR) robot toolkit. Lengths in mm, "
                 "angles in degrees on the command line.")
     p.add_argument("--version", action="version", version=f"dextar {__version__}")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
     p.set_defaults(parsers={})
-    for name in COMMANDS:
-        mod = _command(name)
-        sp = sub.add_parser(mod.NAME, help=mod.HELP, description=mod.HELP)
-        sp.registries = getattr(mod, "REGISTRIES_HELP", False)
-        if only is None or only == mod.NAME:
-            mod.add_arguments(sp)
-        p.get_default("parsers")[mod.NAME] = sp
-        sp.set_defaults(run=mod.run)
+    for name, cmd in COMMANDS.items():
+        sp = sub.add_parser(name, help=cmd.help, description=cmd.help)
+        sp.registries = cmd.registries_help
+        if only is None or only == name:
+            cmd.add_arguments(sp)
+        p.get_default("parsers")[name] = sp
+        sp.set_defaults(command_entry=cmd)
     return p
 
 
@@ -94,9 +87,10 @@ def _emit(args: argparse.Namespace, res: Result) -> int:
         sys.stdout.flush()
     for w in res.warnings:
         sys.stderr.write(w + "\n")
-    if not getattr(args, "quiet", False) or args.json:
+    as_json = getattr(args, "json", False)
+    if not getattr(args, "quiet", False) or as_json:
         stream = sys.stderr if getattr(args, "out", None) == "-" else sys.stdout
-        print(json.dumps(res.payload) if args.json else res.text, file=stream)
+        print(json.dumps(res.payload) if as_json else res.text, file=stream)
     return int(res.code)
 
 
@@ -115,7 +109,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         with warnings.catch_warnings():  # numerical warnings of a failing solve: the error
             warnings.simplefilter("ignore", RuntimeWarning)  # that follows says it in words
-            return _emit(args, args.run(args))
+            return _emit(args, args.command_entry.run(args))
     except KeyboardInterrupt:
         return _interrupted(args.command)
     except Exception as exc:

@@ -55,7 +55,7 @@ class ProgramTable(Table):
         from ..laws import law_type
 
         t = cls(**read_params(cls.NAME, raw, cls.PARAMS))
-        law_type(t.law)
+        law_type(t.law, "config key [program].law")
         if t.working_mode is not None:
             try:
                 canonical_working_mode(t.working_mode)
@@ -96,11 +96,7 @@ def _move_kind(label: str, raw: Mapping[str, Any]) -> MoveType:
     if "type" not in raw:
         raise ConfigError(f"config key {label}.type is required: one of "
                           f"{', '.join(MOVE_TYPES)}")
-    try:
-        return move_type(raw["type"])
-    except DextarError:
-        raise ConfigError(f"config key {label}.type must be one of {', '.join(MOVE_TYPES)}, "
-                          f"got {raw['type']!r}") from None
+    return move_type(raw["type"], f"config key {label}.type")
 
 
 def _read_move(i: int, raw: Mapping[str, Any], program: ProgramTable) -> Move:
@@ -112,12 +108,7 @@ def _read_move(i: int, raw: Mapping[str, Any], program: ProgramTable) -> Move:
     mt = _move_kind(label, raw)
     lt = None
     if mt.has_law:
-        law_name = raw.get("law", program.law)
-        try:
-            lt = law_type(law_name)
-        except ConfigError:
-            raise ConfigError(f"config key {label}.law must be one of the laws, got "
-                              f"{law_name!r}") from None
+        lt = law_type(raw.get("law", program.law), f"config key {label}.law")
     law_keys = {k: p for k, p in (lt.params if lt else {}).items() if k != "duration"}
     known = ["type", *mt.params, *(("law", "duration") if lt else ()),
              *(("blend",) if mt.path is not None else ()), *law_keys]

@@ -25,6 +25,7 @@ from ..motors import MotorLimits
 from ..output.run import FIGURES as FIGURES
 from ..params import Param, read_params, to_run_units
 from ..paths import Path, PathType, path_type
+from ..registry import Registry
 from ..units import Units
 
 if TYPE_CHECKING:
@@ -49,12 +50,12 @@ class Table:
 
 
 #: The table registry: TOML name -> dataclass.
-TABLES: dict[str, type[Table]] = {}
+TABLES: Registry[type[Table]] = Registry("config table", "config table")
 
 
 def register_table(cls: type[T]) -> type[T]:
     """Make ``[cls.NAME]`` a known table of the config files."""
-    TABLES[cls.NAME] = cls
+    TABLES.register(cls, cls.NAME)
     return cls
 
 

@@ -17,9 +17,9 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from ..errors import ConfigError
 from ..params import Param
 from ..paths import Path
+from ..registry import Registry
 from ..units import Units
 from .base import Law
 
@@ -90,18 +90,17 @@ class LawType:
     fit: Callable[[LawRequest, Shortest], Law] | None = None
 
 
-LAW_TYPES: dict[str, LawType] = {}
+#: The laws by config name; installed packages add theirs through the entry-point group
+#: ``dextar.laws``.
+LAW_TYPES: Registry[LawType] = Registry("law", "config key [law].type", group="dextar.laws")
 
 
 def register_law(kind: LawType) -> LawType:
     """Add a law to the registry (a later registration of the same name replaces it)."""
-    LAW_TYPES[kind.name] = kind
-    return kind
+    return LAW_TYPES.register(kind)
 
 
-def law_type(name: object) -> LawType:
-    """The registered law ``name``; a :class:`ConfigError` lists the known ones."""
-    if not isinstance(name, str) or name not in LAW_TYPES:
-        raise ConfigError(f"config key [law].type must be one of {', '.join(LAW_TYPES)}, got "
-                          f"{name!r}")
-    return LAW_TYPES[name]
+def law_type(name: object, where: str | None = None) -> LawType:
+    """The registered law ``name``; an :class:`~dextar.registry.UnknownNameError` (a
+    :class:`~dextar.errors.ConfigError`) naming ``where`` lists the known ones."""
+    return LAW_TYPES.lookup(name, where)
