@@ -289,6 +289,63 @@ def test_bad_measurements_exit_2_in_one_line(story, tmp_path, capsys, name, edit
     assert not (tmp_path / "o").exists()
 
 
+def test_a_wrong_assembly_is_named_by_its_row(story, tmp_path, capsys):
+    """Row 23 (the 22nd pose) said "down" while the robot was up: the fit of all rows was
+    dragged until row 2 left its working mode, and the error blamed row 2. Now the robust
+    fit of the others names row 23 alone, 173 mm off as given and 0.07 mm in the other
+    assembly (outlier bound 0.08 mm), exit 2 in one line."""
+    rows = read_rows(story["measured"])
+    rows = [r + (["assembly"] if i == 0 else ["down" if i == 22 else "up"])
+            for i, r in enumerate(rows)]
+    bad = tmp_path / "down.csv"
+    _write(bad, rows)
+    code, out, err = cli(["calibrate", bad, "--config", story["cfg"], "--out",
+                          tmp_path / "o"], capsys)
+    assert code == 2 and out == "" and err.count("\n") == 1, err
+    assert err.startswith(f"dextar calibrate: error: {bad}: row 23 (assembly down as given: ")
+    assert "its assembly is wrong?) disagrees with the others" in err
+    assert "--robust soft_l1" in err and not (tmp_path / "o").exists()
+    # the same file with row 23 up calibrates
+    rows[22][-1] = "up"
+    _write(bad, rows)
+    code, _, err = cli(["calibrate", bad, "--config", story["cfg"], "--out", tmp_path / "o",
+                        "--quiet"], capsys)
+    assert code == 0, err
+
+
+def test_points_in_metres_exit_2_named(story, tmp_path, capsys):
+    """The measurements with x_mm, y_mm in metres (0.37 for 368.5 mm) were blamed on row 2's
+    rods (exit 2) or ran into a fit that did not converge; now the unit is named."""
+    rows = read_rows(story["measured"])
+    for r in rows[1:]:
+        r[2], r[3] = repr(float(r[2]) / 1e3), repr(float(r[3]) / 1e3)
+    bad = tmp_path / "metres.csv"
+    _write(bad, rows)
+    code, out, err = cli(["calibrate", bad, "--config", story["cfg"], "--out",
+                          tmp_path / "o"], capsys)
+    assert code == 2 and out == "" and err.count("\n") == 1, err
+    assert "x_mm, y_mm look written in metres (row 2: " in err
+    assert "write them in millimetres" in err and not (tmp_path / "o").exists()
+
+
+def test_a_fit_that_did_not_converge_writes_no_calibrated_config(story, tmp_path, capsys,
+                                                                 monkeypatch, no_figures):
+    """A solver stopped after one evaluation: exit 1, the diagnosis files, no
+    calibrated.toml (not even the one of an earlier run in the same directory)."""
+    out = tmp_path / "o"
+    code, _, _ = cli(["calibrate", story["measured"], "--config", story["cfg"], "--out", out,
+                      "--quiet"], capsys)
+    assert code == 0 and (out / "calibrated.toml").exists()
+    monkeypatch.setattr(cal, "calibrate", functools.partial(cal.calibrate, max_nfev=1))
+    code, text, err = cli(["calibrate", story["measured"], "--config", story["cfg"], "--out",
+                           out, "--force"], capsys)
+    assert code == 1 and "not converged" in err and "no calibrated.toml written" in err, err
+    assert not (out / "calibrated.toml").exists()
+    s = json.loads((out / "summary.json").read_text())
+    assert s["status"] == "not converged" and s["status_code"] == 1
+    assert (out / "parameters.csv").exists() and "calibrated.toml" not in text
+
+
 def test_a_single_working_mode_that_couples_parameters_exit_2(story, tmp_path, capsys):
     """Poses of one mode in a 60 mm patch: the frame and the robot's parameters coupled."""
     _, cand = candidates(NOMINAL, ("+-",), 1, margin=0.2, closure_slack=4e-3, resolution=61,

@@ -34,6 +34,9 @@ STATUS_WORDS = {0: "calibrated", 1: "not converged", 2: "residuals above the sta
                 3: "outliers"}
 #: The status code of a fit whose data hold outliers (no calibrated config is written).
 OUTLIERS = 3
+#: The status code of a fit that did not converge (no calibrated config is written: its
+#: parameters are where the solver stopped, not a calibration).
+NOT_CONVERGED = 1
 #: Every file of ``dextar calibrate``.
 CALIBRATION_FILES = ("calibrated.toml", "parameters.csv", "summary.json", "residuals.png",
                      "accuracy.png", "report.html")
@@ -420,15 +423,16 @@ def calibration_files(res: CalibrationResult, *, data: str, config: str = "",
                       resolution: int = 121, dpi: int = 110, outliers: Sequence[int] = (),
                       outlier_message: str = "", sigma_mm: float | None = None
                       ) -> dict[str, str | bytes]:
-    """Every file of ``dextar calibrate`` by name: ``calibrated.toml``, ``parameters.csv``,
-    ``summary.json`` and, with ``figures``, ``residuals.png``, ``accuracy.png`` and
-    ``report.html`` (the accuracy maps of the working modes of the kept poses, in
+    """Every file of ``dextar calibrate`` by name: ``calibrated.toml`` (not for a fit that
+    did not converge), ``parameters.csv``, ``summary.json`` and, with ``figures``,
+    ``residuals.png``, ``accuracy.png`` and ``report.html`` (the accuracy maps of the working modes of the kept poses, in
     ``assembly_mode``, with the encoders' rounding of ``encoder_counts`` per turn).
 
     ``extra`` holds the user's other config tables (raw TOML values) to carry into
     ``calibrated.toml``; ``validation`` the held-out poses of ``res.validation`` (drawn in
     ``residuals.png``); ``resolution`` the accuracy maps' grid, ``dpi`` the figures';
-    ``sigma_mm`` the instrument's noise (``[instrument].sigma_mm``), kept in the config. With ``outliers`` (the rows of a fit that kept them, see :func:`calibration_summary`)
+    ``sigma_mm`` the instrument's noise (``[instrument].sigma_mm``), kept in the config.
+    With ``outliers`` (the rows of a fit that kept them, see :func:`calibration_summary`)
     every file but ``calibrated.toml`` is written: a diagnosis, not a calibration.
     """
     from ..calibration.accuracy import accuracy_map
@@ -448,7 +452,7 @@ def calibration_files(res: CalibrationResult, *, data: str, config: str = "",
                f"{summary['rms_error_before_mm']:.4g} -> {summary['rms_error_after_mm']:.4g} "
                f"mm RMS over {summary['n_poses']} poses)")
     files: dict[str, str | bytes] = {}
-    if not outliers:
+    if not outliers and res.status != NOT_CONVERGED:
         files["calibrated.toml"] = calibrated_toml(
             res.calibrated, working_mode=working_mode, assembly_mode=assembly_mode,
             frame_identified=res.frame == "instrument", encoder_counts=encoder_counts,
@@ -584,8 +588,10 @@ class CalibrationRun:
             stated = (f"; or [instrument].sigma_mm = {self.sigma_mm:g} mm understates the "
                       "instrument's noise" if res.status == 2 and res.data.sigma is None
                       and self.sigma_mm is not None else "")
+            unwritten = (f"; no calibrated.toml written (the files in {self.out} are a "
+                         "diagnosis)" if res.status == NOT_CONVERGED else "")
             out.append(f"dextar calibrate: {STATUS_WORDS.get(res.status)}: "
-                       f"{res.message}{stated}")
+                       f"{res.message}{stated}{unwritten}")
         if res.rejected:
             out.append(f"dextar calibrate: note: the robust loss {self.robust} rejected "
                        f"row{'s' if len(res.rejected) > 1 else ''} "
