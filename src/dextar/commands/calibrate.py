@@ -72,7 +72,8 @@ def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
                               working_mode=rt.working_mode, assembly_mode=rt.assembly_mode,
                               encoder_counts=rt.encoder_counts, extra=extra,
                               validation=held, figures=figures, outliers=outliers,
-                              outlier_message=problem, sigma_mm=inst.sigma_mm)
+                              outlier_message=problem, sigma_mm=inst.sigma_mm,
+                              region_mm=inst.region_mm)
     said = CalibrationRun(res, shown(args.out), write_calibration(od, files),
                           outliers=outliers, problem=problem, robust=args.robust,
                           sigma_mm=inst.sigma_mm, working_mode=rt.working_mode,

@@ -125,7 +125,9 @@ class InstrumentTable(Table):
     """``[instrument]``: the measuring instrument (a laser tracker, a camera, a CMM) that
     sees the robot: the pose of the robot frame in the instrument's frame (a point ``P`` of
     the robot frame is measured at ``R(theta0) P + (x0, y0)``) and the instrument's noise.
-    It converts measured points only; every command works in the robot frame."""
+    It converts measured points only; every command works in the robot frame. ``region``
+    ``[xmin, xmax, ymin, ymax]`` (mm, robot frame) is where it can measure: ``dextar poses``
+    chooses every pose inside."""
 
     NAME: ClassVar[str] = "instrument"
     PARAMS: ClassVar[dict[str, Param]] = {
@@ -143,6 +145,29 @@ class InstrumentTable(Table):
     y0_mm: float = 0.0
     theta0_deg: float = 0.0
     sigma_mm: float | None = None
+    region_mm: tuple[float, float, float, float] | None = None
+
+    @classmethod
+    def from_toml(cls, raw: Mapping[str, object]) -> InstrumentTable:
+        """Read ``[instrument]``; ``region`` is four numbers ``[xmin, xmax, ymin, ymax]``
+        (mm, robot frame), each minimum below its maximum."""
+        unknown = [k for k in raw if k not in cls.PARAMS and k != "region"]
+        if unknown:
+            raise ConfigError(f"config key [instrument].{unknown[0]} is not known; known "
+                              f"keys: {', '.join([*cls.PARAMS, 'region'])}")
+        t = read_params(cls.NAME, raw, cls.PARAMS, ignore=("region",))
+        region = None
+        if "region" in raw:
+            from ..calibration.poses import checked_region
+
+            try:
+                region = checked_region(raw["region"], "config key [instrument].region")
+            except DextarError as exc:
+                raise ConfigError(str(exc)) from None
+            if max(abs(v) for v in region) > 1e6:
+                raise ConfigError(f"config key [instrument].region {list(region)} must be "
+                                  "within 1e6 mm")
+        return cls(**t, region_mm=region)
 
     @property
     def frame(self) -> tuple[float, float, float]:
