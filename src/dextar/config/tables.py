@@ -579,8 +579,11 @@ class DriveTable(Table):
         "encoder_counts": _pair("", "counts per motor turn", 4096.0, positive=True),
         "rated_torque_Nm": _pair("", "motor-side rated torque, N m (0x6076)", None,
                                  positive=True),
-        "pvt_period_ms": Param("number", "", 10.0, "period of the PVT points, ms",
-                               positive=True, maximum=1000.0),
+        "pvt_period_ms": Param("number", "", 10.0, "period of the PVT points, ms (a whole "
+                               "number of servo ticks)", positive=True, maximum=1000.0),
+        "max_torque_permille": _pair("", "largest torque the drive gives, per-mille of the "
+                                     "rated torque (0x6072); a torque feedforward beyond it "
+                                     "does not fit (exit 1)", None, positive=True),
     }
 
     gear_ratio: tuple[float, float] = (1.0, 1.0)
@@ -588,6 +591,7 @@ class DriveTable(Table):
     rated_torque_Nm: tuple[float, float] | None = None
     pvt_period_ms: float = 10.0
     given: bool = False
+    max_torque_permille: tuple[float, float] | None = None
 
     @classmethod
     def from_toml(cls, raw: Mapping[str, object]) -> DriveTable:
@@ -600,6 +604,9 @@ class DriveTable(Table):
         if any(c != int(c) for c in t.encoder_counts):
             raise ConfigError(f"config key [drive].encoder_counts {list(t.encoder_counts)} "
                               "must be whole numbers")
+        if t.max_torque_permille is not None and t.rated_torque_Nm is None:
+            raise ConfigError("config key [drive].max_torque_permille needs "
+                              "[drive].rated_torque_Nm (the torque it is a per-mille of)")
         return t
 
 
