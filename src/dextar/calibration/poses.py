@@ -213,8 +213,12 @@ def candidates(nominal: KinematicModel, modes: Sequence[str], assembly: int, *,
 def _gains(Jc: Array, Minv: Array) -> Array:
     """``det(I + J_i M^-1 J_i^T)`` of each candidate (c,): the factor by which adding it
     multiplies ``det M``."""
-    G = np.einsum("cik,kl,cjl->cij", Jc, Minv, Jc, optimize=True)
-    return np.asarray((1.0 + G[:, 0, 0]) * (1.0 + G[:, 1, 1]) - G[:, 0, 1] * G[:, 1, 0])
+    A = (Jc.reshape(-1, Jc.shape[-1]) @ Minv).reshape(Jc.shape)  # one BLAS product
+    g00 = np.einsum("ck,ck->c", A[:, 0], Jc[:, 0])
+    g11 = np.einsum("ck,ck->c", A[:, 1], Jc[:, 1])
+    g01 = np.einsum("ck,ck->c", A[:, 0], Jc[:, 1])
+    g10 = np.einsum("ck,ck->c", A[:, 1], Jc[:, 0])
+    return np.asarray((1.0 + g00) * (1.0 + g11) - g01 * g10)
 
 
 def _d_optimal(Jc: Array, modes: Array, P: Array, count: int, spacing: float,
@@ -451,7 +455,7 @@ def _information(J: Array, idx: Sequence[int], S: Array, point_std: float | None
     """The candidates' scaled Jacobians (c, 2, k) of the parameters ``idx`` (scales ``S``),
     whitened by each one's covariance ``sigma^2 I + s_r^2 J_q J_q^T`` (times ``sigma``)
     when both noises are given (step 2 of the module doc)."""
-    Js = J[:, :, idx] * S[idx]
+    Js = np.ascontiguousarray(J[:, :, idx] * S[idx])  # (fancy indexing leaves it strided)
     if point_std is None or reading_std is None:
         return Js
     Jq = J[:, :, 5:7]
