@@ -72,7 +72,8 @@ def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
                               working_mode=rt.working_mode, assembly_mode=rt.assembly_mode,
                               encoder_counts=rt.encoder_counts, extra=extra,
                               validation=held, figures=figures, outliers=outliers,
-                              outlier_message=problem, sigma_mm=inst.sigma_mm)
+                              outlier_message=problem, sigma_mm=inst.sigma_mm,
+                              region_mm=inst.region_mm)
     said = CalibrationRun(res, shown(args.out), write_calibration(od, files),
                           outliers=outliers, problem=problem, robust=args.robust,
                           sigma_mm=inst.sigma_mm, working_mode=rt.working_mode,
@@ -86,9 +87,10 @@ def _fit_or_diagnose(args: argparse.Namespace, data: PoseData, nominal: Kinemati
                      ) -> tuple[CalibrationResult, tuple[int, ...], str]:
     """The calibration the options ask for; when it finds outliers, the fit that keeps
     them (a diagnosis: their arrows in residuals.png) with their rows and the error's
-    words."""
+    words; when that fit fails its own checks (rows that wreck it), the outliers' error."""
     from ..calibration import OutlierError, calibrate
     from ..calibration.fit import OUTLIER_FACTOR
+    from ..errors import DextarError
 
     def fit(factor: float) -> CalibrationResult:
         return calibrate(data, nominal, frame=args.frame, robust=args.robust,
@@ -99,4 +101,7 @@ def _fit_or_diagnose(args: argparse.Namespace, data: PoseData, nominal: Kinemati
     try:
         return fit(factor), (), ""
     except OutlierError as exc:
-        return fit(1e300), exc.rows, str(exc)
+        try:
+            return fit(1e300), exc.rows, str(exc)
+        except DextarError:
+            raise OutlierError(f"{exc} (--robust soft_l1)", exc.rows) from None

@@ -1,5 +1,6 @@
 """``dextar export mjcf``: the MuJoCo model of the configured robot, with a keyframe at the
-motion's start."""
+motion's start, in SI (m, kg, s) whatever ``[output].units`` says; the paper's dimensionless
+units only with ``--units paper``."""
 
 from __future__ import annotations
 
@@ -13,11 +14,14 @@ REGISTRIES_HELP = True
 
 
 def add_arguments(sp: argparse.ArgumentParser) -> None:
-    """``format``, ``[config]``, ``--out``, ``--json``."""
+    """``format``, ``[config]``, ``--out``, ``--units``, ``--json``."""
     sp.add_argument("format", choices=["mjcf"])
     config_argument(sp)
     json_flag(sp)
     sp.add_argument("--out", required=True, help="XML file (- for stdout)")
+    sp.add_argument("--units", choices=["si", "paper"], default="si",
+                    help="unit system of the model: si (default, what MuJoCo users expect: m, "
+                    "kg, s, N m) or the paper's dimensionless units (not [output].units)")
 
 
 def run(args: argparse.Namespace) -> Result:
@@ -25,11 +29,12 @@ def run(args: argparse.Namespace) -> Result:
     from ..config import load_scenario
     from ..output.mjcf import to_mjcf
 
-    sc = load_scenario(args.config, model=args.model)
+    sc = load_scenario(args.config, model=args.model).in_units(args.units)
     path = out_file(args.out, ".xml")
     tr = sc.trajectory(samples=2)
     where, data = write_or_hand_back(path, to_mjcf(sc.model(tr.assembly),
-                                                   start=(tr.q[0], tr.dq[0])))
+                                                   start=(tr.q[0], tr.dq[0]),
+                                                   units=units_note(sc)))
     return Result({"out": where, "units": sc.units.describe()},
                   f"wrote {where} (MuJoCo model in {units_note(sc)}; keyframe 'start' at the "
                   "motion's start)", data=data)

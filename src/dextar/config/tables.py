@@ -126,7 +126,9 @@ class InstrumentTable(Table):
     """``[instrument]``: the measuring instrument (a laser tracker, a camera, a CMM) that
     sees the robot: the pose of the robot frame in the instrument's frame (a point ``P`` of
     the robot frame is measured at ``R(theta0) P + (x0, y0)``) and the instrument's noise.
-    It converts measured points only; every command works in the robot frame."""
+    It converts measured points only; every command works in the robot frame. ``region``
+    ``[xmin, xmax, ymin, ymax]`` (mm, robot frame) is where it can measure: ``dextar poses``
+    chooses every pose inside."""
 
     NAME: ClassVar[str] = "instrument"
     PARAMS: ClassVar[dict[str, Param]] = {
@@ -144,6 +146,29 @@ class InstrumentTable(Table):
     y0_mm: float = 0.0
     theta0_deg: float = 0.0
     sigma_mm: float | None = None
+    region_mm: tuple[float, float, float, float] | None = None
+
+    @classmethod
+    def from_toml(cls, raw: Mapping[str, object]) -> InstrumentTable:
+        """Read ``[instrument]``; ``region`` is four numbers ``[xmin, xmax, ymin, ymax]``
+        (mm, robot frame), each minimum below its maximum."""
+        unknown = [k for k in raw if k not in cls.PARAMS and k != "region"]
+        if unknown:
+            raise ConfigError(f"config key [instrument].{unknown[0]} is not known; known "
+                              f"keys: {', '.join([*cls.PARAMS, 'region'])}")
+        t = read_params(cls.NAME, raw, cls.PARAMS, ignore=("region",))
+        region = None
+        if "region" in raw:
+            from ..calibration.poses import checked_region
+
+            try:
+                region = checked_region(raw["region"], "config key [instrument].region")
+            except DextarError as exc:
+                raise ConfigError(str(exc)) from None
+            if max(abs(v) for v in region) > 1e6:
+                raise ConfigError(f"config key [instrument].region {list(region)} must be "
+                                  "within 1e6 mm")
+        return cls(**t, region_mm=region)
 
     @property
     def frame(self) -> tuple[float, float, float]:
@@ -555,8 +580,11 @@ class DriveTable(Table):
         "encoder_counts": _pair("", "counts per motor turn", 4096.0, positive=True),
         "rated_torque_Nm": _pair("", "motor-side rated torque, N m (0x6076)", None,
                                  positive=True),
-        "pvt_period_ms": Param("number", "", 10.0, "period of the PVT points, ms",
-                               positive=True, maximum=1000.0),
+        "pvt_period_ms": Param("number", "", 10.0, "period of the PVT points, ms (a whole "
+                               "number of servo ticks)", positive=True, maximum=1000.0),
+        "max_torque_permille": _pair("", "largest torque the drive gives, per-mille of the "
+                                     "rated torque (0x6072); a torque feedforward beyond it "
+                                     "does not fit (exit 1)", None, positive=True),
     }
 
     gear_ratio: tuple[float, float] = (1.0, 1.0)
@@ -564,6 +592,7 @@ class DriveTable(Table):
     rated_torque_Nm: tuple[float, float] | None = None
     pvt_period_ms: float = 10.0
     given: bool = False
+    max_torque_permille: tuple[float, float] | None = None
 
     @classmethod
     def from_toml(cls, raw: Mapping[str, object]) -> DriveTable:
@@ -576,6 +605,9 @@ class DriveTable(Table):
         if any(c != int(c) for c in t.encoder_counts):
             raise ConfigError(f"config key [drive].encoder_counts {list(t.encoder_counts)} "
                               "must be whole numbers")
+        if t.max_torque_permille is not None and t.rated_torque_Nm is None:
+            raise ConfigError("config key [drive].max_torque_permille needs "
+                              "[drive].rated_torque_Nm (the torque it is a per-mille of)")
         return t
 
 

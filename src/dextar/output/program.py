@@ -126,7 +126,7 @@ def setpoint_columns(res: ProgramResult,
     """``setpoints.csv``: time, move, end-effector (mm), joint motion in encoder readings
     (the geometric angles minus ``encoder_offset_deg``) and torques (SI)."""
     off = np.radians(encoder_offset_deg)
-    return {"t_s": res.t, "move": res.move_index.astype(float), "x_mm": res.P[:, 0] * 1e3,
+    return {"t_s": res.t, "move": res.move_index, "x_mm": res.P[:, 0] * 1e3,
             "y_mm": res.P[:, 1] * 1e3, "phi_rad": res.q[:, 0] - off[0],
             "psi_rad": res.q[:, 1] - off[1],
             "dphi_rad_s": res.dq[:, 0], "dpsi_rad_s": res.dq[:, 1],
@@ -143,8 +143,8 @@ def write_program(out: str, res: ProgramResult, summary: ProgramSummary, robot_m
     from ..program.drive import csp_columns, pvt_points
 
     with OutputDir(out, force=force, produces=PROGRAM_FILES) as od:
-        od.write_text("setpoints.csv", csv_text(setpoint_columns(res,
-                                                                 summary.encoder_offset_deg)))
+        od.write_text("setpoints.csv", _counts_csv(setpoint_columns(
+            res, summary.encoder_offset_deg)))
         if drive is not None:
             od.write_text("csp.csv", _counts_csv(csp_columns(res, drive)))
             od.write_text("pvt.csv", _counts_csv((pvt or pvt_points(res, drive)).columns()))
@@ -160,15 +160,20 @@ def write_program(out: str, res: ProgramResult, summary: ProgramSummary, robot_m
 
 
 def _counts_csv(columns: dict[str, Array]) -> str:
-    """CSV of the drive files: positions in counts and torques in per-mille as whole numbers,
-    the other columns as :func:`csv_text` writes them."""
-    text = csv_text(columns).splitlines()
+    """CSV of the setpoints and the drive files: the move index, positions in counts and
+    torques in per-mille as whole numbers, the other columns as :func:`csv_text` writes
+    them (the shortest text that reads back to the same double); a value that is not finite
+    is a :class:`~dextar.errors.NumericalError` naming its column and row."""
     names = list(columns)
-    whole = [n.startswith(("pos", "torque")) for n in names]
-    rows = [",".join(str(int(float(v))) if w else v for v, w in zip(r.split(","), whole,
-                                                                       strict=True))
-            for r in text[1:]]
-    return "\n".join([text[0], *rows]) + "\n"
+    texts = []
+    for n in names:
+        v = np.asarray(columns[n], dtype=float) + 0.0  # + 0.0: no negative zeros
+        if not np.isfinite(v).all():
+            csv_text({n: v})  # raises, naming the column and row
+        whole = n == "move" or n.startswith(("pos", "torque"))
+        texts.append([str(int(x)) for x in v.tolist()] if whole else
+                     list(map(repr, v.tolist())))
+    return ",".join(names) + "\n" + "".join(",".join(r) + "\n" for r in zip(*texts, strict=True))
 
 
 def _figures(res: ProgramResult, summary: ProgramSummary, robot_mm: FiveBar, mode: str
