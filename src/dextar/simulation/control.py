@@ -23,7 +23,6 @@ from ..geometry import FiveBar
 from ..kinematics import direct_kinematics
 from ..trajectory import Trajectory
 
-
 #: The default tracking tolerance, a fraction of the robot's reach ``max(l1 + L1, l2 + L2)``:
 #: 3 % (4.8 mm on the DexTAR, 9 mm on a 120/180 mm robot). Measured with the default
 #: controller (10 Hz, masses 20 % off, an unknown payload) and the examples' own: the
