@@ -8,7 +8,7 @@ import argparse
 import time
 from typing import Any
 
-from .base import Result, config_argument, into_directory, shown
+from .base import Result, config_argument, into_directory, shown, with_notes
 
 NAME = "run"
 HELP = ("reproduce the paper end to end and write a report (exit 1 when a physics check "
@@ -23,6 +23,11 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> Result:
+    """The command, with the config's notes (:func:`.base.with_notes`)."""
+    return with_notes(NAME, args, _run)
+
+
+def _run(args: argparse.Namespace) -> Result:
     """Compute through the stages, write every file, word the law and the claims."""
     import sys
 

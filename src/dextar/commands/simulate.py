@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 
-from .base import Result, config_argument, into_directory, shown
+from .base import Result, config_argument, into_directory, shown, with_notes
 
 NAME = "simulate"
 HELP = ("computed-torque tracking against a perturbed plant (exit 1 when the robot leaves "
@@ -20,6 +20,11 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> Result:
+    """The command, with the config's notes (:func:`.base.with_notes`)."""
+    return with_notes(NAME, args, _run)
+
+
+def _run(args: argparse.Namespace) -> Result:
     """Simulate, write the files, word the errors and the saturation."""
     from ..config import load_scenario
     from ..dynamics import Model
