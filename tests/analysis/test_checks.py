@@ -181,3 +181,16 @@ def test_run_says_exit_1_with_every_file_when_a_check_fails(tmp_path, monkeypatc
     html = (out / "report.html").read_text()
     assert "drift per window" in html
     assert ("FAILED" in html) is fails
+
+
+def test_a_trapezoid_of_a_duration_without_vmax_writes_its_summary(tmp_path):
+    """Found by the dry-friction fuzz shape: vmax, none given, was inf in summary.json (an
+    internal error writing it); now null, and the run passes its checks."""
+    cfg = tmp_path / "c.toml"
+    cfg.write_text('[path]\ntype = "line"\nstart = [-60.0, 90.0]\nend = [60.0, 115.0]\n'
+                   '[law]\ntype = "trapezoid"\nduration = 0.5\n[friction]\ncoulomb = 0.002\n'
+                   '[output]\nfigures = []\nsamples = 101\n')
+    out = tmp_path / "out"
+    assert main(["run", str(cfg), "--out", str(out), "--quiet"]) == 0
+    s = json.loads((out / "summary.json").read_text())
+    assert s["law"]["vmax"] is None and s["law"]["amax"] > 0 and s["validation"]["passed"]
