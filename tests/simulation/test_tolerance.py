@@ -92,3 +92,19 @@ def test_a_tolerance_that_is_not_positive_is_refused(tmp_path, capsys):
     cfg.write_text(ROBOT + "tolerance_mm = -1\n")
     assert main(["simulate", str(cfg), "--out", str(tmp_path / "s")]) == 2
     assert "[control].tolerance_mm" in capsys.readouterr().err
+
+
+def test_a_trial_state_at_a_singularity_is_a_singularity_met(tmp_path, capsys):
+    """Found by the falling-simulation fuzz shape: the integrator tried a state exactly at a
+    parallel singularity and the controller's dynamics divided by zero (an internal error);
+    it is the singularity met, named with its time: exit 1, the files written."""
+    cfg = tmp_path / "c.toml"
+    cfg.write_text('[path]\ntype = "arc"\nradius = 40.0\ncenter = [0.0, 110.0]\n'
+                   '[law]\ntype = "min-jerk"\nduration = 3.0\n[inertia]\neffector_mass = 0.1\n'
+                   '[friction]\nviscous = 0.005\n[gravity]\nvector = [0.0, -9810.0]\n'
+                   '[control]\ntorque_limit = 0.1\nnatural_frequency_hz = 2.0\n'
+                   '[output]\nsamples = 201\n')
+    code = main(["simulate", str(cfg), "--out", str(tmp_path / "s"), "--quiet"])
+    err = capsys.readouterr().err
+    assert code == 1 and "internal error" not in err
+    assert "met a singularity at t = " in err and (tmp_path / "s" / "tracking.json").exists()

@@ -8,6 +8,7 @@ integrates its own (true) dynamics, e.g. with masses off by 20 % and an unmodell
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -19,7 +20,13 @@ from scipy.interpolate import CubicHermiteSpline
 from .._arrays import Array
 from ..dynamics.exact import Model, state_dynamics
 from ..dynamics.forward import SimResult
-from ..errors import ConvergenceError, ParameterError, SingularityError
+from ..errors import (
+    AssemblyError,
+    ConvergenceError,
+    DextarError,
+    ParameterError,
+    SingularityError,
+)
 from ..geometry import FiveBar
 from ..kinematics import direct_kinematics
 from ..trajectory import Trajectory
@@ -152,17 +159,24 @@ def simulate_computed_torque(trajectory: Trajectory, controller: Model, plant: M
 
     def rhs(t: float, y: Array) -> Array:
         q, dq = y[:2], y[2:]
-        tau, _ = control(t, q, dq)
-        try:
+        try:  # the plant first: a state it cannot take is a singularity met
             M, h = state_dynamics(plant, q, dq)
-        except SingularityError as exc:
-            raise SingularityError(f"the controlled robot met a singularity at t = {t:.6g}: "
-                                   f"{exc}") from None
-        return np.concatenate([dq, np.linalg.solve(M, tau - h)])
+            tau, _ = control(t, q, dq)
+            acc = np.linalg.solve(M, tau - h)
+        except (SingularityError, AssemblyError, ArithmeticError,
+                np.linalg.LinAlgError) as exc:
+            # (an integrator's trial state exactly at a parallel singularity divides by zero
+            # before the tolerance is checked)
+            why = str(exc) if isinstance(exc, DextarError) else (
+                f"parallel (type 2) singularity: q = ({math.degrees(q[0]):.6g}, "
+                f"{math.degrees(q[1]):.6g}) deg")
+            raise SingularityError(f"the controlled robot met a singularity at t = "
+                                   f"{t * time_s:.6g} s: {why}") from None
+        return np.concatenate([dq, acc])
 
     y0 = np.concatenate([tr.q[0] + np.asarray(initial_error, float), tr.dq[0]])
     dt = float(np.min(np.diff(tr.t)))
-    t_end, sol, stop = _integrate(rhs, tr.t, y0, rtol=rtol, max_step=4 * dt)
+    t_end, sol, stop = _integrate(rhs, tr.t, y0, rtol=rtol, max_step=4 * dt, time_s=time_s)
     n = int(np.searchsorted(tr.t, t_end, side="right"))
     t = tr.t[:n]
     y = sol(t)
@@ -194,7 +208,8 @@ def simulate_computed_torque(trajectory: Trajectory, controller: Model, plant: M
 
 
 def _integrate(rhs: Callable[[float, Array], Array], t: Array, y0: Array, *, rtol: float,
-               max_step: float) -> tuple[float, Callable[[Array], Array], str | None]:
+               max_step: float, time_s: float = 1.0
+               ) -> tuple[float, Callable[[Array], Array], str | None]:
     """Step the plant from ``t[0]`` towards ``t[-1]``; a singularity met on the way ends the
     integration there (a result, not a failure). Returns the last time reached, the dense
     solution up to it and why it stopped early (None: it did not)."""
@@ -205,7 +220,7 @@ def _integrate(rhs: Callable[[float, Array], Array], t: Array, y0: Array, *, rto
     while solver.status == "running":
         if len(times) > MAX_STEPS:
             stop = (f"the integration was stopped after {MAX_STEPS} steps at t = "
-                    f"{solver.t:.6g} (run time unit)")
+                    f"{solver.t * time_s:.6g} s")
             break
         try:
             solver.step()
@@ -213,7 +228,7 @@ def _integrate(rhs: Callable[[float, Array], Array], t: Array, y0: Array, *, rto
             stop = str(exc)
             break
         if solver.status == "failed":
-            raise ConvergenceError(f"control simulation failed at t = {solver.t:.6g}: "
+            raise ConvergenceError(f"control simulation failed at t = {solver.t * time_s:.6g} s: "
                                    "the integrator's step became too small")
         times.append(solver.t)
         pieces.append(solver.dense_output())
