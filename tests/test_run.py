@@ -75,7 +75,9 @@ def test_every_file_well_formed(run_dir):
     assert s["units"]["system"] == "paper" and s["units"]["length_unit_in_mm"] == 87.0
     assert s["cost"]["total"] == pytest.approx(s["cost"]["kinetic"] + s["cost"]["inertial"])
     assert s["validation"]["power_balance_relative"] < 1e-8
-    assert s["validation"]["forward_resimulation"]["final_error_relative_to_range"] < 1e-6
+    fw = s["validation"]["forward_resimulation"]
+    assert s["validation"]["passed"] and fw["passed"] and fw["windows"] == len(fw["drift_rad"])
+    assert fw["max_drift_ratio"] < 1e-8 and fw["max_drift_rad"] < 1e-9
     assert {"max", "rms", "max_relative", "rms_relative"} <= set(s["paper_model"]["error_vs_exact"])
     p = _Html()
     p.feed((run_dir / "report.html").read_text())

@@ -201,3 +201,15 @@ def run_identify_case(text: str, options: list[str], config: str | None) -> tupl
             argv += ["--config", config]
         # a poor fit is a result: exit 1 with its files written
         return run_case(argv, work, out / "summary.json", allow_exceeds=True)
+
+
+def run_run_case(doc: dict[str, Any]) -> tuple[str, str]:
+    """Write ``doc`` as a config and run ``dextar run`` on it (exit 1, a physics check that
+    failed with its files written, is an outcome of its own: ``exceeds``)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        work = Path(tmp)
+        cfg = work / "case.toml"
+        cfg.write_text(toml_text(doc))
+        out = work / "out"
+        return run_case(["run", str(cfg), "--out", str(out), "--quiet"], work,
+                        out / "summary.json", allow_exceeds=True)

@@ -19,9 +19,19 @@ from .harness import (
     run_config_case,
     run_identify_case,
     run_program_case,
+    run_run_case,
     toml_text,
 )
-from .strategies import COMMANDS, configs, kinematics_argv, motion_files, programs
+from .strategies import (
+    COMMANDS,
+    configs,
+    dry_friction_runs,
+    falling_simulations,
+    kinematics_argv,
+    metre_configs,
+    motion_files,
+    programs,
+)
 
 SETTINGS = settings(max_examples=100, deadline=None, derandomize=True,
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
@@ -107,3 +117,30 @@ def test_a_parameter_held_at_its_bound_gives_a_summary_not_an_error():
                 assert p["rel_std"] is None and p["poorly_determined"], p
             else:
                 assert isinstance(p["rel_std"], float), p
+
+
+SHAPES = settings(max_examples=8, deadline=None, derandomize=True,
+                  suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+
+
+@SHAPES
+@given(doc=metre_configs(), command=st.sampled_from(["plan", "simulate"]))
+def test_metre_sized_lengths_never_crash(doc, command):
+    outcome, detail = run_config_case(doc, command)
+    assert outcome not in DEFECTS, f"{outcome}: {detail}\nconfig:\n{toml_text(doc)}"
+
+
+@SHAPES
+@given(doc=falling_simulations())
+def test_falling_simulations_never_crash(doc):
+    """A robot that falls is a result: exit 1 with its files, within the time bound."""
+    outcome, detail = run_config_case(doc, "simulate")
+    assert outcome not in DEFECTS, f"{outcome}: {detail}\nconfig:\n{toml_text(doc)}"
+
+
+@settings(max_examples=3, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@given(doc=dry_friction_runs())
+def test_long_runs_with_dry_friction_never_crash(doc):
+    outcome, detail = run_run_case(doc)
+    assert outcome not in DEFECTS, f"{outcome}: {detail}\nconfig:\n{toml_text(doc)}"

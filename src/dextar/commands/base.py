@@ -10,11 +10,12 @@ so that the command line starts at once.
 from __future__ import annotations
 
 import argparse
-from dataclasses import dataclass, field
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ..errors import ConfigError
+from ..errors import ConfigError, DextarError
 
 if TYPE_CHECKING:
     from ..config import Scenario
@@ -147,3 +148,30 @@ def law_warnings(command: str, law: Law) -> list[str]:
     if law.success:
         return []
     return [f"dextar {command}: warning: {law.name} law status {law.status}: {law.message}"]
+
+
+
+def config_notes(command: str, notes: tuple[str, ...]) -> list[str]:
+    """A scenario's notes (:attr:`dextar.config.Scenario.notes`) as stderr lines."""
+    return [f"dextar {command}: note: {n}" for n in notes]
+
+
+def with_notes(command: str, args: argparse.Namespace,
+               body: Callable[[argparse.Namespace], Result]) -> Result:
+    """``body(args)`` with the notes of the config ``args.config`` (a robot in metres, an
+    empty file: :attr:`dextar.config.Scenario.notes`) first among its warnings and beside
+    its error, where they are the likely cause (a point out of reach)."""
+    from ..config import load_scenario
+
+    try:
+        notes = load_scenario(args.config, model=getattr(args, "model", None)).notes
+    except DextarError:
+        notes = ()  # the body says what is wrong with the config
+    try:
+        res = body(args)
+    except DextarError as exc:
+        if not notes:
+            raise
+        raise type(exc)(f"{exc} (note: {'; '.join(notes)})") from None
+    lines = config_notes(command, notes)
+    return res if not lines else replace(res, warnings=[*lines, *res.warnings])

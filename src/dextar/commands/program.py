@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 
-from .base import Result, config_argument, into_directory
+from .base import Result, config_argument, into_directory, with_notes
 
 NAME = "program"
 HELP = ("plan a robot program under the motors: setpoints and sizing (exit 1 when a motor "
@@ -23,6 +23,11 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> Result:
+    """The command, with the config's notes (:func:`.base.with_notes`)."""
+    return with_notes(NAME, args, _run)
+
+
+def _run(args: argparse.Namespace) -> Result:
     """Plan, size, write, word (the figures unless ``--no-figures``)."""
     from dataclasses import replace
 

@@ -8,10 +8,11 @@ import argparse
 import time
 from typing import Any
 
-from .base import Result, config_argument, into_directory, shown
+from .base import Result, config_argument, into_directory, shown, with_notes
 
 NAME = "run"
-HELP = "reproduce the paper end to end and write a report"
+HELP = ("reproduce the paper end to end and write a report (exit 1 when a physics check "
+        "fails, the files written)")
 REGISTRIES_HELP = True
 
 
@@ -22,6 +23,11 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> Result:
+    """The command, with the config's notes (:func:`.base.with_notes`)."""
+    return with_notes(NAME, args, _run)
+
+
+def _run(args: argparse.Namespace) -> Result:
     """Compute through the stages, write every file, word the law and the claims."""
     import sys
 
@@ -54,6 +60,8 @@ def run(args: argparse.Namespace) -> Result:
     warnings = ([] if law["success"] else
                 [f"dextar run: warning: {law['type']} law status {law['status']}: "
                  f"{law['message']}"])
+    checks = s["validation"]
+    warnings += [f"dextar run: check failed: {why}" for why in checks["failed"]]
     lines = [f"wrote {len(s['files'])} files to {shown(args.out)} (open "
              f"{shown(args.out, 'report.html')})",
              f"{law['type']} law: motion time {law['duration_s']:.6g} s; status "
@@ -64,4 +72,16 @@ def run(args: argparse.Namespace) -> Result:
                  f"{s['units']['torque_unit']}")
     lines += [f"  {c['verdict']:>11}: {c['claim']} ({c['value']:.3g})"
               for c in s.get("claims", [])]
-    return Result(s, "\n".join(lines), warnings)
+    fw = checks["forward_resimulation"]
+    lines.append(
+        f"checks {'passed' if checks['passed'] else 'FAILED'}: power balance "
+        f"{_figure(checks['power_balance_relative'])} (at most {checks['power_balance_threshold']:g}); "
+        f"forward re-simulation in {fw.get('windows', 0)} windows, largest drift "
+        f"{_figure(fw.get('max_drift_rad'))} rad, {_figure(fw.get('max_drift_ratio'))} of the "
+        f"peak acceleration's (at most {fw['threshold']:g})")
+    return Result(s, "\n".join(lines), warnings, code=0 if checks["passed"] else 1)
+
+
+def _figure(v: float | None) -> str:
+    """A check's figure, or "-" where it could not be computed."""
+    return "-" if v is None else f"{v:.3g}"

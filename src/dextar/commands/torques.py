@@ -14,6 +14,7 @@ from .base import (
     law_warnings,
     out_file,
     units_note,
+    with_notes,
     write_or_hand_back,
 )
 
@@ -28,6 +29,11 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> Result:
+    """The command, with the config's notes (:func:`.base.with_notes`)."""
+    return with_notes(NAME, args, _run)
+
+
+def _run(args: argparse.Namespace) -> Result:
     """Analyse, write the columns, word the peaks and the paper model's error."""
     import numpy as np
 

@@ -57,6 +57,13 @@ if TYPE_CHECKING:
 
 T = TypeVar("T", bound=Table)
 
+#: Where a scenario of no file comes from.
+DEFAULT_SOURCE = "defaults (the paper's example)"
+
+#: A robot whose longest length is below this (mm) looks written in metres: the DexTAR in
+#: metres is 0.087 at most, the smallest five-bars built are tens of millimetres.
+METRES_LIKE_MM = 1.0
+
 
 @dataclass(frozen=True)
 class Scenario:
@@ -77,7 +84,7 @@ class Scenario:
     """
 
     tables: Mapping[str, Table]
-    source: str = "defaults (the paper's example)"
+    source: str = "defaults (the paper's example)"  # DEFAULT_SOURCE
     moves: tuple[Move, ...] = ()
     doc: Mapping[str, Any] = field(default_factory=dict)
     text: bytes = b""
@@ -86,6 +93,24 @@ class Scenario:
         """The parsed table ``[name]`` (a registered table; the typed properties below name
         the built-in ones)."""
         return self.tables[name]
+
+    @property
+    def notes(self) -> tuple[str, ...]:
+        """What the user may not have meant, in words (each command says them on stderr and
+        beside its error): a config file with no table runs the paper's example; a robot
+        whose lengths are all below :data:`METRES_LIKE_MM` looks written in metres."""
+        out = []
+        if not self.doc and self.source != DEFAULT_SOURCE:
+            out.append(f"{self.source} has no table: this runs the paper's example (the "
+                       "DexTAR, the 120 mm semicircle, the optimal law)")
+        g = self.robot_table.geometry_mm
+        longest = max(g.l1, g.l2, g.L1, g.L2, g.d)
+        if longest < METRES_LIKE_MM:
+            shown = ", ".join(f"{k} = {getattr(g, k):g}" for k in ("l1", "l2", "L1", "L2", "d"))
+            out.append(f"the robot's lengths ({shown}) are read in mm: its longest, "
+                       f"{longest:g} mm, looks like metres ({longest:g} m = "
+                       f"{longest * 1e3:g} mm); config lengths are in mm")
+        return tuple(out)
 
     def _get(self, cls: type[T]) -> T:
         t = self.tables[cls.NAME]

@@ -382,6 +382,9 @@ class ControlTable(Table):
                               positive=True, maximum=1e6),
         "initial_error_deg": Param("point", "", (0.0, 0.0), "initial joint error [deg, deg], "
                                    "each within +-90"),
+        "tolerance_mm": Param("number", "mm", None, "the task error within which the motion "
+                              "is followed (default 3 % of the robot's reach); past it "
+                              "simulate exits 1", positive=True, maximum=1e9),
     }
 
     natural_frequency_hz: float = 10.0
@@ -390,6 +393,7 @@ class ControlTable(Table):
     payload: float | None = None
     torque_limit: float | None = None
     initial_error_deg: tuple[float, float] = (0.0, 0.0)
+    tolerance_mm: float | None = None
 
     @classmethod
     def from_toml(cls, raw: Mapping[str, object]) -> ControlTable:
@@ -412,6 +416,9 @@ class ControlTable(Table):
                 self.torque_limit),
             "torque_limit_nm": self.torque_limit,
             "initial_error": tuple(math.radians(v) for v in self.initial_error_deg),
+            "tolerance": None if self.tolerance_mm is None else units.length(
+                self.tolerance_mm),
+            "tolerance_mm": self.tolerance_mm,
         }
 
 

@@ -38,6 +38,11 @@ def _leg_solve(
 def _reach_error(
     P: Array, shape: tuple[int, ...], i: int, rho2: float, l: float, L: float, leg: int
 ) -> ReachError:
+    if not np.isfinite(P[i]).all():
+        from .checker import not_a_number
+
+        return ReachError(f"point ({P[i, 0]:.6g}, {P[i, 1]:.6g})"
+                          f"{where(flat_index(i, shape), shape)} {not_a_number(P[i])}")
     rho = float(np.sqrt(rho2))
     rin, rout = abs(l - L), l + L
     out = max(rin - rho, rho - rout, 0.0)

@@ -196,8 +196,10 @@ class TrapezoidalLaw(Law):
         return cls(S, v * (1.0 + 1e-12), v / (rho * T), T)
 
     def report(self, units: Units) -> dict[str, Any]:
-        """The limits and the cruise speed (run units)."""
-        return {"vmax": self.vmax, "amax": self.amax, "cruise_speed": self.cruise}
+        """The limits and the cruise speed (run units; ``vmax`` None when none was given:
+        a trapezoid of a duration without one)."""
+        return {"vmax": self.vmax if math.isfinite(self.vmax) else None, "amax": self.amax,
+                "cruise_speed": self.cruise}
 
     def breakpoints(self) -> Array:
         """The ends of the acceleration and deceleration phases."""

@@ -513,8 +513,20 @@ class _Solution(NamedTuple):
     integrals: tuple[float, float] | None = None
 
 
+def _said(T: float, eta: float, m: float, S: float, units: Units | None) -> dict[str, str]:
+    """The law's figures in words, in the user's units (s, s^2/kg, kg, mm) when the run's
+    are known, else as they are."""
+    if units is None:
+        return {"eta": f"eta = {eta:g}", "duration": f"duration {T:g}", "mass": f"mass {m:g}",
+                "length": f"{S:.6g}"}
+    return {"eta": f"eta = {eta * units.time_s**2 / units.mass_kg:g} s^2/kg",
+            "duration": f"duration {T * units.time_s:g} s",
+            "mass": f"mass {m * units.mass_kg:g} kg", "length": f"{S * units.length_mm:.6g} mm"}
+
+
 def solve_optimal_law(path: Path, *, duration: float = 1.0, eta: float = 0.1, mass: float = 1.0,
-                      tol: float = 1e-10, max_nodes: int = 1024) -> OptimalLaw:
+                      tol: float = 1e-10, max_nodes: int = 1024,
+                      units: Units | None = None) -> OptimalLaw:
     """Solve the paper's optimal law of motion along ``path``.
 
     Parameters
@@ -531,6 +543,8 @@ def solve_optimal_law(path: Path, *, duration: float = 1.0, eta: float = 0.1, ma
         Target for the ODE residual between the nodes, relative to ``1 + max |s''''|``.
     max_nodes : int
         Largest number of Chebyshev nodes tried (per element).
+    units : Units, optional
+        The run's units, so that an error speaks the user's (s, kg, s^2/kg, mm).
 
     Returns
     -------
@@ -547,10 +561,12 @@ def solve_optimal_law(path: Path, *, duration: float = 1.0, eta: float = 0.1, ma
     m = _positive("mass", mass)
     S = path.length
     G = T / math.sqrt(eta * m)
-    if G > 1e4:
-        raise ParameterError(f"eta = {eta:g} is too small for duration {T:g} and mass {m:g}: "
-                             f"boundary layers of relative width {1 / G:.1e} (need "
-                             f"T / sqrt(eta m) <= 1e4)")
+    said = _said(T, eta, m, S, units)
+    if not G <= 1e4:
+        raise ParameterError(f"{said['eta']} is too small for {said['duration']} and "
+                             f"{said['mass']}: boundary layers of relative width {1 / G:.1e} "
+                             f"(need duration / sqrt(eta mass) <= 1e4, here {G:.3g}): a larger "
+                             "eta or a shorter duration")
     if path.constant_curvature is not None:
         sol = _solve_spectral(path.constant_curvature * S, G, tol, max_nodes)
     else:
@@ -559,8 +575,9 @@ def solve_optimal_law(path: Path, *, duration: float = 1.0, eta: float = 0.1, ma
             sol = _solve_local(path, S, G, max(tol, 1e-8))
     if sol.sigma is None:
         raise ConvergenceError(
-            f"optimal law did not converge for eta = {eta:g}, mass = {m:g}, duration {T:g} on "
-            f"a path of length {S:.6g} (G = T/sqrt(eta m) = {G:.4g}) with {sol.method}")
+            f"optimal law did not converge for {said['eta']}, {said['mass']}, "
+            f"{said['duration']} on a path of length {said['length']} (duration / sqrt(eta "
+            f"mass) = {G:.4g}) with {sol.method}")
     resid, nodes = sol.residual, sol.nodes
     law = OptimalLaw(distance=S, duration=T, eta=eta, mass=m, sigma=sol.sigma, residual=resid,
                      nodes=nodes, iterations=sol.iterations,
@@ -839,6 +856,7 @@ def _register() -> None:
          "eta": Param("number", "s^2/kg", 0.1, "weight of the mean-square inertia forces",
                       positive=True)},
         lambda r: solve_optimal_law(r.path, duration=r.params["duration"], eta=r.params["eta"],
+                                    units=r.units,
                                     mass=r.mass),
         "the paper's optimal law: minimise (m/2) Int |rdot|^2 + (eta m^2/2) Int |rddot|^2"))
 

@@ -1,0 +1,110 @@
+"""`dextar simulate`'s verdict from its tracking error (issue 28, item 4): followed within
+`[control].tolerance_mm` (default 3 % of the reach), else exit 1 with the files written and
+the time and the error named."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from dextar.cli import main
+from dextar.geometry import DEXTAR_MM
+from dextar.simulation import TRACKING_TOLERANCE, tracking_tolerance
+
+#: The issue's robot and task: 0.4 kg at the effector, gravity, friction; its motors hold
+#: 1.5 N m, at 0.3 N m it falls (before: max task error 272.6 mm, saturated 100 %, exit 0).
+ROBOT = """
+[robot]
+l1 = 120.0
+l2 = 120.0
+L1 = 180.0
+L2 = 180.0
+d = 100.0
+[path]
+type = "arc"
+radius = 40.0
+center = [0.0, 220.0]
+start_deg = 0.0
+end_deg = 180.0
+[law]
+type = "min-jerk"
+duration = 1.0
+[inertia]
+effector_mass = 0.1
+payload = 0.3
+[friction]
+viscous = 0.005
+coulomb = 0.02
+[gravity]
+vector = [0.0, -9810.0]
+[output]
+units = "si"
+samples = 201
+[control]
+"""
+
+
+def _simulate(tmp_path, control, capsys):
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(ROBOT + control)
+    out = tmp_path / "sim"
+    capsys.readouterr()
+    code = main(["simulate", str(cfg), "--out", str(out), "--json"])
+    o, e = capsys.readouterr()
+    return code, json.loads(o), e, out
+
+
+def test_a_falling_robot_is_not_followed_exit_1_with_its_files(tmp_path, capsys):
+    code, rep, err, out = _simulate(tmp_path, "torque_limit = 0.3\n", capsys)
+    assert code == 1 and rep["status"] == 2 and not rep["followed"]
+    assert rep["max_task_error_mm"] > 100 and rep["tolerance_mm"] == pytest.approx(9.0)
+    assert 0 < rep["left_tolerance_at_s"] < 0.5
+    assert "left the tolerance 9 mm at t = " in err and "task error" in err
+    for name in ("tracking.csv", "tracking.png", "tracking.json"):
+        assert (out / name).exists()
+    assert json.loads((out / "tracking.json").read_text())["followed"] is False
+
+
+def test_motors_strong_enough_follow_within_the_default(tmp_path, capsys):
+    code, rep, err, _ = _simulate(tmp_path, "torque_limit = 1.5\n", capsys)
+    # measured 0.62 mm against the default 9 mm
+    assert code == 0 and rep["followed"] and rep["status"] == 0
+    assert rep["max_task_error_mm"] < 0.2 * rep["tolerance_mm"] and err == ""
+
+
+@pytest.mark.parametrize("tol, code", [(0.1, 1), (5.0, 0)])
+def test_the_tolerance_is_the_users(tmp_path, capsys, tol, code):
+    """The same motion (0.62 mm off) is not followed within 0.1 mm and followed within 5."""
+    got, rep, err, _ = _simulate(tmp_path, f"torque_limit = 1.5\ntolerance_mm = {tol}\n",
+                                 capsys)
+    assert got == code and rep["followed"] is (code == 0) and rep["tolerance_mm"] == tol
+    if code:
+        assert f"left the tolerance {tol:g} mm" in err
+
+
+def test_the_default_tolerance_is_a_share_of_the_reach():
+    assert tracking_tolerance(DEXTAR_MM) == pytest.approx(TRACKING_TOLERANCE * 159.0)
+
+
+def test_a_tolerance_that_is_not_positive_is_refused(tmp_path, capsys):
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(ROBOT + "tolerance_mm = -1\n")
+    assert main(["simulate", str(cfg), "--out", str(tmp_path / "s")]) == 2
+    assert "[control].tolerance_mm" in capsys.readouterr().err
+
+
+def test_a_trial_state_at_a_singularity_is_a_singularity_met(tmp_path, capsys):
+    """Found by the falling-simulation fuzz shape: the integrator tried a state exactly at a
+    parallel singularity and the controller's dynamics divided by zero (an internal error);
+    it is the singularity met, named with its time: exit 1, the files written."""
+    cfg = tmp_path / "c.toml"
+    cfg.write_text('[path]\ntype = "arc"\nradius = 40.0\ncenter = [0.0, 110.0]\n'
+                   '[law]\ntype = "min-jerk"\nduration = 3.0\n[inertia]\neffector_mass = 0.1\n'
+                   '[friction]\nviscous = 0.005\n[gravity]\nvector = [0.0, -9810.0]\n'
+                   '[control]\ntorque_limit = 0.1\nnatural_frequency_hz = 2.0\n'
+                   '[output]\nsamples = 201\n')
+    code = main(["simulate", str(cfg), "--out", str(tmp_path / "s"), "--quiet"])
+    err = capsys.readouterr().err
+    assert code == 1 and "internal error" not in err
+    assert "met a singularity at t = " in err and (tmp_path / "s" / "tracking.json").exists()
