@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 from .base import Result, config_argument, json_flag, out_file, write_or_hand_back
 
 if TYPE_CHECKING:
+    from .._arrays import Array
     from ..config import Scenario
     from ..identification.coverage import JointRegion
 
@@ -78,9 +79,17 @@ def run(args: argparse.Namespace) -> Result:
 def task_region(path: str, sc: Scenario) -> JointRegion:
     """The joint region a task visits, with its speeds: its program planned, or its run
     sampled (SI), on the config's robot."""
+    from ..identification.coverage import JointRegion
+
+    q, dq, _ = task_motion(path, sc)
+    return JointRegion.from_samples(q, dq)
+
+
+def task_motion(path: str, sc: Scenario) -> tuple[Array, Array, Array]:
+    """The joint motion ``(q, dq, ddq)`` (SI) of a task: its program planned, or its run
+    sampled, on the config's robot."""
     from ..config import load_scenario
     from ..errors import ConfigError
-    from ..identification.coverage import JointRegion
 
     task = load_scenario(path)
     if task.robot_mm != sc.robot_mm:
@@ -88,6 +97,6 @@ def task_region(path: str, sc: Scenario) -> JointRegion:
                           f"mm) than the config's ({sc.robot_mm.as_dict()} mm)")
     if task.moves:
         res = task.program_request().plan()
-        return JointRegion.from_samples(res.q, res.dq)
+        return res.q, res.dq, res.ddq
     tr = task.in_units("si").trajectory()
-    return JointRegion.from_samples(tr.q, tr.dq)
+    return tr.q, tr.dq, tr.ddq

@@ -62,11 +62,13 @@ from ..dynamics.exact import Model
 from ..dynamics.inertia import Inertia, Rod
 from ..dynamics.regressor import INDEX, STANDARD, standard_parameters
 from ..errors import NumericalError, ParameterError
+from ..geometry import FiveBar
 from .base import BaseParameters, base_parameters
 from .coverage import Coverage, coverage
 from .data import MotionData
 from .filtering import Conditioned, Filters, condition, default_cutoff
 from .modes import check_modes
+from .verdict import check_time_base, envelope, prediction_uncertainty, torque_noise
 
 __all__ = ["COND_WARNING", "Conditioned", "Filters", "IdentificationResult", "POOR_FIT",
            "STATUS", "Validation", "check_modes", "check_working_mode", "condition",
@@ -84,8 +86,19 @@ POOR_FIT = 0.2
 TORQUE_SCALE = 10.0
 #: Relative standard deviation above which a base parameter is flagged.
 REL_STD_FLAG = 0.5
+#: Predicted-torque uncertainty (RMS std over RMS torque along the reference motion) above
+#: which the model is poorly determined for its use.
+UNCERTAINTY_LIMIT = 0.02
+#: Fit quality that good fits of noise-free data reach (encoder quantisation, the filters,
+#: the friction's regularisation): the part of the residual no torque noise explains.
+RESIDUAL_FLOOR = 0.0075
+#: Largest ratio of the fit quality to the one noise and filters explain.
+RESIDUAL_FACTOR = 2.0
+#: Distance (standard deviations, Mahalanobis) beyond which a least-squares estimate that is
+#: not physical contradicts physics rather than scatters about it.
+PHYSICAL_SIGMAS = 5.0
 #: The status codes of :class:`IdentificationResult` and their names (as summaries print them).
-STATUS = {0: "identified", 1: "poorly conditioned", 2: "not physically consistent",
+STATUS = {0: "identified", 1: "poorly determined", 2: "not physically consistent",
           3: "poor fit"}
 
 #: Former name of :func:`check_modes` (which also checks the assembly mode).
@@ -121,10 +134,13 @@ class IdentificationResult:
     consistent : bool
         True when ``inertia`` reproduces ``beta`` to 1e-9 relative.
     status : int
-        0 success, 1 poorly conditioned (``condition_number`` above 1e3), 2 the physical set
-        does not reproduce the base parameters exactly, 3 poor fit (``fit_quality`` above
-        :data:`POOR_FIT` on a motor, or the torques' scale unlike the prior's); the
-        estimates are computed whatever the status. :data:`STATUS` names them.
+        0 identified; 1 poorly determined (``uncertainty`` above :data:`UNCERTAINTY_LIMIT`
+        on a motor, or ``condition_number`` above :data:`COND_WARNING`); 2 not physically
+        consistent (no physical set of standard parameters has these base parameters, see
+        :func:`physical_set`); 3 poor fit (``fit_quality`` above :data:`POOR_FIT` or above
+        :data:`RESIDUAL_FACTOR` times ``explained_quality`` on a motor, or the torques'
+        scale unlike the prior's); the estimates are computed whatever the status.
+        :data:`STATUS` names them.
     message : str
     warnings : list of str
     conditioned : Conditioned, optional
@@ -142,6 +158,26 @@ class IdentificationResult:
     rows_used : ndarray of int, shape (2,)
         Rows of each motor in the fit (the others carry a friction sign the data cannot
         tell).
+    covariance : ndarray, shape (n_base, n_base)
+        Of ``beta`` (autocorrelation consistent).
+    uncertainty : ndarray, shape (2,)
+        Each motor's predicted-torque uncertainty along ``reference``: the RMS standard
+        deviation of the predicted torques over their RMS (:func:`~dextar.identification.
+        verdict.prediction_uncertainty`).
+    reference : str
+        The motion ``uncertainty`` is measured on: the task given, or the excitation's
+        envelope (:func:`~dextar.identification.verdict.envelope`).
+    torque_noise : ndarray, shape (2,)
+        Standard deviation of each motor's torque noise after the parallel filter (N m).
+    explained_quality : ndarray, shape (2,)
+        The fit quality noise and filters explain: ``sqrt((torque_noise / RMS torque)^2 +``
+        :data:`RESIDUAL_FLOOR` ``^2)``.
+    reasons : tuple of str
+        Every reason the status is not 0, the worst last.
+    unphysical_distance : float
+        How far the least-squares estimate lies from the physical set fitted instead, in
+        standard deviations (the Mahalanobis distance under ``covariance``); 0 when the
+        least-squares estimate is physical.
     """
 
     base: BaseParameters
@@ -167,6 +203,13 @@ class IdentificationResult:
     torque_scale: Array = field(default_factory=lambda: np.ones(2))
     parallel_hz: float = math.nan
     rows_used: Array = field(default_factory=lambda: np.zeros(2, int))
+    covariance: Array = field(default_factory=lambda: np.zeros((0, 0)))
+    uncertainty: Array = field(default_factory=lambda: np.zeros(2))
+    reference: str = "the excitation's envelope"
+    torque_noise: Array = field(default_factory=lambda: np.zeros(2))
+    explained_quality: Array = field(default_factory=lambda: np.zeros(2))
+    reasons: tuple[str, ...] = ()
+    unphysical_distance: float = 0.0
 
     @property
     def success(self) -> bool:
@@ -213,8 +256,9 @@ def _rank_check(A: Array, base: BaseParameters, source: str) -> float:
 
 
 def identify(data: MotionData, model: Model, *, mode: str, cutoff_hz: float | None = None,
-             parallel_hz: float | None = None, base: BaseParameters | None = None
-             ) -> IdentificationResult:
+             parallel_hz: float | None = None, base: BaseParameters | None = None,
+             reference: tuple[Array, Array, Array] | None = None,
+             reference_name: str = "the task") -> IdentificationResult:
     """Identify the base parameters of ``model``'s robot from ``data``.
 
     Parameters
@@ -233,18 +277,24 @@ def identify(data: MotionData, model: Model, *, mode: str, cutoff_hz: float | No
         The parallel filter's cut-off (default: ``cutoff_hz / 2.5``).
     base : BaseParameters, optional
         Precomputed base parameters of ``model``.
+    reference : (q, dq, ddq), optional
+        The motion the model is for (each (n, 2), SI): the predicted-torque uncertainty is
+        measured along it (default: the excitation's envelope).
+    reference_name : str
+        How messages name ``reference``.
 
     Returns
     -------
     IdentificationResult
-        Status 3 ("poor fit") still carries every estimate.
+        Every status still carries every estimate.
 
     Raises
     ------
     ParameterError
-        Data outside the working or assembly mode, too few samples, or a rank-deficient
-        regressor.
+        Data outside the working or assembly mode, a time column not in seconds, too few
+        samples, or a rank-deficient regressor.
     """
+    check_time_base(data)
     check_modes(data, model, mode)
     base = base or base_parameters(model)
     c = condition(data, model, cutoff_hz=cutoff_hz, parallel_hz=parallel_hz)
@@ -258,37 +308,57 @@ def identify(data: MotionData, model: Model, *, mode: str, cutoff_hz: float | No
             f"({len(data.t)} read), fewer than {need} ({SAMPLES_PER_PARAMETER} per base "
             f"parameter, {base.size} of them): record longer, or move more")
     Yb = base.columns(c.Y)
-    beta, std, sigma, cond, Aw, bw = _weighted_fit(Yb, c.tau, keep, sizes, base, data.source)
+    beta, cov, sigma, cond, Aw, bw = _weighted_fit(Yb, c.tau, keep, sizes, base, data.source)
     prior = standard_parameters(model.inertia)
     method = "weighted least squares"
-    theta, ok = physical_set(beta, base, prior, model.inertia)
+    theta, ok = physical_set(beta, base, prior, model.inertia, model.robot)
+    consistent = True
+    distance = 0.0
     if not ok:
         method = "constrained"
-        theta = _constrained_fit(Aw, bw, base, prior, model.inertia)
+        theta = _constrained_fit(Aw, bw, base, prior, model.inertia, model.robot)
+        distance = _mahalanobis(beta - base.of(theta), cov)
         beta = base.of(theta)
-        std = _hac_std(Aw, Aw @ beta - bw, sizes)  # the spread about the constrained fit
-    inertia = realise(theta, model.inertia)
+        cov = _hac_cov(Aw, Aw @ beta - bw, sizes)  # the spread about the constrained fit
+        consistent = _physical(theta, model.inertia, model.robot)
+    std = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    inertia = realise(theta, model.inertia, model.robot)
     back = base.of(standard_parameters(inertia))
-    consistent = bool(np.all(np.abs(back - beta) <= 1e-9 * np.maximum(np.abs(beta), 1e-12)
-                             + 1e-12 * np.abs(beta).max()))
+    consistent = consistent and bool(np.all(
+        np.abs(back - beta) <= 1e-9 * np.maximum(np.abs(beta), 1e-12)
+        + 1e-12 * np.abs(beta).max()))
     pred = Yb @ beta
     rms, quality, scale = _fit_figures(pred, c.tau, c.Y @ prior, keep)
+    noise = torque_noise(data, c.parallel_hz)
+    rms_tau = np.where(quality > 0, rms / np.where(quality > 0, quality, 1.0), math.inf)
+    explained = np.sqrt((noise / np.where(rms_tau > 0, rms_tau, math.inf)) ** 2
+                        + RESIDUAL_FLOOR ** 2)
+    if reference is None:
+        ref, ref_name = envelope(c), "the excitation's envelope"
+    else:
+        ref, ref_name = reference, reference_name
+    u_std, u_rms = prediction_uncertainty(model, base, beta, cov, *ref)
+    uncertainty = np.where(u_rms > 0, u_std / np.where(u_rms > 0, u_rms, 1.0), math.inf)
     with np.errstate(divide="ignore"):
         rel = np.where(beta != 0, std / np.abs(beta), math.inf)
     flagged = tuple(n for n, r in zip(base.names, rel, strict=True) if r > REL_STD_FLAG)
-    status, message, warnings = _status(cond, consistent, method, flagged, quality, scale)
+    status, message, warnings, reasons = _status(
+        _Findings(cond, consistent, method, flagged, quality, scale, explained, uncertainty,
+                  ref_name, u_std, distance))
+    consistent = consistent and distance <= PHYSICAL_SIGMAS
     return IdentificationResult(base, beta, std, theta, inertia, method, cond, rms, sigma,
                                 len(data.t), len(c.t), c.cutoff_hz, consistent, status, message,
                                 warnings, c, quality, rel, flagged, scale, c.parallel_hz,
-                                np.array(sizes))
+                                np.array(sizes), cov, uncertainty, ref_name, noise, explained,
+                                reasons, distance)
 
 
 def _weighted_fit(Yb: Array, tau: Array, keep: Array, sizes: tuple[int, int],
                   base: BaseParameters, source: str
                   ) -> tuple[Array, Array, Array, float, Array, Array]:
     """Ordinary least squares, each motor's residual standard deviation, then the rows of
-    each motor weighted by its inverse: the estimates, their standard deviations, the
-    weights, the condition number and the weighted system ``(Aw, bw)``."""
+    each motor weighted by its inverse: the estimates, their covariance, the weights, the
+    condition number and the weighted system ``(Aw, bw)``."""
     A, b = _stack(Yb, tau, np.ones(2), keep)
     _rank_check(A, base, source)
     beta0, *_ = np.linalg.lstsq(A, b, rcond=None)
@@ -300,7 +370,7 @@ def _weighted_fit(Yb: Array, tau: Array, keep: Array, sizes: tuple[int, int],
     Aw, bw = _stack(Yb, tau, sigma, keep)
     cond = _rank_check(Aw, base, source)
     beta, *_ = np.linalg.lstsq(Aw, bw, rcond=None)
-    return beta, _hac_std(Aw, Aw @ beta - bw, sizes), sigma, cond, Aw, bw
+    return beta, _hac_cov(Aw, Aw @ beta - bw, sizes), sigma, cond, Aw, bw
 
 
 def _fit_figures(pred: Array, tau: Array, prior_pred: Array, keep: Array
@@ -317,33 +387,74 @@ def _fit_figures(pred: Array, tau: Array, prior_pred: Array, keep: Array
     return rms, quality, scale
 
 
-def _status(cond: float, consistent: bool, method: str, flagged: tuple[str, ...],
-            quality: Array, scale: Array) -> tuple[int, str, list[str]]:
-    """The result's status, message and warnings (the worst finding last)."""
-    warnings = []
-    status, message = 0, "identified"
-    if cond > COND_WARNING:
-        status = 1
-        message = (f"condition number {cond:.3g} above {COND_WARNING:g}: the data excite "
-                   "poorly, the estimates are uncertain (dextar excite designs a better motion)")
-        warnings.append(message)
-    if not consistent:
-        status = 2
-        message = "the physical parameter set does not reproduce the base parameters exactly"
-        warnings.append(message)
-    if method == "constrained":
+@dataclass(frozen=True)
+class _Findings:
+    """The figures a verdict is made of (see :func:`_status`)."""
+
+    cond: float
+    consistent: bool
+    method: str
+    flagged: tuple[str, ...]
+    quality: Array
+    scale: Array
+    explained: Array
+    uncertainty: Array
+    reference: str
+    uncertainty_nm: Array
+    distance: float
+
+
+def _status(f: _Findings) -> tuple[int, str, list[str], tuple[str, ...]]:
+    """The result's status, message (every reason, the worst first), warnings and reasons."""
+    warnings: list[str] = []
+    reasons: list[tuple[int, str]] = []
+    if f.cond > COND_WARNING:
+        reasons.append((1, f"condition number {f.cond:.3g} above {COND_WARNING:g}: the data "
+                           "excite poorly (dextar excite designs a better motion)"))
+    if (f.uncertainty > UNCERTAINTY_LIMIT).any():
+        worst = ""
+        if f.flagged:
+            worst = (f"; the data hardly determine {', '.join(f.flagged)} (relative std "
+                     f"above {100 * REL_STD_FLAG:g} %)")
+        reasons.append((1, f"poorly determined: the parameters' uncertainty makes the torques "
+                           f"predicted along {f.reference} uncertain by "
+                           f"{100 * f.uncertainty[0]:.3g} % / {100 * f.uncertainty[1]:.3g} % "
+                           f"of their RMS ({f.uncertainty_nm[0]:.3g} / "
+                           f"{f.uncertainty_nm[1]:.3g} N m, motor A / D; limit "
+                           f"{100 * UNCERTAINTY_LIMIT:g} %){worst}: record longer or excite "
+                           "more (dextar excite, --task for the motion the model is for)"))
+    if not f.consistent:
+        reasons.append((2, "not physically consistent: the physical parameter set does not "
+                           "reproduce the base parameters exactly"))
+    elif f.distance > PHYSICAL_SIGMAS:
+        reasons.append((2, f"not physically consistent: the least-squares estimate lies "
+                           f"{f.distance:.3g} standard deviations from the nearest physical "
+                           f"parameters (limit {PHYSICAL_SIGMAS:g}): no set of rods with "
+                           "masses not negative, centres of mass within their rods' length "
+                           "of their joints and inertias of at least m c^2, with friction not "
+                           "negative, explains the torques; the model written is the closest "
+                           "physical fit. Likely causes: a time column or torques in another "
+                           "unit, the config's geometry or gravity off, or data from another "
+                           "robot"))
+    if f.method == "constrained":
         warnings.append("the least-squares solution is not physical (a negative mass, "
-                        "inertia or friction): the fit was constrained to physical parameters")
-    if flagged:
-        warnings.append(f"base parameter{'s' if len(flagged) > 1 else ''} "
-                        f"{', '.join(flagged)} {'have' if len(flagged) > 1 else 'has'} a "
+                        "inertia or friction, or a centre of mass beyond its rod): the fit "
+                        "was constrained to physical parameters")
+    if f.flagged:
+        warnings.append(f"base parameter{'s' if len(f.flagged) > 1 else ''} "
+                        f"{', '.join(f.flagged)} {'have' if len(f.flagged) > 1 else 'has'} a "
                         f"relative standard deviation above {100 * REL_STD_FLAG:g} %: the data "
                         "hardly determine them")
-    poor = _verdict(quality, scale)
+    poor = _verdict(f.quality, f.scale, f.explained)
     if poor:
-        status, message = 3, poor
-        warnings.append(poor)
-    return status, message, warnings
+        reasons.append((3, poor))
+    if not reasons:
+        return 0, "identified", warnings, ()
+    reasons.sort(key=lambda r: r[0])
+    status = reasons[-1][0]
+    texts = tuple(r[1] for r in reasons)
+    warnings.extend(texts)
+    return status, "; ".join(reversed(texts)), warnings, texts
 
 
 @dataclass(frozen=True)
@@ -426,7 +537,7 @@ def _rms(x: Array) -> float:
     return float(np.sqrt((x ** 2).mean())) if len(x) else 0.0
 
 
-def _verdict(quality: Array, scale: Array) -> str:
+def _verdict(quality: Array, scale: Array, explained: Array) -> str:
     """The poor-fit message, or "" for a fit the model explains."""
     if (quality > POOR_FIT).any():
         return (f"poor fit: the model leaves {100 * quality[0]:.3g} % / {100 * quality[1]:.3g} % "
@@ -440,12 +551,30 @@ def _verdict(quality: Array, scale: Array) -> str:
                 f"the prior model's for motor A / D (beyond a factor {TORQUE_SCALE:g}). "
                 "Likely causes: torques in another unit (mN m, A, a motor-side torque before "
                 "the gear), or a config for another robot")
+    if (quality > RESIDUAL_FACTOR * explained).any():
+        return (f"poor fit: the model leaves {100 * quality[0]:.3g} % / {100 * quality[1]:.3g} % "
+                f"of the RMS torque of motor A / D unexplained where the torques' noise and "
+                f"the filters explain {100 * explained[0]:.3g} % / {100 * explained[1]:.3g} % "
+                f"(limit {RESIDUAL_FACTOR:g}x that). Likely causes: the config's geometry or "
+                "gravity direction a little off, torques and angles out of step, or effects "
+                "the model lacks (backlash, a cable, a spring, friction beyond Coulomb and "
+                "viscous)")
     return ""
 
 
+def _mahalanobis(d: Array, cov: Array) -> float:
+    """``sqrt(d^T cov^-1 d)`` (the pseudo-inverse where ``cov`` is singular)."""
+    return float(math.sqrt(max(float(d @ np.linalg.pinv(cov, hermitian=True) @ d), 0.0)))
+
+
 def _hac_std(A: Array, r: Array, sizes: tuple[int, int]) -> Array:
-    """Standard deviations of least-squares estimates whose residuals ``r`` are correlated
-    in time (the low-pass leaves neighbouring samples related): the heteroskedasticity and
+    """Standard deviations of :func:`_hac_cov`."""
+    return np.asarray(np.sqrt(np.clip(np.diag(_hac_cov(A, r, sizes)), 0.0, None)))
+
+
+def _hac_cov(A: Array, r: Array, sizes: tuple[int, int]) -> Array:
+    """Covariance of least-squares estimates whose residuals ``r`` are correlated in time
+    (the low-pass leaves neighbouring samples related): the heteroskedasticity and
     autocorrelation consistent (Newey-West, Bartlett weights) covariance
     ``(A^T A)^-1 S (A^T A)^-1``, lags within each motor's rows (``sizes`` of them), scaled
     by ``n / (n - p)``."""
@@ -463,7 +592,7 @@ def _hac_std(A: Array, r: Array, sizes: tuple[int, int]) -> Array:
         S += w * (G + G.T)
     inv = np.linalg.inv(A.T @ A)
     cov = inv @ S @ inv * (n / max(n - p, 1))
-    return np.asarray(np.sqrt(np.clip(np.diag(cov), 0.0, None)))
+    return np.asarray(0.5 * (cov + cov.T))
 
 
 # ----------------------------------------------------------------------- physical parameters
@@ -488,24 +617,58 @@ def _scaled_bounds(prior_inertia: Inertia, s: Array) -> list[tuple[float | None,
 _RODS = ((INDEX["J_BP"], INDEX["h_BP"], INDEX["m_BP"]), (INDEX["J_CP"], INDEX["h_CP"], INDEX["m_CP"]))
 
 
-def _rod_slack(x: Array, s: Array) -> Array:
-    """``J m - h^2`` of each distal rod (>= 0 when its inertia about its centre is not
-    negative), for scaled parameters ``x = theta / s``, in scaled units, shape (2,)."""
+def _rod_slack(x: Array, s: Array, lengths: Array) -> Array:
+    """For scaled parameters ``x = theta / s``, in scaled units, shape (6,): ``J m - h^2`` of
+    each distal rod (>= 0 when its inertia about its centre is not negative), then ``L m - h``
+    and ``L m + h`` of each (>= 0 when its centre of mass lies within its length ``L`` of its
+    joint)."""
     th = x * s
-    return np.array([(th[J] * th[m] - th[h] ** 2) / (s[J] * s[m]) for J, h, m in _RODS])
+    out = [(th[J] * th[m] - th[h] ** 2) / (s[J] * s[m]) for J, h, m in _RODS]
+    for (_J, h, m), L in zip(_RODS, lengths, strict=True):
+        scale = max(L * s[m], s[h])
+        out += [(L * th[m] - th[h]) / scale, (L * th[m] + th[h]) / scale]
+    return np.array(out)
+
+
+def _lengths(robot: FiveBar | None) -> Array:
+    """The distal rods' lengths (L1, L2), or no limit without a robot."""
+    return (np.array([math.inf, math.inf]) if robot is None
+            else np.array([robot.L1, robot.L2], float))
+
+
+def _physical(theta: Array, prior_inertia: Inertia, robot: FiveBar | None, tol: float = 1e-9
+              ) -> bool:
+    """True when the standard parameters ``theta`` are physical (see :func:`physical_set`)
+    to a relative ``tol``."""
+    s = _scales(np.abs(theta) + 1e-300)
+    x = theta / s
+    slack = _rod_slack(x, s, np.where(np.isfinite(_lengths(robot)), _lengths(robot), 1e300))
+    lo = _scaled_bounds(prior_inertia, s)
+    return bool(np.all(slack >= -tol) and all(b is None or x[i] >= b - tol
+                                              for i, (b, _h) in enumerate(lo)))
 
 
 def physical_set(beta: Array, base: BaseParameters, prior: Array, prior_inertia: Inertia,
-                 ) -> tuple[Array, bool]:
+                 robot: FiveBar | None = None) -> tuple[Array, bool]:
     """Standard parameters ``theta`` (15,) closest to ``prior`` (scaled) with
-    ``base.of(theta) = beta`` and physical values; ``ok`` is False when none exists."""
+    ``base.of(theta) = beta`` and physical values; ``ok`` is False when none exists.
+
+    Physical in the full sense where the base parameters allow the check: masses, inertias
+    about the joints and friction not negative, the point mass at least the payload, each
+    distal rod's inertia about its centre not negative (``J m >= h^2``: its pseudo-inertia
+    positive semi-definite) and its centre of mass within its length of its joint
+    (``|h| <= L m``, with ``robot``). A proximal rod's mass is not in the torques (only its
+    ``J`` and ``h``): a mass placing its centre within its length and ``J`` at least
+    ``m c^2`` always exists when ``J >= 0`` (:func:`realise` picks it)."""
     s = _scales(prior)
     K = base.K * s
     x0 = prior / s
     sb = _scaled_bounds(prior_inertia, s)
+    lengths = _lengths(robot)
+    finite = np.where(np.isfinite(lengths), lengths, 1e300)
 
     def rods(x: Array) -> Array:
-        return _rod_slack(x, s)
+        return _rod_slack(x, s, finite)
 
     bscale = np.maximum(np.abs(beta), 1e-300)
     cons = [{"type": "eq", "fun": lambda x: (K @ x - beta) / bscale,
@@ -534,7 +697,7 @@ def _polish(theta: Array, base: BaseParameters, beta: Array) -> Array:
 
 
 def _constrained_fit(Aw: Array, bw: Array, base: BaseParameters, prior: Array,
-                     prior_inertia: Inertia) -> Array:
+                     prior_inertia: Inertia, robot: FiveBar | None = None) -> Array:
     """Least squares over physical standard parameters (a tiny pull to the prior fixes the
     directions the torques do not see)."""
     s = _scales(prior)
@@ -544,9 +707,11 @@ def _constrained_fit(Aw: Array, bw: Array, base: BaseParameters, prior: Array,
     x0 = prior / s
     eps = 1e-9 * float(np.trace(G)) / len(x0)
     sb = _scaled_bounds(prior_inertia, s)
+    lengths = _lengths(robot)
+    finite = np.where(np.isfinite(lengths), lengths, 1e300)
 
     def rods(x: Array) -> Array:
-        return _rod_slack(x, s)
+        return _rod_slack(x, s, finite)
 
     def f(x: Array) -> float:
         return float(x @ G @ x - 2 * g @ x + eps * ((x - x0) ** 2).sum())
@@ -561,11 +726,12 @@ def _constrained_fit(Aw: Array, bw: Array, base: BaseParameters, prior: Array,
     return np.asarray(r.x * s)
 
 
-def realise(theta: Array, template: Inertia) -> Inertia:
+def realise(theta: Array, template: Inertia, robot: FiveBar | None = None) -> Inertia:
     """An :class:`Inertia` with the standard parameters ``theta`` (physical), gravity and
     Coulomb regularisation of ``template``; each proximal rod keeps the template's mass (or
-    the smallest mass its first moment allows) and inertia where they fit, the rest of its
-    ``J`` going to the rotor; the payload stays the template's."""
+    the smallest mass its first moment allows: ``J >= m c^2`` and, with ``robot``, its centre
+    within its length of its joint) and inertia where they fit, the rest of its ``J`` going
+    to the rotor; the payload stays the template's."""
     th = np.asarray(theta, float)
     distal = []
     for J, h, m in ((th[INDEX["J_BP"]], th[INDEX["h_BP"]], th[INDEX["m_BP"]]),
@@ -579,8 +745,9 @@ def realise(theta: Array, template: Inertia) -> Inertia:
         p = template.proximal[k]
         J = max(J, 0.0)
         m = p.mass
-        if h != 0 and (m <= 0 or m * J < h * h):
-            m = h * h / J if J > 0 else abs(h) / 1e-12
+        reach = math.inf if robot is None else (robot.l1, robot.l2)[k]
+        if h != 0 and (m <= 0 or m * J < h * h or abs(h) > reach * m):
+            m = max(h * h / J if J > 0 else abs(h) / 1e-12, abs(h) / reach)
         c = h / m if m > 0 else 0.0
         rest = max(J - m * c * c, 0.0)
         inert = min(p.inertia, rest) if m > 0 else 0.0
