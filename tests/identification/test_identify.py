@@ -143,11 +143,13 @@ def test_gravity_left_out_is_a_poor_fit_with_outputs(prior, excitation, base):
 
 
 def test_torques_in_another_unit_are_a_poor_fit(prior, excitation, base):
-    """mN m fit exactly as well, but 1000x the prior's torques (good fits: 1.05-1.10)."""
+    """mN m fit exactly as well by least squares, but 1000x the prior's torques (good fits:
+    1.05-1.10), and with masses no physical robot of this size has (beyond 10x the prior's
+    heaviest body)."""
     model, mode, _ = prior
     d = synthetic(model, excitation, 10.0, seed=10)
     res = identify(dataclasses.replace(d, tau=1e3 * d.tau), model, mode=mode, base=base)
-    assert (res.fit_quality < 0.05).all()
+    assert res.unphysical_distance > 100 and not res.consistent
     assert res.status == 3 and "another unit" in res.message, res.message
     assert (res.torque_scale > 500).all()
 

@@ -16,7 +16,8 @@ if TYPE_CHECKING:
 
 NAME = "excite"
 HELP = ("an exciting trajectory for identification (a Fourier series per motor, regressor "
-        "condition number minimised) to CSV")
+        "condition number minimised, coverage floors checked) to CSV (exit 1 below its "
+        "floors)")
 
 
 def add_arguments(sp: argparse.ArgumentParser) -> None:
@@ -40,7 +41,12 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> Result:
     """Design the motion, sample it at the servo rate, write it."""
     from ..config import load_scenario
-    from ..identification.excite import design_excitation
+    from ..identification.excite import (
+        ACCELERATION_FLOOR,
+        RANGE_FLOOR,
+        SPEED_FLOOR,
+        design_excitation,
+    )
     from ..output.identification import excitation_columns, excitation_payload
     from ..output.tables import csv_text
 
@@ -63,7 +69,19 @@ def run(args: argparse.Namespace) -> Result:
             f"distances type 1 {res.min_type1_distance:.3g}, type 2 "
             f"{res.min_type2_distance:.3g}; wrote {where} ({payload['samples']} samples at "
             f"{rate:g} Hz)")
-    warnings = [] if res.status == 0 else [f"dextar excite: warning: {res.message}"]
+    cov = res.coverage
+    if cov is not None:
+        fr = cov.fractions
+        text += (f"; coverage of what the {'task' if region is not None else 'free range'} "
+                 f"and motors allow, motor A / D: range {fr['range'][0]:.0%} / "
+                 f"{fr['range'][1]:.0%}, speed {fr['speed'][0]:.0%} / {fr['speed'][1]:.0%}, "
+                 f"acceleration {fr['acceleration'][0]:.0%} / {fr['acceleration'][1]:.0%} "
+                 f"(floors {RANGE_FLOOR:.0%}, {SPEED_FLOOR:.0%}, {ACCELERATION_FLOOR:.0%}; "
+                 f"{res.attempts} design{'s' if res.attempts > 1 else ''})")
+    code = 1 if res.status == 2 else 0  # written, but short of its floors
+    warnings = ([] if res.status == 0 else
+                [f"dextar excite: {res.message}" if code else
+                 f"dextar excite: warning: {res.message}"])
     if region is not None:
         text += (f"; covers {res.region_coverage:.1%} of the task's poses, at "
                  f"{res.region_speed_ratio[0]:.2f} and {res.region_speed_ratio[1]:.2f} of its "
@@ -73,7 +91,7 @@ def run(args: argparse.Namespace) -> Result:
                             f"{res.region_coverage:.1%} of the task's poses and reaches "
                             f"{res.region_speed_ratio.min():.2f} of its peak speed: an "
                             "identification from it extrapolates on the rest")
-    return Result(payload, text, warnings, data=data)
+    return Result(payload, text, warnings, data=data, code=code)
 
 
 def task_region(path: str, sc: Scenario) -> JointRegion:

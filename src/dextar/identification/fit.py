@@ -314,21 +314,26 @@ def identify(data: MotionData, model: Model, *, mode: str, cutoff_hz: float | No
     theta, ok = physical_set(beta, base, prior, model.inertia, model.robot)
     consistent = True
     distance = 0.0
-    if not ok:
+    ls_pred = Yb @ beta  # the torques' scale is the least-squares fit's (a fit in another
+    if not ok:           # unit is not physical: the constrained fit would hide the unit)
         method = "constrained"
         theta = _constrained_fit(Aw, bw, base, prior, model.inertia, model.robot)
         distance = _mahalanobis(beta - base.of(theta), cov)
         beta = base.of(theta)
         cov = _hac_cov(Aw, Aw @ beta - bw, sizes)  # the spread about the constrained fit
-        consistent = _physical(theta, model.inertia, model.robot)
+        consistent = _physical(theta, prior, model.inertia, model.robot)
     std = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     inertia = realise(theta, model.inertia, model.robot)
+    if method == "constrained":  # the model written is the fit (realise may move it by
+        theta = standard_parameters(inertia)  # rounding where a constraint is active)
+        beta = base.of(theta)
     back = base.of(standard_parameters(inertia))
     consistent = consistent and bool(np.all(
         np.abs(back - beta) <= 1e-9 * np.maximum(np.abs(beta), 1e-12)
         + 1e-12 * np.abs(beta).max()))
     pred = Yb @ beta
-    rms, quality, scale = _fit_figures(pred, c.tau, c.Y @ prior, keep)
+    rms, quality, _ = _fit_figures(pred, c.tau, c.Y @ prior, keep)
+    scale = _fit_figures(ls_pred, c.tau, c.Y @ prior, keep)[2]
     noise = torque_noise(data, c.parallel_hz)
     rms_tau = np.where(quality > 0, rms / np.where(quality > 0, quality, 1.0), math.inf)
     explained = np.sqrt((noise / np.where(rms_tau > 0, rms_tau, math.inf)) ** 2
@@ -539,6 +544,11 @@ def _rms(x: Array) -> float:
 
 def _verdict(quality: Array, scale: Array, explained: Array) -> str:
     """The poor-fit message, or "" for a fit the model explains."""
+    if ((scale > TORQUE_SCALE) | (scale < 1.0 / TORQUE_SCALE)).any():
+        return (f"poor fit: the identified torques are {scale[0]:.3g} / {scale[1]:.3g} times "
+                f"the prior model's for motor A / D (beyond a factor {TORQUE_SCALE:g}). "
+                "Likely causes: torques in another unit (mN m, A, a motor-side torque before "
+                "the gear), or a config for another robot")
     if (quality > POOR_FIT).any():
         return (f"poor fit: the model leaves {100 * quality[0]:.3g} % / {100 * quality[1]:.3g} % "
                 f"of the RMS torque of motor A / D unexplained (limit {100 * POOR_FIT:g} %). "
@@ -546,11 +556,6 @@ def _verdict(quality: Array, scale: Array, explained: Array) -> str:
                 "no config: the DexTAR's defaults assumed), gravity left out or in another "
                 "direction, data from another machine, torques of another sign or motor "
                 "order, or effects the model lacks (backlash, a cable, a spring)")
-    if ((scale > TORQUE_SCALE) | (scale < 1.0 / TORQUE_SCALE)).any():
-        return (f"poor fit: the identified torques are {scale[0]:.3g} / {scale[1]:.3g} times "
-                f"the prior model's for motor A / D (beyond a factor {TORQUE_SCALE:g}). "
-                "Likely causes: torques in another unit (mN m, A, a motor-side torque before "
-                "the gear), or a config for another robot")
     if (quality > RESIDUAL_FACTOR * explained).any():
         return (f"poor fit: the model leaves {100 * quality[0]:.3g} % / {100 * quality[1]:.3g} % "
                 f"of the RMS torque of motor A / D unexplained where the torques' noise and "
@@ -614,38 +619,75 @@ def _scaled_bounds(prior_inertia: Inertia, s: Array) -> list[tuple[float | None,
     return [(None if v is None else v / s[i], None) for i, v in enumerate(lo)]
 
 
-_RODS = ((INDEX["J_BP"], INDEX["h_BP"], INDEX["m_BP"]), (INDEX["J_CP"], INDEX["h_CP"], INDEX["m_CP"]))
+#: (J, h, m) of each rod: the proximal rods' masses are variables 15 and 16 (not in the
+#: torques), the distal rods' are standard parameters.
+_RODS = ((INDEX["J_A"], INDEX["h_AB"], 15), (INDEX["J_D"], INDEX["h_DC"], 16),
+         (INDEX["J_BP"], INDEX["h_BP"], INDEX["m_BP"]),
+         (INDEX["J_CP"], INDEX["h_CP"], INDEX["m_CP"]))
+#: A rod heavier than this many times the prior's heaviest body is not physical here (the
+#: proximal rods' masses are not in the torques: without a bound any first moment would fit
+#: with a mass that tends to infinity and a centre of mass at the joint).
+MASS_BOUND = 10.0
 
 
-def _rod_slack(x: Array, s: Array, lengths: Array) -> Array:
-    """For scaled parameters ``x = theta / s``, in scaled units, shape (6,): ``J m - h^2`` of
-    each distal rod (>= 0 when its inertia about its centre is not negative), then ``L m - h``
-    and ``L m + h`` of each (>= 0 when its centre of mass lies within its length ``L`` of its
-    joint)."""
-    th = x * s
-    out = [(th[J] * th[m] - th[h] ** 2) / (s[J] * s[m]) for J, h, m in _RODS]
-    for (_J, h, m), L in zip(_RODS, lengths, strict=True):
-        scale = max(L * s[m], s[h])
-        out += [(L * th[m] - th[h]) / scale, (L * th[m] + th[h]) / scale]
-    return np.array(out)
+class _Physics:
+    """The physical region of the standard parameters, in scaled variables ``x`` (17,):
+    ``theta / s`` then the proximal rods' masses over their scale (see
+    :func:`physical_set`)."""
+
+    def __init__(self, prior: Array, prior_inertia: Inertia, robot: FiveBar | None) -> None:
+        s = _scales(prior)
+        masses = [r.mass for r in (*prior_inertia.proximal, *prior_inertia.distal)]
+        heaviest = max([*masses, prior_inertia.point_mass, float(s[INDEX["m_P"]])])
+        sm = np.maximum(np.array([r.mass for r in prior_inertia.proximal], float),
+                        1e-3 * heaviest)
+        self.s = np.concatenate([s, sm])
+        self.prior = np.concatenate([prior, sm])
+        lo = _scaled_bounds(prior_inertia, s)
+        top = MASS_BOUND * heaviest
+        mass_hi = [None if i not in (INDEX["m_BP"], INDEX["m_CP"], INDEX["m_P"]) else
+                   top / s[i] for i in range(len(s))]
+        self.bounds: list[tuple[float | None, float | None]] = [
+            (lo_, hi) for (lo_, _), hi in zip(lo, mass_hi, strict=True)]
+        self.bounds += [(0.0, top / sm[0]), (0.0, top / sm[1])]
+        self.lengths = (np.full(4, 1e300) if robot is None
+                        else np.array([robot.l1, robot.l2, robot.L1, robot.L2], float))
+
+    def K(self, base: BaseParameters) -> Array:
+        """``base.K`` in the scaled variables (the proximal masses do not enter)."""
+        return np.concatenate([base.K * self.s[:15], np.zeros((base.size, 2))], axis=1)
+
+    def slack(self, x: Array) -> Array:
+        """>= 0 where physical, in scaled units, shape (12,): per rod ``J m - h^2`` (its
+        inertia about its centre not negative), ``L m - h`` and ``L m + h`` (its centre of
+        mass within its length ``L`` of its joint)."""
+        s = self.s
+        th = x * s
+        out = []
+        for (J, h, m), L in zip(_RODS, self.lengths, strict=True):
+            scale = max(L * s[m], s[h])
+            out += [(th[J] * th[m] - th[h] ** 2) / (s[J] * s[m]),
+                    (L * th[m] - th[h]) / scale, (L * th[m] + th[h]) / scale]
+        return np.array(out)
+
+    def physical(self, x: Array, tol: float = 1e-9) -> bool:
+        """Every constraint and bound met at ``x`` (within ``tol``, scaled)."""
+        return bool(np.all(self.slack(x) >= -tol) and all(
+            (lo is None or x[i] >= lo - tol) and (hi is None or x[i] <= hi * (1 + tol))
+            for i, (lo, hi) in enumerate(self.bounds)))
 
 
-def _lengths(robot: FiveBar | None) -> Array:
-    """The distal rods' lengths (L1, L2), or no limit without a robot."""
-    return (np.array([math.inf, math.inf]) if robot is None
-            else np.array([robot.L1, robot.L2], float))
-
-
-def _physical(theta: Array, prior_inertia: Inertia, robot: FiveBar | None, tol: float = 1e-9
+def _physical(theta: Array, prior: Array, prior_inertia: Inertia, robot: FiveBar | None
               ) -> bool:
     """True when the standard parameters ``theta`` are physical (see :func:`physical_set`)
-    to a relative ``tol``."""
-    s = _scales(np.abs(theta) + 1e-300)
-    x = theta / s
-    slack = _rod_slack(x, s, np.where(np.isfinite(_lengths(robot)), _lengths(robot), 1e300))
-    lo = _scaled_bounds(prior_inertia, s)
-    return bool(np.all(slack >= -tol) and all(b is None or x[i] >= b - tol
-                                              for i, (b, _h) in enumerate(lo)))
+    with some proximal masses (the smallest each rod allows)."""
+    ph = _Physics(prior, prior_inertia, robot)
+    x = np.concatenate([theta, np.zeros(2)]) / ph.s
+    for k, (J, h, _m) in enumerate(_RODS[:2]):
+        need = max(theta[h] ** 2 / theta[J] if theta[J] > 0 else math.inf,
+                   abs(theta[h]) / ph.lengths[k]) if theta[h] != 0 else 0.0
+        x[15 + k] = need / ph.s[15 + k]
+    return ph.physical(x)
 
 
 def physical_set(beta: Array, base: BaseParameters, prior: Array, prior_inertia: Inertia,
@@ -653,36 +695,28 @@ def physical_set(beta: Array, base: BaseParameters, prior: Array, prior_inertia:
     """Standard parameters ``theta`` (15,) closest to ``prior`` (scaled) with
     ``base.of(theta) = beta`` and physical values; ``ok`` is False when none exists.
 
-    Physical in the full sense where the base parameters allow the check: masses, inertias
-    about the joints and friction not negative, the point mass at least the payload, each
-    distal rod's inertia about its centre not negative (``J m >= h^2``: its pseudo-inertia
-    positive semi-definite) and its centre of mass within its length of its joint
-    (``|h| <= L m``, with ``robot``). A proximal rod's mass is not in the torques (only its
-    ``J`` and ``h``): a mass placing its centre within its length and ``J`` at least
-    ``m c^2`` always exists when ``J >= 0`` (:func:`realise` picks it)."""
-    s = _scales(prior)
-    K = base.K * s
-    x0 = prior / s
-    sb = _scaled_bounds(prior_inertia, s)
-    lengths = _lengths(robot)
-    finite = np.where(np.isfinite(lengths), lengths, 1e300)
-
-    def rods(x: Array) -> Array:
-        return _rod_slack(x, s, finite)
-
+    Physical in the full sense where the base parameters allow the check: inertias about the
+    joints and friction not negative, the point mass at least the payload and every rod's
+    mass not negative (at most :data:`MASS_BOUND` times the prior's heaviest body), every
+    rod's inertia at least ``m c^2`` (``J m >= h^2``: its pseudo-inertia positive
+    semi-definite) and, with ``robot``, its centre of mass within its length of its joint
+    (``|h| <= l m``). A proximal rod's mass is not in the torques: it is a variable here,
+    and :func:`realise` picks the smallest that fits."""
+    ph = _Physics(prior, prior_inertia, robot)
+    K = ph.K(base)
+    x0 = ph.prior / ph.s
     bscale = np.maximum(np.abs(beta), 1e-300)
     cons = [{"type": "eq", "fun": lambda x: (K @ x - beta) / bscale,
              "jac": lambda x: K / bscale[:, None]},
-            {"type": "ineq", "fun": rods}]
+            {"type": "ineq", "fun": ph.slack}]
     # start from the prior moved onto the affine set K theta = beta (least-norm correction)
     x_start = x0 + np.linalg.lstsq(K, beta - K @ x0, rcond=None)[0]
     r = optimize.minimize(lambda x: float(((x - x0) ** 2).sum()), x_start,
-                          jac=lambda x: 2 * (x - x0), bounds=sb, constraints=cons,
+                          jac=lambda x: 2 * (x - x0), bounds=ph.bounds, constraints=cons,
                           method="SLSQP", options={"maxiter": 500, "ftol": 1e-14})
-    theta = r.x * s
+    theta = r.x[:15] * ph.s[:15]
     ok = bool(np.all(np.abs(base.of(theta) - beta) <= 1e-9 * bscale + 1e-12 * np.abs(beta).max())
-              and np.all(rods(r.x) >= -1e-9)
-              and all(lo is None or r.x[i] >= lo - 1e-12 for i, (lo, _hi) in enumerate(sb)))
+              and ph.physical(r.x))
     if ok:  # land exactly on the constraints (SLSQP stops within its tolerance)
         theta = _polish(theta, base, beta)
     return theta, ok
@@ -700,18 +734,13 @@ def _constrained_fit(Aw: Array, bw: Array, base: BaseParameters, prior: Array,
                      prior_inertia: Inertia, robot: FiveBar | None = None) -> Array:
     """Least squares over physical standard parameters (a tiny pull to the prior fixes the
     directions the torques do not see)."""
-    s = _scales(prior)
-    M = Aw @ (base.K * s)
-    G = M.T @ M
-    g = M.T @ bw
-    x0 = prior / s
+    ph = _Physics(prior, prior_inertia, robot)
+    M = Aw @ ph.K(base)
+    norm = max(float(bw @ bw), 1e-300)  # the cost in units of the data's (SLSQP's ftol is
+    G = M.T @ M / norm                   # absolute)
+    g = M.T @ bw / norm
+    x0 = ph.prior / ph.s
     eps = 1e-9 * float(np.trace(G)) / len(x0)
-    sb = _scaled_bounds(prior_inertia, s)
-    lengths = _lengths(robot)
-    finite = np.where(np.isfinite(lengths), lengths, 1e300)
-
-    def rods(x: Array) -> Array:
-        return _rod_slack(x, s, finite)
 
     def f(x: Array) -> float:
         return float(x @ G @ x - 2 * g @ x + eps * ((x - x0) ** 2).sum())
@@ -719,11 +748,12 @@ def _constrained_fit(Aw: Array, bw: Array, base: BaseParameters, prior: Array,
     def df(x: Array) -> Array:
         return np.asarray(2 * (G @ x - g) + 2 * eps * (x - x0))
 
-    x_start = np.clip(x0, [lo if lo is not None else -np.inf for lo, _ in sb], None)
-    r = optimize.minimize(f, x_start, jac=df, bounds=sb,
-                          constraints=[{"type": "ineq", "fun": rods}], method="SLSQP",
-                          options={"maxiter": 1000, "ftol": 1e-15})
-    return np.asarray(r.x * s)
+    x_start = np.clip(x0, [lo if lo is not None else -np.inf for lo, _ in ph.bounds],
+                      [hi if hi is not None else np.inf for _, hi in ph.bounds])
+    r = optimize.minimize(f, x_start, jac=df, bounds=ph.bounds,
+                          constraints=[{"type": "ineq", "fun": ph.slack}], method="SLSQP",
+                          options={"maxiter": 1000, "ftol": 1e-13})
+    return np.asarray(r.x[:15] * ph.s[:15])
 
 
 def realise(theta: Array, template: Inertia, robot: FiveBar | None = None) -> Inertia:
@@ -733,11 +763,14 @@ def realise(theta: Array, template: Inertia, robot: FiveBar | None = None) -> In
     within its length of its joint) and inertia where they fit, the rest of its ``J`` going
     to the rotor; the payload stays the template's."""
     th = np.asarray(theta, float)
-    distal = []
+    distal: list[Rod] = []
     for J, h, m in ((th[INDEX["J_BP"]], th[INDEX["h_BP"]], th[INDEX["m_BP"]]),
                     (th[INDEX["J_CP"]], th[INDEX["h_CP"]], th[INDEX["m_CP"]])):
         m = max(m, 0.0)
         c = h / m if m > 0 else 0.0
+        if robot is not None:  # within its length (to the constraints' tolerance)
+            L = (robot.L1, robot.L2)[len(distal)]
+            c = min(max(c, -L), L)
         distal.append(Rod(m, c, max(J - m * c * c, 0.0) if m > 0 else 0.0))
     prox, rotor = [], []
     for k, (J, h) in enumerate(((th[INDEX["J_A"]], th[INDEX["h_AB"]]),

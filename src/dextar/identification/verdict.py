@@ -81,10 +81,9 @@ def torque_noise(data: MotionData, parallel_hz: float) -> Array:
 
 
 def peak_speed(data: MotionData) -> Array:
-    """Each motor's 99th-percentile speed (rad/s) from the angles' differences (the
-    measured rates when the data have them), shape (2,)."""
-    v = (np.abs(data.dq) if data.dq is not None
-         else np.abs(np.diff(data.q, axis=0)) / np.diff(data.t)[:, None])
+    """Each motor's 99th-percentile speed (rad/s) from the angles' differences over the time
+    column's (the time base in question; measured rates are not used), shape (2,)."""
+    v = np.abs(np.diff(data.q, axis=0)) / np.diff(data.t)[:, None]
     return np.asarray(np.percentile(v, 99.0, axis=0))
 
 

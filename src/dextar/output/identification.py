@@ -56,9 +56,38 @@ def excitation_payload(res: ExcitationResult, harmonics: int, base_hz: float, sa
             "status": res.status, "message": res.message, "out": out,
             "headroom": [float(v) for v in res.headroom],
             "headroom_note": "each motor's peak use of its torque (at its speed) and speed",
+            "attempts": res.attempts,
+            **({} if res.coverage is None else {"coverage": _coverage(res)}),
             **({} if math.isnan(res.region_coverage) else {
                 "task_coverage": res.region_coverage,
                 "task_speed_ratio": [float(v) for v in res.region_speed_ratio]})}
+
+
+def _coverage(res: ExcitationResult) -> dict[str, Any]:
+    """The excitation's coverage against its floors (JSON)."""
+    from ..identification.excite import (
+        ACCELERATION_FLOOR,
+        COND_CEILING,
+        RANGE_FLOOR,
+        SPEED_FLOOR,
+    )
+
+    c = res.coverage
+    assert c is not None
+    return {"floors": {"range": RANGE_FLOOR, "speed": SPEED_FLOOR,
+                       "acceleration": ACCELERATION_FLOOR, "condition_number": COND_CEILING},
+            "range_deg": [float(v) for v in np.degrees(c.range)],
+            "allowed_range_deg": [float(v) for v in np.degrees(c.allowed.range)],
+            "peak_speed_rad_s": [float(v) for v in c.speed],
+            "allowed_speed_rad_s": [float(v) for v in c.allowed.speed],
+            "peak_acceleration_rad_s2": [float(v) for v in c.acceleration],
+            "allowed_acceleration_rad_s2": [float(v) for v in c.allowed.acceleration],
+            "fractions": {k: [float(x) for x in v] for k, v in c.fractions.items()},
+            "met": c.met, "missed": list(c.missed),
+            "note": "each motor's range, peak speed and peak acceleration over what the "
+                    "task region (or the free range from the rest pose) and the motors "
+                    "allow; a design that misses a floor is made again from new "
+                    "deterministic starts"}
 
 
 def _finite(v: float) -> float | None:
