@@ -91,7 +91,7 @@ REL_STD_FLAG = 0.5
 UNCERTAINTY_LIMIT = 0.02
 #: Fit quality that good fits of noise-free data reach (encoder quantisation, the filters,
 #: the friction's regularisation): the part of the residual no torque noise explains.
-RESIDUAL_FLOOR = 0.0075
+RESIDUAL_FLOOR = 0.01
 #: Largest ratio of the fit quality to the one noise and filters explain.
 RESIDUAL_FACTOR = 2.0
 #: Distance (standard deviations, Mahalanobis) beyond which a least-squares estimate that is
@@ -543,27 +543,28 @@ def _rms(x: Array) -> float:
 
 
 def _verdict(quality: Array, scale: Array, explained: Array) -> str:
-    """The poor-fit message, or "" for a fit the model explains."""
+    """The poor-fit message, or "" for a fit the model explains: the torques' scale unlike
+    the prior's, or a residual above :data:`RESIDUAL_FACTOR` times what noise and filters
+    explain (the likely causes by its size: above :data:`POOR_FIT`, another robot)."""
     if ((scale > TORQUE_SCALE) | (scale < 1.0 / TORQUE_SCALE)).any():
         return (f"poor fit: the identified torques are {scale[0]:.3g} / {scale[1]:.3g} times "
                 f"the prior model's for motor A / D (beyond a factor {TORQUE_SCALE:g}). "
                 "Likely causes: torques in another unit (mN m, A, a motor-side torque before "
                 "the gear), or a config for another robot")
-    if (quality > POOR_FIT).any():
-        return (f"poor fit: the model leaves {100 * quality[0]:.3g} % / {100 * quality[1]:.3g} % "
-                f"of the RMS torque of motor A / D unexplained (limit {100 * POOR_FIT:g} %). "
-                "Likely causes: another robot's geometry or assembly mode in the config (or "
-                "no config: the DexTAR's defaults assumed), gravity left out or in another "
-                "direction, data from another machine, torques of another sign or motor "
-                "order, or effects the model lacks (backlash, a cable, a spring)")
-    if (quality > RESIDUAL_FACTOR * explained).any():
-        return (f"poor fit: the model leaves {100 * quality[0]:.3g} % / {100 * quality[1]:.3g} % "
-                f"of the RMS torque of motor A / D unexplained where the torques' noise and "
-                f"the filters explain {100 * explained[0]:.3g} % / {100 * explained[1]:.3g} % "
-                f"(limit {RESIDUAL_FACTOR:g}x that). Likely causes: the config's geometry or "
-                "gravity direction a little off, torques and angles out of step, or effects "
-                "the model lacks (backlash, a cable, a spring, friction beyond Coulomb and "
-                "viscous)")
+    unexplained = quality > RESIDUAL_FACTOR * explained
+    what = (f"poor fit: the model leaves {100 * quality[0]:.3g} % / {100 * quality[1]:.3g} % "
+            f"of the RMS torque of motor A / D unexplained where the torques' noise and the "
+            f"filters explain {100 * explained[0]:.3g} % / {100 * explained[1]:.3g} % "
+            f"(limit {RESIDUAL_FACTOR:g}x that). ")
+    if (unexplained & (quality > POOR_FIT)).any():
+        return (what + "Likely causes: another robot's geometry or assembly mode in the "
+                "config (or no config: the DexTAR's defaults assumed), gravity left out or in "
+                "another direction, data from another machine, torques of another sign or "
+                "motor order, or effects the model lacks (backlash, a cable, a spring)")
+    if unexplained.any():
+        return (what + "Likely causes: the config's geometry or gravity direction a little "
+                "off, torques and angles out of step, or effects the model lacks (backlash, "
+                "a cable, a spring, friction beyond Coulomb and viscous)")
     return ""
 
 
