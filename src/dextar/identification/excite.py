@@ -50,12 +50,15 @@ Measured (``benchmarks/bench_excite_seeds.py``, 20 seeds, 15 s, 5 harmonics of 0
 issue 28's 80/75/95/92/58 mm robot the designs reach a median of about 90 % / 60 % of the
 range, 50 % / 30 % of the speed, 30 % / 20 % of the acceleration (motor A / D); the issue's
 motion (19 deg on motor D, 0.9 rad/s) is 16 % / 13 % of motor D's range and speed, and 4
-of 20 first designs miss a floor like it (seeds 1, 3, 5, 17 at 13-17 % of motor D's range or
-speed, 8-10 % of its acceleration); redesigned, they reach 25-101 %. The floors sit at about
-a third of the median. Identified from MuJoCo's data with 50 mN m of torque noise, the
-worst prediction error of an unseen line and arc over the 20 seeds is printed by the
-benchmark for the first designs and the ones kept (the README quotes it); on the
-pick-and-place robot the stored excitations reach 32-90 %, 36-99 % and 13-33 %.
+of 20 first designs miss a floor like it (seeds 1, 3, 5, 17: 13-20 % of a motor's speed or
+range, 8-9 % of its acceleration); redesigned, they reach 16-123 %. The floors sit at about
+a third of the median. Identified from MuJoCo's data with 50 mN m of torque noise, the worst
+prediction error of an unseen line and arc over the 20 seeds: 1.0 / 0.80 % with the first
+designs, 1.0 / 0.68 % with the designs kept (seed 1, the issue's kind of motion: 0.49 / 0.80
+% before, 0.33 / 0.58 % redesigned). On a flat 120/180 mm robot with dry friction 1 seed of
+20 is redesigned (16 % of motor A's range); there the worst error, 3.8 / 4.8 %, is the
+torque noise on its small torques, not the excitation. On the pick-and-place robot the
+stored excitations reach 32-90 %, 36-99 % and 13-33 %.
 """
 
 from __future__ import annotations
