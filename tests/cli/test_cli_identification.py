@@ -37,6 +37,13 @@ def test_excite_prints_its_condition_number(tmp_path, capsys):
     payload = json.loads(capsys.readouterr().out)
     assert 1 < payload["condition_number"] < 1e3
     assert payload["periods"] == 1 and payload["samples"] == 5001
+    # the coverage floors and what the design reached (met: 47-117 % of the range, 77-99 %
+    # of the speed, 43-47 % of the acceleration allowed, against floors of 20 / 20 / 10 %)
+    cov = payload["coverage"]
+    assert cov["met"] and not cov["missed"] and payload["status"] == 0
+    assert set(cov["floors"]) == {"range", "speed", "acceleration", "condition_number"}
+    for key in ("range", "speed", "acceleration"):
+        assert min(cov["fractions"][key]) >= cov["floors"][key]
 
 
 def test_identify_writes_a_config_that_reproduces_the_base_parameters(excite_csv, tmp_path,
@@ -72,6 +79,8 @@ def test_identify_writes_a_config_that_reproduces_the_base_parameters(excite_csv
      "tau1_Nm, tau2_Nm is NaN or infinite at row 6"),
     (lambda rows: rows[:5] + [["x", *rows[5][1:]]] + rows[6:], "row 6, column t_s: 'x' is not"),
     (lambda rows: rows[:1] + rows[1:][::-1], "t_s does not increase"),
+    (lambda rows: rows[:1] + [[repr(1e3 * float(r[0])), *r[1:]] for r in rows[1:]],
+     "Is the time in milliseconds?"),
 ])
 def test_bad_data_exit_2_with_one_line(excite_csv, tmp_path, capsys, edit, message):
     with open(excite_csv) as fh:
@@ -165,3 +174,30 @@ def test_every_config_command_takes_a_model_file(excite_csv, tmp_path):
     bad = tmp_path / "bad.toml"
     bad.write_text("[motors]\npeak_torque = 1.0\n")
     assert main(["plan", "--model", str(bad), "--out", str(tmp_path / "r.csv")]) == 2
+
+
+def test_a_motion_too_small_for_its_task_is_exit_1(tmp_path, capsys):
+    """A stored excitation at a quarter of its size with 20 mN m of noise, identified for the
+    pick-and-place program (--task): the program's torques predicted within 85-99 % (1
+    sigma; limit 2 %): "poorly determined", exit 1, every file written, the reason named."""
+    from dextar.identification.excite import FourierTrajectory
+
+    from ..identification.conftest import synthetic
+    from ..identification.excitations import EXCITATIONS
+
+    sc = load_scenario(CONFIG)
+    tr = EXCITATIONS[0]
+    small = FourierTrajectory(tr.q0, 0.25 * tr.a, 0.25 * tr.b, tr.base_hz)
+    d = synthetic(sc.si_model, small, 10.0, seed=3, noise=0.02)
+    data = tmp_path / "small.csv"
+    np.savetxt(data, np.column_stack([d.t, d.q, d.tau]), delimiter=",", comments="",
+               header="t_s,phi_rad,psi_rad,tau1_Nm,tau2_Nm")
+    out = tmp_path / "id"
+    assert main(["identify", str(data), "--config", CONFIG, "--task", CONFIG, "--out",
+                 str(out), "--quiet"]) == 1
+    err = capsys.readouterr().err
+    assert "dextar identify: poorly determined:" in err and f"along the task {CONFIG}" in err
+    s = json.loads((out / "summary.json").read_text())
+    assert s["status"] == "poorly determined" and s["reasons"]
+    assert min(s["prediction_uncertainty"]) > 10 * s["prediction_uncertainty_limit"]
+    assert (out / "identified.toml").exists()

@@ -76,6 +76,8 @@ def test_design_uses_the_headroom_and_covers_the_region(designed, region):
     assert (designed.region_speed_ratio > 0.7).all(), designed.region_speed_ratio
     # the rest pose is one of the region's
     assert region.distance(designed.trajectory.q0[None])[0] < 1e-12
+    # every coverage floor met (the task's range, speed and acceleration)
+    assert designed.coverage is not None and designed.coverage.met, designed.coverage.missed
 
 
 def test_design_is_well_conditioned_and_beats_random_starts(prior, base, designed):
@@ -110,3 +112,40 @@ def test_bad_design_options_are_refused(prior, base):
         design_excitation(model, mode, motors=motors, safety=1.5, base=base)
     with pytest.raises(ParameterError, match="joint region needs finite poses"):
         JointRegion(np.zeros((0, 2)), np.ones(2))
+
+
+def test_coverage_floors_tell_a_small_motion(prior):
+    """The stored excitations reach 32-90 % of the free range, 36-99 % of the speed and
+    13-33 % of the acceleration allowed (floors 20 / 20 / 10 %); at a quarter of their size,
+    8-22 %, 9-25 %, 3-8 %: the range or acceleration floor is missed and named. Issue 28's
+    motion (19 deg on motor D, 0.9 rad/s) was 16 % / 13 % of its robot's range and speed."""
+    from dextar.identification.excite import allowed_motion, check_coverage
+
+    from .excitations import EXCITATIONS
+
+    model, _, motors = prior
+    tr = EXCITATIONS[0]
+    allowed = allowed_motion(model, tr.q0, 5, 0.2, motors, None)
+    for t in EXCITATIONS.values():
+        assert check_coverage(t, allowed, 5.0).met
+        small = FourierTrajectory(t.q0, 0.25 * t.a, 0.25 * t.b, t.base_hz)
+        cov = check_coverage(small, allowed, 5.0)
+        assert not cov.met and any("allowed (floor" in m for m in cov.missed), cov.missed
+    assert check_coverage(tr, allowed, 50.0).missed == ("condition number 50 above 20",)
+
+
+def test_a_design_short_of_its_floors_is_designed_again_and_says_so(prior, base, monkeypatch):
+    """A floor no motion meets (1000 % of the range): a second design from new
+    deterministic starts, then status 2 naming the floor; the same result twice."""
+    from dextar.identification import excite
+
+    model, mode, motors = prior
+    monkeypatch.setattr(excite, "RANGE_FLOOR", 10.0)
+    monkeypatch.setattr(excite, "ATTEMPTS", 2)
+    kw = dict(harmonics=3, starts=1, duration=5.0, motors=motors, seed=0, base=base)
+    a = design_excitation(model, mode, **kw)
+    assert a.attempts == 2 and a.status == 2
+    assert "misses its coverage floors after 2 designs" in a.message
+    assert "range" in a.message and "floor 1000 %" in a.message
+    b = design_excitation(model, mode, **kw)
+    assert np.array_equal(a.trajectory.a, b.trajectory.a)

@@ -10,12 +10,14 @@ from typing import TYPE_CHECKING
 from .base import Result, config_argument, json_flag, out_file, write_or_hand_back
 
 if TYPE_CHECKING:
+    from .._arrays import Array
     from ..config import Scenario
     from ..identification.coverage import JointRegion
 
 NAME = "excite"
 HELP = ("an exciting trajectory for identification (a Fourier series per motor, regressor "
-        "condition number minimised) to CSV")
+        "condition number minimised, coverage floors checked) to CSV (exit 1 below its "
+        "floors)")
 
 
 def add_arguments(sp: argparse.ArgumentParser) -> None:
@@ -39,7 +41,12 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> Result:
     """Design the motion, sample it at the servo rate, write it."""
     from ..config import load_scenario
-    from ..identification.excite import design_excitation
+    from ..identification.excite import (
+        ACCELERATION_FLOOR,
+        RANGE_FLOOR,
+        SPEED_FLOOR,
+        design_excitation,
+    )
     from ..output.identification import excitation_columns, excitation_payload
     from ..output.tables import csv_text
 
@@ -62,7 +69,19 @@ def run(args: argparse.Namespace) -> Result:
             f"distances type 1 {res.min_type1_distance:.3g}, type 2 "
             f"{res.min_type2_distance:.3g}; wrote {where} ({payload['samples']} samples at "
             f"{rate:g} Hz)")
-    warnings = [] if res.status == 0 else [f"dextar excite: warning: {res.message}"]
+    cov = res.coverage
+    if cov is not None:
+        fr = cov.fractions
+        text += (f"; coverage of what the {'task' if region is not None else 'free range'} "
+                 f"and motors allow, motor A / D: range {fr['range'][0]:.0%} / "
+                 f"{fr['range'][1]:.0%}, speed {fr['speed'][0]:.0%} / {fr['speed'][1]:.0%}, "
+                 f"acceleration {fr['acceleration'][0]:.0%} / {fr['acceleration'][1]:.0%} "
+                 f"(floors {RANGE_FLOOR:.0%}, {SPEED_FLOOR:.0%}, {ACCELERATION_FLOOR:.0%}; "
+                 f"{res.attempts} design{'s' if res.attempts > 1 else ''})")
+    code = 1 if res.status == 2 else 0  # written, but short of its floors
+    warnings = ([] if res.status == 0 else
+                [f"dextar excite: {res.message}" if code else
+                 f"dextar excite: warning: {res.message}"])
     if region is not None:
         text += (f"; covers {res.region_coverage:.1%} of the task's poses, at "
                  f"{res.region_speed_ratio[0]:.2f} and {res.region_speed_ratio[1]:.2f} of its "
@@ -72,15 +91,23 @@ def run(args: argparse.Namespace) -> Result:
                             f"{res.region_coverage:.1%} of the task's poses and reaches "
                             f"{res.region_speed_ratio.min():.2f} of its peak speed: an "
                             "identification from it extrapolates on the rest")
-    return Result(payload, text, warnings, data=data)
+    return Result(payload, text, warnings, data=data, code=code)
 
 
 def task_region(path: str, sc: Scenario) -> JointRegion:
     """The joint region a task visits, with its speeds: its program planned, or its run
     sampled (SI), on the config's robot."""
+    from ..identification.coverage import JointRegion
+
+    q, dq, _ = task_motion(path, sc)
+    return JointRegion.from_samples(q, dq)
+
+
+def task_motion(path: str, sc: Scenario) -> tuple[Array, Array, Array]:
+    """The joint motion ``(q, dq, ddq)`` (SI) of a task: its program planned, or its run
+    sampled, on the config's robot."""
     from ..config import load_scenario
     from ..errors import ConfigError
-    from ..identification.coverage import JointRegion
 
     task = load_scenario(path)
     if task.robot_mm != sc.robot_mm:
@@ -88,6 +115,6 @@ def task_region(path: str, sc: Scenario) -> JointRegion:
                           f"mm) than the config's ({sc.robot_mm.as_dict()} mm)")
     if task.moves:
         res = task.program_request().plan()
-        return JointRegion.from_samples(res.q, res.dq)
+        return res.q, res.dq, res.ddq
     tr = task.in_units("si").trajectory()
-    return JointRegion.from_samples(tr.q, tr.dq)
+    return tr.q, tr.dq, tr.ddq

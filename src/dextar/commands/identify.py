@@ -9,14 +9,19 @@ from .base import Result, into_directory, model_argument, shown
 
 NAME = "identify"
 HELP = ("identify the base parameters from measured motion and write a config with them "
-        "(exit 1 for a poor fit)")
+        "(exit 1 when poorly determined, not physical or a poor fit)")
 
 
 def add_arguments(sp: argparse.ArgumentParser) -> None:
-    """``data``, ``--config``, ``--validate``, ``--cutoff-hz``, ``--out``, ``--force``."""
+    """``data``, ``--config``, ``--task``, ``--validate``, ``--cutoff-hz``, ``--out``,
+    ``--force``."""
     sp.add_argument("data", help="CSV with t_s, phi_rad, psi_rad, tau1_Nm, tau2_Nm (SI)")
     sp.add_argument("--config", help="TOML config: the robot and the prior masses")
     model_argument(sp)
+    sp.add_argument("--task", metavar="TASK.toml",
+                    help="a program or run config the model is for (its robot must be the "
+                    "config's): the predicted-torque uncertainty is measured along it "
+                    "(default: along the data's own envelope)")
     sp.add_argument("--validate", metavar="DATA2.csv",
                     help="data not used in the fit: predicted against measured torques")
     sp.add_argument("--cutoff-hz", type=float, default=None,
@@ -33,6 +38,7 @@ def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
     from ..identification.data import read_motion_csv
     from ..identification.fit import identify
     from ..output.identification import IdentificationReport, write_identification
+    from .excite import task_motion
 
     cutoff = args.cutoff_hz
     if cutoff is not None and not (np.isfinite(cutoff) and cutoff > 0):
@@ -41,7 +47,9 @@ def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
     model = sc.si_model
     data = read_motion_csv(args.data)
     vdata = read_motion_csv(args.validate) if args.validate else None
-    res = identify(data, model, mode=sc.mode, cutoff_hz=cutoff)
+    reference = None if args.task is None else task_motion(args.task, sc)
+    res = identify(data, model, mode=sc.mode, cutoff_hz=cutoff, reference=reference,
+                   reference_name=f"the task {args.task}")
     rep = IdentificationReport.of(res, data, model, sc.mode, args.data, args.config, vdata,
                                   args.validate)
     comment = (f"identified by dextar from {args.data} ({res.method}, condition number "
@@ -54,13 +62,13 @@ def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
     lines = rep.lines()
     lines.append(f"wrote {shown(args.out, 'identified.toml')}, parameters.csv, summary.json"
                  + (", fit.png, report.html" if figures else ""))
-    poor = res.message if res.status == 3 else None  # computed, but it does not explain
-    warnings = [f"dextar identify: {w}" if w == poor else f"dextar identify: warning: {w}"
-                for w in rep.summary["warnings"]]  # the poor fit's message names itself
+    # each reason the status is not "identified" names itself; the rest are warnings
+    warnings = [f"dextar identify: {w}" if w in res.reasons else f"dextar identify: warning: {w}"
+                for w in rep.summary["warnings"]]
     if args.config is None and args.model is None:
         g = sc.robot_mm
         warnings.insert(0, f"dextar identify: note: no --config: the robot is assumed to be "
                         f"the DexTAR (l1 = {g.l1:g}, l2 = {g.l2:g}, L1 = {g.L1:g}, L2 = "
                         f"{g.L2:g}, d = {g.d:g} mm, working mode {sc.mode}) without gravity; "
                         "give the robot's config with --config")
-    return Result(rep.summary, "\n".join(lines), warnings, code=1 if res.status == 3 else 0)
+    return Result(rep.summary, "\n".join(lines), warnings, code=0 if res.success else 1)

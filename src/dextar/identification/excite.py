@@ -36,6 +36,29 @@ Two more terms in the cost, each zero when met:
 
 The result reports the headroom used, the fraction of the region's poses within its radius
 of the motion (:mod:`~dextar.identification.coverage`'s rule) and the speeds reached.
+
+**Coverage floors** (:func:`check_coverage`): each motor's range, peak speed and peak
+acceleration must reach :data:`RANGE_FLOOR`, :data:`SPEED_FLOOR` and
+:data:`ACCELERATION_FLOOR` of what is allowed (:func:`allowed_motion`: the task region's
+range, else the motor's free range from the rest pose; the top harmonic sweeping it, capped
+by the motors), and the condition number stay below :data:`COND_CEILING`. A design that
+misses them (a local optimum: the optimiser is chaotic to one rounding unit) is made again
+from starts drawn from ``(seed, attempt)``, deterministic, up to :data:`ATTEMPTS` designs;
+the one closest to the floors is kept and, still short, its status is 2.
+
+Measured (``benchmarks/bench_excite_seeds.py``, 20 seeds, 15 s, 5 harmonics of 0.2 Hz): on
+issue 28's 80/75/95/92/58 mm robot the designs reach a median of about 90 % / 60 % of the
+range, 50 % / 30 % of the speed, 30 % / 20 % of the acceleration (motor A / D); the issue's
+motion (19 deg on motor D, 0.9 rad/s) is 16 % / 13 % of motor D's range and speed, and 4
+of 20 first designs miss a floor like it (seeds 1, 3, 5, 17: 13-20 % of a motor's speed or
+range, 8-9 % of its acceleration); redesigned, they reach 16-123 %. The floors sit at about
+a third of the median. Identified from MuJoCo's data with 50 mN m of torque noise, the worst
+prediction error of an unseen line and arc over the 20 seeds: 1.0 / 0.80 % with the first
+designs, 1.0 / 0.68 % with the designs kept (seed 1, the issue's kind of motion: 0.49 / 0.80
+% before, 0.33 / 0.58 % redesigned). On a flat 120/180 mm robot with dry friction 1 seed of
+20 is redesigned (16 % of motor A's range); there the worst error, 3.8 / 4.8 %, is the
+torque noise on its small torques, not the excitation. On the pick-and-place robot the
+stored excitations reach 32-90 %, 36-99 % and 13-33 %.
 """
 
 from __future__ import annotations
@@ -76,6 +99,17 @@ RESTARTS = 1
 MAX_EVALUATIONS = 500
 #: A motion grown towards the motors' headroom may lose this factor of condition number.
 GROW_COND = 1.25
+#: Coverage floors: each motor's range, peak speed and peak acceleration as fractions of what
+#: the region and the motors allow (:func:`allowed_motion`), and the largest condition number
+#: (see the module doc for the measurements behind them).
+RANGE_FLOOR = 0.2
+SPEED_FLOOR = 0.2
+ACCELERATION_FLOOR = 0.1
+COND_CEILING = 20.0
+#: Further designs (each from its own deterministic starts) when a design misses a floor.
+ATTEMPTS = 4
+#: Joint-space grid (points per motor over a turn) of the region the motion may use.
+REGION_GRID = 121
 
 
 @dataclass(frozen=True)
@@ -142,8 +176,9 @@ class ExcitationResult:
         Predicted by the model.
     peak_speed : ndarray, shape (2,)
     status : int
-        0 success (a start converged; the best feasible point any start met is kept); 1 no
-        start converged (the best feasible point met is kept).
+        0 success (a start converged, every coverage floor met); 1 no start converged (the
+        best feasible point met is kept; every floor met); 2 a coverage floor missed after
+        :data:`ATTEMPTS` designs (the design closest to the floors is kept).
     message : str
     headroom : ndarray, shape (2,)
         Each motor's peak use of its limits (``max`` over the motion of ``|tau| /`` available
@@ -154,6 +189,10 @@ class ExcitationResult:
     region_speed_ratio : ndarray, shape (2,)
         Each motor's peak speed over the region's (``nan`` without a region); below 1 where
         the motors' safe speed is below the task's.
+    coverage : ExcitationCoverage
+        Range, speed, acceleration against the floors (:func:`check_coverage`).
+    attempts : int
+        Designs made (1 when the seed's own met every floor).
     """
 
     trajectory: FourierTrajectory
@@ -168,6 +207,8 @@ class ExcitationResult:
     headroom: Array = field(default_factory=lambda: np.full(2, np.nan))
     region_coverage: float = math.nan
     region_speed_ratio: Array = field(default_factory=lambda: np.full(2, np.nan))
+    coverage: ExcitationCoverage | None = None
+    attempts: int = 1
 
     @property
     def duration(self) -> float:
@@ -273,6 +314,139 @@ def _region_cost(region: JointRegion, q: Array, peak_speed: Array, safe_speed: A
     return float((far ** 2).mean() + (short ** 2).sum())
 
 
+@dataclass(frozen=True)
+class Allowed:
+    """What the region and the motors allow each motor (shape (2,) each): the joint range
+    (rad), the peak speed (rad/s) and the peak acceleration (rad/s^2) of an excitation of
+    ``harmonics`` harmonics of ``base_hz`` (see :func:`allowed_motion`)."""
+
+    range: Array
+    speed: Array
+    acceleration: Array
+
+
+@dataclass(frozen=True)
+class ExcitationCoverage:
+    """An excitation's coverage against the floors.
+
+    Attributes
+    ----------
+    range, speed, acceleration : ndarray, shape (2,)
+        Each motor's joint range (rad), peak speed (rad/s) and peak acceleration (rad/s^2).
+    allowed : Allowed
+    fractions : dict of str to ndarray (2,)
+        ``range``, ``speed``, ``acceleration`` over the allowed.
+    missed : tuple of str
+        The floors missed, in words (empty when every floor is met).
+    """
+
+    range: Array
+    speed: Array
+    acceleration: Array
+    allowed: Allowed
+    fractions: dict[str, Array]
+    missed: tuple[str, ...]
+
+    @property
+    def met(self) -> bool:
+        """True when every floor is met."""
+        return not self.missed
+
+
+def free_range(model: Model, q0: Array, resolution: int = REGION_GRID) -> Array:
+    """Each motor's free range (rad, shape (2,)) from the rest pose ``q0``: the interval of
+    its angle, the other motor at rest, that contains ``q0`` and stays :data:`MARGIN` from
+    both singularity types (so in its working and assembly modes), on a grid of
+    ``6 resolution`` points over a turn (a whole turn at most)."""
+    g = np.linspace(-math.pi, math.pi, 6 * resolution + 1)
+    mid = len(g) // 2
+    out = np.zeros(2)
+    r = model.robot
+    for k in range(2):
+        q = np.repeat(np.asarray(q0, float)[None, :], len(g), axis=0)
+        q[:, k] += g
+        B, C = elbows(r, q)
+        d2 = ((B - C) ** 2).sum(axis=1)
+        ok = (d2 < (r.L1 + r.L2) ** 2 * (1 - 1e-9)) & (d2 > (r.L1 - r.L2) ** 2 * (1 + 1e-9))
+        f = _feasibility(model, q[ok])
+        free = np.zeros(len(g), bool)
+        if f is not None:
+            free[ok] = (f[0] >= MARGIN) & (f[1] >= MARGIN)
+        if not free[mid]:
+            continue
+        lo = mid - int(np.argmin(free[mid::-1])) if not free[:mid + 1].all() else 0
+        hi = mid + int(np.argmin(free[mid:])) if not free[mid:].all() else len(g)
+        out[k] = min((hi - lo) * (g[1] - g[0]), 2 * math.pi)
+    return out
+
+
+def allowed_motion(model: Model, q0: Array, harmonics: int, base_hz: float,
+                   motors: MotorLimits | None, region: JointRegion | None,
+                   safety: float = SAFETY) -> Allowed:
+    """What the region and the motors allow each motor of an excitation of ``harmonics``
+    harmonics of ``base_hz`` resting at ``q0``:
+
+    * range: the task region's extent (``region``), else :func:`free_range` (each motor
+      alone from the rest pose);
+    * speed: the top harmonic sweeping that range, ``pi N f R``, capped at ``safety`` of the
+      motor's maximum speed;
+    * acceleration: the same, ``2 pi^2 (N f)^2 R``, capped at what ``safety`` of the peak
+      torque, less the gravity torque at rest, gives the motor's own inertia at ``q0``
+      (``M_kk``)."""
+    from ..dynamics.exact import gravity_torques, mass_matrix
+
+    R = (np.asarray(region.upper - region.lower, float) if region is not None
+         else free_range(model, q0))
+    w = math.pi * harmonics * base_hz
+    speed = w * R
+    acc = 2.0 * w * w * R
+    if motors is not None:
+        speed = np.minimum(speed, safety * np.asarray(motors.max_speed, float))
+        g = np.abs(gravity_torques(model, q0))
+        M = np.diag(mass_matrix(model, q0))
+        peak = np.asarray(motors.peak_torque, float)
+        acc = np.minimum(acc, np.maximum(safety * peak - g, 0.0) / M)
+    return Allowed(np.asarray(R, float), np.asarray(speed, float), np.asarray(acc, float))
+
+
+def check_coverage(tr: FourierTrajectory, allowed: Allowed, cond: float) -> ExcitationCoverage:
+    """The excitation's range, peak speed and acceleration (on a fine grid of a period)
+    against :data:`RANGE_FLOOR`, :data:`SPEED_FLOOR`, :data:`ACCELERATION_FLOOR` of the
+    allowed, and its condition number against :data:`COND_CEILING`."""
+    t = np.linspace(0.0, tr.period, 40 * GRID_PER_HARMONIC * tr.a.shape[1], endpoint=False)
+    q, dq, ddq = tr.evaluate(t)
+    got = {"range": np.ptp(q, axis=0), "speed": np.abs(dq).max(axis=0),
+           "acceleration": np.abs(ddq).max(axis=0)}
+    ref = {"range": allowed.range, "speed": allowed.speed,
+           "acceleration": allowed.acceleration}
+    floors = {"range": RANGE_FLOOR, "speed": SPEED_FLOOR, "acceleration": ACCELERATION_FLOOR}
+    units = {"range": "deg", "speed": "rad/s", "acceleration": "rad/s^2"}
+    fractions: dict[str, Array] = {}
+    missed: list[str] = []
+    for key, v in got.items():
+        with np.errstate(divide="ignore", invalid="ignore"):
+            frac = np.where(ref[key] > 0, v / np.where(ref[key] > 0, ref[key], 1.0), math.inf)
+        fractions[key] = np.asarray(frac)
+        for k, name in enumerate(("A", "D")):
+            if frac[k] < floors[key]:
+                scale = math.degrees(1.0) if key == "range" else 1.0
+                missed.append(f"motor {name}'s {key} {scale * v[k]:.3g} {units[key]} is "
+                              f"{100 * frac[k]:.3g} % of the {scale * ref[key][k]:.3g} "
+                              f"{units[key]} allowed (floor {100 * floors[key]:g} %)")
+    if not cond <= COND_CEILING:
+        missed.append(f"condition number {cond:.3g} above {COND_CEILING:g}")
+    return ExcitationCoverage(got["range"], got["speed"], got["acceleration"], allowed, fractions,
+                    tuple(missed))
+
+
+def _score(cov: ExcitationCoverage, cond: float) -> tuple[int, float, float]:
+    """Ranks designs: fewer floors missed, then the smallest shortfall, then the condition
+    number."""
+    floors = {"range": RANGE_FLOOR, "speed": SPEED_FLOOR, "acceleration": ACCELERATION_FLOOR}
+    short = min(float((cov.fractions[k] / f).min()) for k, f in floors.items())
+    return len(cov.missed), -min(short, 1.0), cond
+
+
 def design_excitation(model: Model, mode: str, *, harmonics: int = 5, base_hz: float = 0.2,
                       duration: float = 20.0, motors: MotorLimits | None = None,
                       seed: int = 0, starts: int = 3, q0: Array | None = None,
@@ -325,8 +499,22 @@ def design_excitation(model: Model, mode: str, *, harmonics: int = 5, base_hz: f
     q0 = rest_pose(model, mode) if q0 is None else np.asarray(q0, float)
     problem = _Problem(model, base, np.asarray(q0, float), harmonics, base_hz, motors, safety,
                        region)
-    best, converged = _optimise(problem, seed, starts)
-    tr, q, dq, ddq, f, cond = _finalise(problem, best)
+    allowed = allowed_motion(model, np.asarray(q0, float), harmonics, base_hz, motors, region,
+                             safety)
+    chosen = None
+    for attempt in range(ATTEMPTS):
+        # the first attempt is the seed's own; the others draw their starts from
+        # (seed, attempt): deterministic, and each a new set of local optima
+        problem.restart()
+        best, ok = _optimise(problem, seed if attempt == 0 else (seed, attempt), starts)
+        fin = _finalise(problem, best)
+        cov = check_coverage(fin[0], allowed, fin[5])
+        if chosen is None or _score(cov, fin[5]) < _score(chosen[1], chosen[0][5]):
+            chosen = (fin, cov, ok, attempt + 1)
+        if cov.met:
+            break
+    assert chosen is not None
+    (tr, q, dq, ddq, f, cond), cover, converged, attempts = chosen
     tau = inverse_dynamics(model, q, dq, ddq)
     periods = max(1, int(math.ceil(duration * base_hz - 1e-9)))
     headroom = (np.full(2, np.nan) if motors is None
@@ -338,12 +526,20 @@ def design_excitation(model: Model, mode: str, *, harmonics: int = 5, base_hz: f
         with np.errstate(divide="ignore", invalid="ignore"):
             speed_ratio = np.where(region.peak_speed > 0, mine.peak_speed / region.peak_speed,
                                    np.inf)
+    if not cover.met:
+        status, message = 2, (f"the excitation misses its coverage floors after {attempts} "
+                              f"designs: {'; '.join(cover.missed)}; an identification from "
+                              "it may be poorly determined (a longer --duration, another "
+                              "--base-hz or more --harmonics may reach them)")
+    elif converged:
+        status, message = 0, "optimised; every coverage floor met"
+    else:
+        status, message = 1, ("no start of the optimiser converged; the best feasible "
+                              "trajectory met is kept (every coverage floor met)")
     return ExcitationResult(tr, cond, periods, float(f[0].min()),
                             float(f[1].min()), np.abs(tau).max(axis=0),
-                            np.abs(dq).max(axis=0), 0 if converged else 1,
-                            "optimised" if converged else "no start of the optimiser "
-                            "converged; the best feasible trajectory met is kept", headroom,
-                            covered, speed_ratio)
+                            np.abs(dq).max(axis=0), status, message, headroom,
+                            covered, speed_ratio, cover, attempts)
 
 
 def _check_options(harmonics: int, base_hz: float, duration: float, safety: float) -> None:
@@ -442,7 +638,7 @@ def _log_condition(model: Model, base: BaseParameters, q: Array, dq: Array,
     return 1e3 if sv is None else float(np.log(sv[0] / max(sv[-1], 1e-300)))
 
 
-def _optimise(pb: _Problem, seed: int, starts: int) -> tuple[Array, bool]:
+def _optimise(pb: _Problem, seed: int | tuple[int, int], starts: int) -> tuple[Array, bool]:
     """The best feasible free coefficients over ``starts`` random starts, and whether a start
     converged (the best point found is at least as good)."""
     rng = np.random.default_rng(seed)

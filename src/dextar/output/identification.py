@@ -19,7 +19,12 @@ from ..dynamics import Model, inverse_dynamics
 from ..dynamics.regressor import NAMES
 from ..identification.data import MotionData
 from ..identification.excite import ExcitationResult
-from ..identification.fit import IdentificationResult, Validation
+from ..identification.fit import (
+    RESIDUAL_FACTOR,
+    UNCERTAINTY_LIMIT,
+    IdentificationResult,
+    Validation,
+)
 from ..identification.fit import validate as validate_fit
 from .config_file import toml_number as _num
 from .files import OutputDir
@@ -51,9 +56,42 @@ def excitation_payload(res: ExcitationResult, harmonics: int, base_hz: float, sa
             "status": res.status, "message": res.message, "out": out,
             "headroom": [float(v) for v in res.headroom],
             "headroom_note": "each motor's peak use of its torque (at its speed) and speed",
+            "attempts": res.attempts,
+            **({} if res.coverage is None else {"coverage": _coverage(res)}),
             **({} if math.isnan(res.region_coverage) else {
                 "task_coverage": res.region_coverage,
                 "task_speed_ratio": [float(v) for v in res.region_speed_ratio]})}
+
+
+def _coverage(res: ExcitationResult) -> dict[str, Any]:
+    """The excitation's coverage against its floors (JSON)."""
+    from ..identification.excite import (
+        ACCELERATION_FLOOR,
+        COND_CEILING,
+        RANGE_FLOOR,
+        SPEED_FLOOR,
+    )
+
+    c = res.coverage
+    assert c is not None
+    return {"floors": {"range": RANGE_FLOOR, "speed": SPEED_FLOOR,
+                       "acceleration": ACCELERATION_FLOOR, "condition_number": COND_CEILING},
+            "range_deg": [float(v) for v in np.degrees(c.range)],
+            "allowed_range_deg": [float(v) for v in np.degrees(c.allowed.range)],
+            "peak_speed_rad_s": [float(v) for v in c.speed],
+            "allowed_speed_rad_s": [float(v) for v in c.allowed.speed],
+            "peak_acceleration_rad_s2": [float(v) for v in c.acceleration],
+            "allowed_acceleration_rad_s2": [float(v) for v in c.allowed.acceleration],
+            "fractions": {k: [float(x) for x in v] for k, v in c.fractions.items()},
+            "met": c.met, "missed": list(c.missed),
+            "note": "each motor's range, peak speed and peak acceleration over what the "
+                    "task region (or the free range from the rest pose) and the motors "
+                    "allow; a design that misses a floor is made again from new "
+                    "deterministic starts"}
+
+
+def _finite(v: float) -> float | None:
+    return float(v) if math.isfinite(v) else None
 
 
 def _rms(x: Array) -> list[float]:
@@ -90,6 +128,19 @@ class IdentificationReport:
             "fit_quality": [float(v) for v in res.fit_quality],
             "fit_quality_note": "RMS residual / RMS torque per motor (motor A, motor D)",
             "torque_scale": [float(v) for v in res.torque_scale],
+            "torque_noise_Nm": [float(v) for v in res.torque_noise],
+            "explained_fit_quality": [float(v) for v in res.explained_quality],
+            "explained_fit_quality_note": (
+                "the fit quality the torques' noise (after the parallel filter) and the "
+                f"filters explain; a poor fit beyond {RESIDUAL_FACTOR:g}x it"),
+            "prediction_uncertainty": [_finite(v) for v in res.uncertainty],
+            "prediction_uncertainty_reference": res.reference,
+            "prediction_uncertainty_limit": UNCERTAINTY_LIMIT,
+            "prediction_uncertainty_note": (
+                "RMS standard deviation of the torques predicted along the reference over "
+                "their RMS, per motor (the parameters' covariance propagated)"),
+            "reasons": list(res.reasons),
+            "unphysical_distance_sigmas": res.unphysical_distance,
             "poorly_determined": list(res.poorly_determined),
             "base_parameters": [{"name": n, "meaning": m, "unit": u, "value": float(v),
                                  "std": float(s),
@@ -129,7 +180,11 @@ class IdentificationReport:
                  f"parallel filter {res.parallel_hz:.3g} Hz): {res.method}, condition number "
                  f"{res.condition_number:.4g}, RMS residual {res.rms_residual[0]:.4g}, "
                  f"{res.rms_residual[1]:.4g} N m, fit quality {res.fit_quality[0]:.2%}, "
-                 f"{res.fit_quality[1]:.2%} of the RMS torques",
+                 f"{res.fit_quality[1]:.2%} of the RMS torques (noise and filters explain "
+                 f"{res.explained_quality[0]:.2%}, {res.explained_quality[1]:.2%}); "
+                 f"predicted torques along {res.reference} uncertain by "
+                 f"{res.uncertainty[0]:.2%}, {res.uncertainty[1]:.2%} of their RMS (limit "
+                 f"{UNCERTAINTY_LIMIT:.0%})",
                  *(f"  {n:<7} = {v: .6g} +- {sd:.2g} {u}  ({m})" for n, m, u, v, sd in
                    zip(res.base.names, res.base.meanings, res.base.units, res.beta, res.std,
                        strict=True))]
@@ -222,6 +277,12 @@ def identification_report(summary: Mapping[str, Any], pngs: dict[str, bytes]) ->
              ("RMS residual [N m]", ", ".join(f"{v:.4g}" for v in summary["rms_residual_Nm"])),
              ("fit quality: RMS residual / RMS torque",
               ", ".join(f"{v:.3%}" for v in summary["fit_quality"])),
+             ("fit quality the noise and filters explain",
+              ", ".join(f"{v:.3%}" for v in summary["explained_fit_quality"])),
+             (f"predicted-torque uncertainty along {summary['prediction_uncertainty_reference']}"
+              f" (limit {summary['prediction_uncertainty_limit']:.0%})",
+              ", ".join("inf" if v is None else f"{v:.3%}"
+                        for v in summary["prediction_uncertainty"])),
              ("parameters with a relative std above 50 %",
               ", ".join(summary["poorly_determined"]) or "none")]
     if "validation_rms_error_Nm" in summary:

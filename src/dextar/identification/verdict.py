@@ -1,0 +1,104 @@
+"""The figures behind an identification's verdict: what the model will predict, what the
+residual should be, and whether the time base is plausible.
+
+* :func:`prediction_uncertainty`: the parameter covariance propagated to a reference motion,
+  ``sqrt(mean_s Y_b(s) C Y_b(s)^T)`` per motor over the RMS torque the model predicts along
+  it. The reference is the task the model is for (``dextar identify --task``) or, without
+  one, the excitation's own envelope (:func:`envelope`): the poses the data visited, with
+  speeds and accelerations drawn within each motor's peaks, independently of the pose, so
+  that a parameter the data confirm only in one combination of pose and motion shows its
+  spread.
+* :func:`torque_noise`: the standard deviation of the measured torques' noise after the
+  parallel filter, from the torques' spectrum floor (the median density over the top 40 %
+  of the band, where no motion is) through the filter's noise gain: the residual a perfect
+  model would leave.
+* :func:`check_time_base`: a sample rate below :data:`MIN_RATE_HZ` with joint speeds below
+  :data:`SLOW_SPEED` (rad/s) is a time column in another unit (milliseconds read as
+  seconds), refused with the rates it would have in milliseconds.
+
+The thresholds that turn these figures into a verdict are in :mod:`dextar.identification.fit`
+with the cases that justify them.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .._arrays import Array
+from ..dynamics.exact import Model
+from ..dynamics.regressor import regressor
+from ..errors import ParameterError
+from .base import BaseParameters
+from .data import MotionData
+from .filtering import Conditioned, filtered_noise, noise_floor
+
+#: Samples of the excitation's envelope (a fixed seed: the same reference for the same data).
+ENVELOPE_SAMPLES = 2000
+#: Below this sample rate (Hz) with joints slower than :data:`SLOW_SPEED` the time column is
+#: questioned (drives log at 100 Hz to 10 kHz).
+MIN_RATE_HZ = 20.0
+#: Peak joint speed (rad/s, 2.9 deg/s) below which data sampled under :data:`MIN_RATE_HZ`
+#: are taken for a time column in milliseconds. The excitations measured move at 0.9-2.8
+#: rad/s (18x above it); the same data with the time in milliseconds at 0.0009-0.0028 (18x
+#: below).
+SLOW_SPEED = 0.05
+
+
+def envelope(c: Conditioned, *, samples: int = ENVELOPE_SAMPLES, seed: int = 0
+             ) -> tuple[Array, Array, Array]:
+    """The excitation's envelope: ``samples`` states ``(q, dq, ddq)`` (each (n, 2)), the poses
+    drawn from the conditioned rows, each motor's speed and acceleration uniform within its
+    peak over those rows."""
+    rng = np.random.default_rng(seed)
+    i = rng.integers(0, len(c.q), size=samples)
+    vmax = np.abs(c.dq).max(axis=0)
+    amax = np.abs(c.ddq).max(axis=0)
+    dq = rng.uniform(-1.0, 1.0, size=(samples, 2)) * vmax
+    ddq = rng.uniform(-1.0, 1.0, size=(samples, 2)) * amax
+    return np.asarray(c.q[i]), dq, ddq
+
+
+def prediction_uncertainty(model: Model, base: BaseParameters, beta: Array, cov: Array,
+                           q: Array, dq: Array, ddq: Array) -> tuple[Array, Array]:
+    """Per motor, the RMS standard deviation of the torques predicted along ``q, dq, ddq``
+    (each (n, 2), SI) by the base parameters ``beta`` of covariance ``cov`` (N m), and the
+    RMS of those torques (N m): ``(std (2,), rms (2,))``."""
+    Yb = base.columns(regressor(model, q, dq, ddq))  # (n, 2, p)
+    var = np.einsum("nkp,pq,nkq->nk", Yb, cov, Yb)
+    std = np.sqrt(np.clip(var, 0.0, None).mean(axis=0))
+    rms = np.sqrt(((Yb @ beta) ** 2).mean(axis=0))
+    return np.asarray(std), np.asarray(rms)
+
+
+def torque_noise(data: MotionData, parallel_hz: float) -> Array:
+    """Standard deviation (N m) of each motor's torque noise after the parallel filter at
+    ``parallel_hz`` (white noise of the torques' spectrum floor), shape (2,)."""
+    fs = data.rate_hz
+    floor = noise_floor(data.tau, fs)[2]
+    return np.asarray(filtered_noise(floor, parallel_hz, fs, derivative=False))
+
+
+def peak_speed(data: MotionData) -> Array:
+    """Each motor's 99th-percentile speed (rad/s) from the angles' differences over the time
+    column's (the time base in question; measured rates are not used), shape (2,)."""
+    v = np.abs(np.diff(data.q, axis=0)) / np.diff(data.t)[:, None]
+    return np.asarray(np.percentile(v, 99.0, axis=0))
+
+
+def check_time_base(data: MotionData) -> None:
+    """Raise :class:`ParameterError` when the sample rate and the joint speeds together say
+    the time column is not in seconds (see the module doc)."""
+    rate = data.rate_hz
+    v = peak_speed(data)
+    if rate < MIN_RATE_HZ and float(v.max()) < SLOW_SPEED:
+        step = 1.0 / rate
+        raise ParameterError(
+            f"{data.source}: t_s advances {step:.6g} s per sample (a sample rate of "
+            f"{rate:.4g} Hz) while the joints move at most {v[0]:.3g} / {v[1]:.3g} rad/s "
+            f"({math.degrees(v[0]):.3g} / {math.degrees(v[1]):.3g} deg/s, motor A / D): no "
+            f"drive logs this slowly (below {MIN_RATE_HZ:g} Hz with joints below "
+            f"{SLOW_SPEED:g} rad/s). Is the time in milliseconds? Read as milliseconds, the "
+            f"data run at {1e3 * rate:.4g} Hz and {1e3 * v.max():.3g} rad/s; divide t_s by "
+            "1000")
