@@ -68,6 +68,7 @@ class Registry(MutableMapping[str, T], Generic[T]):
         self.group = group
         self._items: dict[str, T] = {}
         self._plugins_loaded = group is None
+        self._plugin_error: PluginError | None = None
 
     def register(self, item: T, name: str | None = None) -> T:
         """Add ``item`` under ``name`` (default ``item.name``); a later registration of the
@@ -95,6 +96,8 @@ class Registry(MutableMapping[str, T], Generic[T]):
     def load_plugins(self) -> None:
         """Load the entry points of the registry's group (once; each plugin's callable
         registers its items)."""
+        if self._plugin_error is not None:  # said again at every use, never half loaded
+            raise self._plugin_error
         if self._plugins_loaded:
             return
         self._plugins_loaded = True  # first: a plugin may consult the registry it extends
@@ -103,11 +106,11 @@ class Registry(MutableMapping[str, T], Generic[T]):
             try:
                 register: Callable[[], object] = ep.load()
                 register()
-            except DextarError:
-                raise
             except Exception as exc:
-                raise PluginError(f"plugin {ep.name!r} of {self.group} ({ep.value}) failed to "
-                                  f"load: {type(exc).__name__}: {exc}") from exc
+                self._plugin_error = PluginError(
+                    f"plugin {ep.name!r} of {self.group} ({ep.value}) failed to load: "
+                    f"{type(exc).__name__}: {exc}")
+                raise self._plugin_error from exc
 
     def __getitem__(self, name: str) -> T:
         if name not in self._items:  # (a package registering its own items loads no plugin)
