@@ -43,6 +43,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .._arrays import Array
+from .._lazy import lazy_module
 from ..errors import AssemblyError, DextarError, ParameterError, ReachError
 from ..geometry import parse_working_mode
 from .data import PoseData, rows_text
@@ -70,6 +71,9 @@ from .observability import (
     multiple_correlation,
     observability,
 )
+
+optimize = lazy_module("scipy.optimize")
+stats = lazy_module("scipy.stats")
 
 #: A row farther from its prediction than this many residual scales is an outlier (the
 #: scale is the per-axis standard deviation estimated from the median error; for Gaussian
@@ -400,7 +404,6 @@ class _Fit:
 
 def _solve(p0: Array, free: Sequence[int], R: Array, M: Array, a: Array, W: Array | None,
            *, loss: str = "linear", f_scale: float = 1.0, max_nfev: int = 200) -> _Fit:
-    from scipy.optimize import least_squares
 
     S = _variable_scales(p0)[list(free)]
     idx = list(free)
@@ -422,7 +425,7 @@ def _solve(p0: Array, free: Sequence[int], R: Array, M: Array, a: Array, W: Arra
 
     method = "lm" if loss == "linear" else "trf"
     with np.errstate(all="ignore"):
-        r = least_squares(fun, np.zeros(len(idx)), jac=jac, method=method, loss=loss,
+        r = optimize.least_squares(fun, np.zeros(len(idx)), jac=jac, method=method, loss=loss,
                           f_scale=f_scale, xtol=1e-12, ftol=1e-12, gtol=1e-12,
                           max_nfev=max_nfev)
     p = params(r.x)
@@ -901,9 +904,8 @@ def _chi_square(f: _Fitted, rss: float, dof: int, s2: float) -> tuple[float | No
     status, message = f.fit.status, f.fit.message
     if f.W is None:
         return None, status, message
-    from scipy.stats import chi2 as chi2_dist
 
-    pval = float(chi2_dist.sf(rss, dof))
+    pval = float(stats.chi2.sf(rss, dof))
     if status == 0 and pval < CHI2_ALPHA:
         return s2, 2, (f"the residuals are {math.sqrt(s2):.3g} times what the stated noise "
                        f"explains (chi-square p = {pval:.2g}): the model misses something (a "

@@ -67,9 +67,9 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import optimize
 
 from .._arrays import Array
+from .._lazy import lazy_module
 from ..dynamics.exact import Model, inverse_dynamics
 from ..dynamics.regressor import regressor
 from ..errors import ParameterError
@@ -78,6 +78,8 @@ from ..kinematics.checker import pose_distances
 from ..laws import MotorLimits
 from .base import BaseParameters, base_parameters
 from .coverage import JointRegion
+
+optimize = lazy_module("scipy.optimize")
 
 #: Smallest normalised distance to either singularity type along an exciting trajectory.
 MARGIN = 0.15

@@ -83,13 +83,16 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import ndimage, signal
 
 from .._arrays import Array
+from .._lazy import lazy_module
 from ..dynamics.exact import Model
 from ..dynamics.regressor import regressor
 from ..errors import NumericalError, ParameterError
 from .data import MotionData
+
+ndimage = lazy_module("scipy.ndimage")
+signal = lazy_module("scipy.signal")
 
 #: The state filter's cut-off never exceeds this fraction of the sample rate.
 STATE_FRACTION = 0.1

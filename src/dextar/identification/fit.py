@@ -88,9 +88,9 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import optimize
 
 from .._arrays import Array
+from .._lazy import lazy_module
 from ..dynamics.exact import Model
 from ..dynamics.inertia import Inertia, Rod
 from ..dynamics.regressor import INDEX, STANDARD, standard_parameters
@@ -102,6 +102,8 @@ from .data import MotionData
 from .filtering import Conditioned, Filters, condition, default_cutoff
 from .modes import check_modes
 from .verdict import check_time_base, envelope, prediction_uncertainty, torque_noise
+
+optimize = lazy_module("scipy.optimize")
 
 __all__ = ["COND_WARNING", "Conditioned", "Filters", "IdentificationResult", "POOR_FIT",
            "STATUS", "Validation", "check_modes", "check_working_mode", "condition",

@@ -49,10 +49,14 @@ import numpy as np
 from numpy.polynomial import chebyshev as cheb
 
 from .._arrays import Array
+from .._lazy import lazy_module
 from ..errors import ConvergenceError, ParameterError
 from ..paths import Path
 from ..units import Units
 from .base import Law, _positive, law_cost
+
+integrate = lazy_module("scipy.integrate")
+interpolate = lazy_module("scipy.interpolate")
 
 
 def line_solution(G: float, tau: Array) -> Array:
@@ -785,13 +789,11 @@ def _solve_local(path: Path, S: float, G: float, tol: float) -> _Solution:
     refinement (scipy's solve_bvp), by continuation in the curvature (``kappa -> lam kappa``,
     ``lam`` from 0, the straight line whose solution is exact, to 1) with adaptive steps, at
     most MAX_CONTINUATION_SOLVES solves."""
-    from scipy.integrate import solve_bvp
-    from scipy.interpolate import make_interp_spline
 
     # curvature along the normalised arc length, tabulated once at 4097 nodes and interpolated
     # by a quintic spline (smooth, so the mesh refinement does not chase interpolation kinks)
     grid = np.linspace(0.0, 1.0, 4097)
-    K_of = make_interp_spline(grid, path.curvature(path.parameter_at(grid * S))[0] * S, k=5)
+    K_of = interpolate.make_interp_spline(grid, path.curvature(path.parameter_at(grid * S))[0] * S, k=5)
     Ks_of = K_of.derivative()
 
     def curvature(sig: Array) -> tuple[Array, Array]:
@@ -822,7 +824,7 @@ def _solve_local(path: Path, S: float, G: float, tol: float) -> _Solution:
     lam, step, solves = 0.0, 1.0, 0
     while lam < 1.0:
         target = min(1.0, lam + step)
-        trial = solve_bvp(make(target), bc, mesh, guess, tol=tol if target == 1.0 else 1e-5,
+        trial = integrate.solve_bvp(make(target), bc, mesh, guess, tol=tol if target == 1.0 else 1e-5,
                           max_nodes=50_000)
         solves += 1
         if trial.success:

@@ -11,12 +11,12 @@ import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from matplotlib.figure import Figure
 
 from .._arrays import Array
+from .._lazy import lazy_module
 from ..calibration.accuracy import AccuracyMap
 from ..calibration.data import PoseData, rows_text
 from ..calibration.fit import CalibrationResult, Errors
@@ -27,6 +27,13 @@ from ..geometry import WORKING_MODES, FiveBar
 from .config_file import toml_number as _num
 from .files import OutputDir
 from .html_page import figures, page
+
+if TYPE_CHECKING:  # the real module; at run time matplotlib is imported where first used
+    import matplotlib.figure as mfigure
+    from matplotlib.figure import Figure
+else:
+    mfigure = lazy_module("matplotlib.figure")
+
 
 #: Colour of each working mode in the figures.
 MODE_COLOURS = {"++": "tab:blue", "+-": "tab:orange", "-+": "tab:green", "--": "tab:red"}
@@ -72,7 +79,7 @@ def poses_summary(sel: PoseSelection) -> dict[str, Any]:
 def poses_figure(sel: PoseSelection, robot: FiveBar) -> Figure:
     """The poses over the legs' reach of ``robot`` (m), coloured by working mode, numbered in
     visiting order (robot frame, mm)."""
-    fig = Figure(figsize=(7.0, 5.6))
+    fig = mfigure.Figure(figsize=(7.0, 5.6))
     ax = fig.subplots()
     _robot_outline(ax, robot)
     P = 1e3 * sel.points
@@ -218,7 +225,7 @@ def residuals_figure(res: CalibrationResult, validation: PoseData | None = None)
     seen (the key gives the scale); a second row for held-out poses (``validation``, the
     :class:`PoseData` of ``res.validation``) when given."""
     rows = 2 if (validation is not None and res.validation is not None) else 1
-    fig = Figure(figsize=(11.0, 4.6 * rows))
+    fig = mfigure.Figure(figsize=(11.0, 4.6 * rows))
     axes = np.atleast_2d(fig.subplots(rows, 2, squeeze=False))
     robot = res.calibrated.robot
     R = res.calibrated.rotation()
@@ -249,7 +256,7 @@ def accuracy_figure(maps: Sequence[AccuracyMap], points: Mapping[str, Array] | N
     n = len(maps)
     cols = 1 if n == 1 else 2
     rows = (n + cols - 1) // cols
-    fig = Figure(figsize=(6.0 * cols, 4.8 * rows))
+    fig = mfigure.Figure(figsize=(6.0 * cols, 4.8 * rows))
     axes = np.atleast_1d(fig.subplots(rows, cols, squeeze=False)).ravel()
     vals = np.concatenate([1e6 * m.std[m.valid] for m in maps]) if maps else np.zeros(0)
     vmax = float(np.quantile(vals, 0.95)) if vals.size else 1.0

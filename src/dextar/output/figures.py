@@ -6,17 +6,24 @@ import io
 import math
 from typing import TYPE_CHECKING, Any
 
-import matplotlib
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
 
 from .._arrays import Array
+from .._lazy import lazy_module
 from ..kinematics import WorkspaceMap, elbows, workspace_map
 
-if TYPE_CHECKING:
+if TYPE_CHECKING:  # the real modules; at run time matplotlib is imported where first used
+    import matplotlib as mpl
+    import matplotlib.backends.backend_agg as backend_agg
+    import matplotlib.figure as mfigure
+    from matplotlib.figure import Figure
+
     from ..analysis import Analysis
     from ..trajectory import Trajectory
+else:
+    mpl = lazy_module("matplotlib")
+    backend_agg = lazy_module("matplotlib.backends.backend_agg")
+    mfigure = lazy_module("matplotlib.figure")
 
 # Figures are matplotlib.figure.Figure objects drawn without pyplot: no global backend or
 # figure registry is touched, as the Matplotlib docs advise for non-interactive output.
@@ -33,8 +40,8 @@ def new_figure(figsize: tuple[float, float], dpi: float = PNG_DPI) -> Figure:
     the layout pass (:func:`tight_layout`) and the PNG then share one renderer, with its
     caches of text extents and parsed mathtext (a figure made without a canvas lays out on
     a renderer of its own at 100 dpi and the PNG parses and measures every text again)."""
-    fig = Figure(figsize=figsize, dpi=dpi)
-    FigureCanvasAgg(fig)
+    fig = mfigure.Figure(figsize=figsize, dpi=dpi)
+    backend_agg.FigureCanvasAgg(fig)
     return fig
 
 
@@ -107,7 +114,7 @@ def fig4(an: Analysis) -> Any:
     ax.plot(tr.P[:, 0], tr.P[:, 1], "k-", lw=1, label="path")
     times = np.linspace(0, an.law.duration, 9)
     idx = [int(np.argmin(np.abs(tr.t - t))) for t in times]
-    colors = matplotlib.colormaps["viridis"](np.linspace(0, 1, len(idx)))
+    colors = mpl.colormaps["viridis"](np.linspace(0, 1, len(idx)))
     for i, c in zip(idx, colors, strict=True):
         B, C = elbows(r, tr.q[i])
         P = tr.P[i]
@@ -191,8 +198,8 @@ def animation_gif(an: Analysis, frames: int = 41) -> bytes:
     draws only the arm and the time over it (blitting), and the frames share one palette.
     """
     tr, r = an.trajectory, an.inputs.robot
-    fig = Figure(figsize=(4.8, 3.6), dpi=80)
-    canvas = FigureCanvasAgg(fig)
+    fig = mfigure.Figure(figsize=(4.8, 3.6), dpi=80)
+    canvas = backend_agg.FigureCanvasAgg(fig)
     ax = fig.subplots()
     ax.plot(tr.P[:, 0], tr.P[:, 1], "k-", lw=0.8)
     ax.plot([r.A[0], r.D[0]], [0, 0], "ks", ms=6)

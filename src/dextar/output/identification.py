@@ -9,12 +9,12 @@ import json
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from matplotlib.figure import Figure
 
 from .._arrays import Array
+from .._lazy import lazy_module
 from ..dynamics import Model, inverse_dynamics
 from ..dynamics.regressor import NAMES
 from ..identification.data import MotionData
@@ -29,6 +29,13 @@ from ..identification.fit import validate as validate_fit
 from .config_file import toml_number as _num
 from .files import OutputDir
 from .html_page import figures, page
+
+if TYPE_CHECKING:  # the real module; at run time matplotlib is imported where first used
+    import matplotlib.figure as mfigure
+    from matplotlib.figure import Figure
+else:
+    mfigure = lazy_module("matplotlib.figure")
+
 
 
 def excitation_columns(model: Model, res: ExcitationResult, rate: float) -> dict[str, Array]:
@@ -235,7 +242,7 @@ def parameters_csv(res: IdentificationResult) -> str:
 def fit_figure(panels: Sequence[tuple[str, Array, Array, Array]]) -> Figure:
     """Measured against predicted torques and their residuals; one column per data set
     ``(title, t (m,), measured (m, 2), predicted (m, 2))``."""
-    fig = Figure(figsize=(5.2 * len(panels), 6.4))
+    fig = mfigure.Figure(figsize=(5.2 * len(panels), 6.4))
     axes = fig.subplots(3, len(panels), squeeze=False, sharex="col")
     for j, (title, t, meas, pred) in enumerate(panels):
         for k, name in enumerate(("motor A", "motor D")):

@@ -11,10 +11,9 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from functools import partial
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from matplotlib.figure import Figure
 
 from .._arrays import Array
 from ..geometry import FiveBar
@@ -25,6 +24,10 @@ from .figures import new_figure, plot_workspace, png_bytes, svg_bytes, tight_lay
 from .files import OutputDir
 from .html_page import figures, grid, page
 from .tables import csv_text
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
 
 #: Every file a program may write (``csp.csv`` and ``pvt.csv`` with a ``[drive]`` table).
 PROGRAM_FILES = ("setpoints.csv", "summary.json", "report.html", "csp.csv", "pvt.csv",

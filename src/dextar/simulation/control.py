@@ -11,13 +11,11 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
-from scipy.integrate import LSODA, OdeSolution
-from scipy.interpolate import CubicHermiteSpline
 
 from .._arrays import Array
+from .._lazy import lazy_module
 from ..dynamics.exact import Model, state_dynamics
 from ..dynamics.forward import SimResult
 from ..errors import (
@@ -31,6 +29,9 @@ from ..geometry import FiveBar
 from ..kinematics import direct_kinematics
 from ..trajectory import Trajectory
 
+integrate = lazy_module("scipy.integrate")
+interpolate = lazy_module("scipy.interpolate")
+
 #: The default tracking tolerance, a fraction of the robot's reach ``max(l1 + L1, l2 + L2)``:
 #: 3 % (4.8 mm on the DexTAR, 9 mm on a 120/180 mm robot). Measured with the default
 #: controller (10 Hz, masses 20 % off, an unknown payload) and the examples' own: the
@@ -42,11 +43,11 @@ from ..trajectory import Trajectory
 #: sets it.
 TRACKING_TOLERANCE = 0.03
 
-#: The plant's integrator: LSODA (Adams, or BDF where dry friction near rest makes the
+#: The plant's integrator (scipy.integrate's solver class of this name): LSODA (Adams, or BDF where dry friction near rest makes the
 #: dynamics stiff). RK45 took 220 s on a 1 s arc of a robot falling to rest against 0.02 N m
 #: of Coulomb friction (its steps held to the friction's time constant); LSODA 3 s, the same
 #: tracking errors to four digits on the examples.
-SOLVER: Any = LSODA
+SOLVER = "LSODA"
 #: Steps after which the plant's integration is stopped (a result: status 1, the files hold
 #: the motion up to there).
 MAX_STEPS = 100_000
@@ -144,8 +145,8 @@ def simulate_computed_torque(trajectory: Trajectory, controller: Model, plant: M
         raise ParameterError(f"tracking tolerance {tolerance!r} must be positive")
     tr = trajectory
     kp, kd = natural_frequency**2, 2.0 * damping * natural_frequency
-    q_d = CubicHermiteSpline(tr.t, tr.q, tr.dq, axis=0)
-    dq_d = CubicHermiteSpline(tr.t, tr.dq, tr.ddq, axis=0)
+    q_d = interpolate.CubicHermiteSpline(tr.t, tr.q, tr.dq, axis=0)
+    dq_d = interpolate.CubicHermiteSpline(tr.t, tr.dq, tr.ddq, axis=0)
     ddq_d = dq_d.derivative()
 
     def control(t: float, q: Array, dq: Array) -> tuple[Array, bool]:
@@ -213,7 +214,7 @@ def _integrate(rhs: Callable[[float, Array], Array], t: Array, y0: Array, *, rto
     """Step the plant from ``t[0]`` towards ``t[-1]``; a singularity met on the way ends the
     integration there (a result, not a failure). Returns the last time reached, the dense
     solution up to it and why it stopped early (None: it did not)."""
-    solver = SOLVER(rhs, float(t[0]), y0, float(t[-1]), rtol=rtol, atol=1e-10,
+    solver = getattr(integrate, SOLVER)(rhs, float(t[0]), y0, float(t[-1]), rtol=rtol, atol=1e-10,
                   max_step=max_step)
     times, pieces = [float(t[0])], []
     stop: str | None = None
@@ -234,5 +235,5 @@ def _integrate(rhs: Callable[[float, Array], Array], t: Array, y0: Array, *, rto
         pieces.append(solver.dense_output())
     if not pieces:
         raise SingularityError(f"the controlled robot cannot start: {stop}")
-    sol = OdeSolution(times, pieces)
+    sol = integrate.OdeSolution(times, pieces)
     return times[-1], (lambda tt: np.asarray(sol(tt))), stop

@@ -24,8 +24,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._arrays import Array
+from .._lazy import lazy_module
 from ..dynamics.exact import Model, inverse_dynamics
 from ..errors import DextarError
+
+integrate = lazy_module("scipy.integrate")
 
 #: ``plan(t (n,)) -> (q, dq, tau)``, each (n, 2): the planned angles, rates and torques at
 #: any times of the motion.
@@ -145,7 +148,6 @@ def replay(model: Model, plan: PlanFunction, edges: Array, peak_acceleration: fl
     ReplayBudgetError
         Past :data:`BUDGET` evaluations.
     """
-    from scipy.integrate import solve_ivp
 
     edges = np.asarray(edges, float)
     start, width = edges[:-1], np.diff(edges)
@@ -205,7 +207,7 @@ def replay(model: Model, plan: PlanFunction, edges: Array, peak_acceleration: fl
 
     # LSODA: Adams while the windows are smooth, BDF where dry friction near rest makes them
     # stiff; the Jacobian is banded (each window's four states, in a row)
-    sol = solve_ivp(rhs, (0.0, 1.0), y0, method="LSODA", rtol=rtol,
+    sol = integrate.solve_ivp(rhs, (0.0, 1.0), y0, method="LSODA", rtol=rtol,
                     atol=np.maximum(atol, 1e-300).reshape(-1), lband=3, uband=3,
                     t_eval=[1.0])
     if sol.status != 0 or sol.y.shape[1] == 0:
