@@ -19,9 +19,10 @@ A plugin that fails to load is a :class:`PluginError` naming the entry point.
 
 from __future__ import annotations
 
+import importlib
 from collections.abc import Callable, Iterator, MutableMapping
 from importlib import metadata
-from typing import Generic, TypeVar
+from typing import Generic, TypeVar, cast
 
 from .errors import ConfigError, DextarError
 
@@ -49,6 +50,18 @@ class PluginError(DextarError):
     """An installed plugin (an entry point) that failed to load or to register its items."""
 
 
+class _Deferred:
+    """An item registered by where it is defined (``"package.module:attribute"``), imported
+    when it is first asked for."""
+
+    def __init__(self, target: str) -> None:
+        self.target = target
+
+    def load(self) -> object:
+        module, _, attribute = self.target.partition(":")
+        return getattr(importlib.import_module(module), attribute)
+
+
 class Registry(MutableMapping[str, T], Generic[T]):
     """Items by name, in registration order, extended by the plugins of one entry-point group.
 
@@ -66,7 +79,7 @@ class Registry(MutableMapping[str, T], Generic[T]):
         self.what = what
         self.key = key
         self.group = group
-        self._items: dict[str, T] = {}
+        self._items: dict[str, T | _Deferred] = {}
         self._plugins_loaded = group is None
         self._plugin_error: PluginError | None = None
 
@@ -81,14 +94,26 @@ class Registry(MutableMapping[str, T], Generic[T]):
         self._items[key] = item
         return item
 
+    def register_deferred(self, name: str, target: str) -> None:
+        """Add the item ``target`` (``"package.module:attribute"``) under ``name``, imported
+        the first time it is asked for: its name is listed (and checked) without importing
+        what defines it."""
+        self._items[name] = _Deferred(target)
+
+    def _resolved(self, name: str) -> T:
+        item = self._items[name]
+        if isinstance(item, _Deferred):
+            item = self._items[name] = cast(T, item.load())
+        return item
+
     def lookup(self, name: object, where: str | None = None) -> T:
         """The item ``name``; an :class:`UnknownNameError` naming ``where`` (default the
         registry's ``key``) and listing the known names otherwise."""
         if isinstance(name, str) and name in self._items:
-            return self._items[name]
+            return self._resolved(name)
         self.load_plugins()
         if isinstance(name, str) and name in self._items:
-            return self._items[name]
+            return self._resolved(name)
         known = tuple(self._items)
         raise UnknownNameError(f"{where or self.key} must be one of {', '.join(known)}, got "
                                f"{name!r}", name, known)
@@ -115,7 +140,7 @@ class Registry(MutableMapping[str, T], Generic[T]):
     def __getitem__(self, name: str) -> T:
         if name not in self._items:  # (a package registering its own items loads no plugin)
             self.load_plugins()
-        return self._items[name]
+        return self._resolved(name)
 
     def __setitem__(self, name: str, item: T) -> None:
         self._items[name] = item

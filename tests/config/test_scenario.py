@@ -6,7 +6,8 @@ import math
 import pytest
 
 from dextar.config import load_robot_table, load_scenario, scenario_from_dict
-from dextar.config.tables import MotorsTable, RobotTable
+from dextar.config.kinematic import RobotTable
+from dextar.config.tables import MotorsTable
 from dextar.errors import ConfigError
 from dextar.program import ProgramRequest
 

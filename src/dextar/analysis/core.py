@@ -37,6 +37,7 @@ from ..kinematics import inverse_kinematics
 from ..kinematics.checker import DEFAULT_TOLERANCES, Tolerances
 from ..laws import Law
 from ..paths import Path
+from ..simulation.replay import replay, replay_edges
 from ..trajectory import Trajectory, path_motion, sample_trajectory
 from ..units import Units
 
@@ -295,8 +296,6 @@ def replay_windows(an: Analysis) -> Array:
     ``1 / rate`` long with ``rate = max |qdot| + sqrt(|g| / l)`` (the velocity products' and
     gravity's growth rates, 1 per run time unit), at least 20 of them
     (:func:`dextar.simulation.replay.replay_edges`)."""
-    from ..simulation.replay import replay_edges
-
     inp, tr = an.inputs, an.trajectory
     g = float(np.hypot(*inp.inertia.gravity))
     rate = float(np.abs(tr.dq).max()) + math.sqrt(g / max(inp.robot.l1, inp.robot.l2))
@@ -308,8 +307,6 @@ def forward_replay(an: Analysis, model: Model | None = None) -> Replay:
     (:mod:`dextar.simulation.replay`): each window starts at the planned state and runs the
     forward dynamics of ``an.model`` under the torques of ``model`` (default: the run's own,
     the exact inverse dynamics at any time of the law)."""
-    from ..simulation.replay import replay
-
     inp, law = an.inputs, an.law
     torque_model = model or an.model
 

@@ -6,7 +6,7 @@ import argparse
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from ..config.tables import InstrumentTable
+    from ..config.kinematic import InstrumentTable
 
 MODE_HELP = "working mode: ++, +-, -+ or -- (aliases pp, pm, mp, mm)"
 

@@ -7,53 +7,50 @@ happens here, once, as the objects are built.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from pathlib import Path as FilePath
-from typing import TYPE_CHECKING, Any, TypeVar
+from typing import Any, TypeVar
 
+from ..analysis import RunInputs
+from ..calibration import KinematicModel
+from ..design.evaluate import Task
+from ..design.space import DesignSpace
 from ..dynamics import Inertia, Model
+from ..dynamics.along_path import RobotAlongPath
 from ..errors import ConfigError, DextarError
 from ..geometry import FiveBar
 from ..kinematics.checker import Tolerances
+from ..laws import Law, LawRequest, law_type
 from ..motors import MotorLimits
+from ..output.config_file import model_toml
 from ..params import read_params
 from ..paths import Path
+from ..program import Move, ProgramRequest
+from ..program.drive import DriveUnits
+from ..trajectory import Trajectory, check_path, sample_trajectory
 from ..units import SI, Units
+from .base import TABLES, Table
 from .design import DesignTable
+from .design_task import design_task
+from .kinematic import InstrumentTable, RobotTable, kinematic_model
 from .program import ProgramTable, read_moves
 from .tables import (
-    TABLES,
     ControlTable,
     DriveTable,
     FrictionTable,
     GravityTable,
     InertiaTable,
-    InstrumentTable,
     LawTable,
     MotorsTable,
     OutputTable,
     PaperTable,
     PathTable,
-    RobotTable,
-    Table,
     TolerancesTable,
 )
 from .toml import check_tables, read_config
-
-if TYPE_CHECKING:
-    from ..analysis import RunInputs
-    from ..calibration import KinematicModel
-    from ..design.evaluate import Task
-    from ..design.space import DesignSpace
-    from ..laws import Law
-    from ..program import Move, ProgramRequest
-    from ..program.drive import DriveUnits
-    from ..trajectory import Trajectory
-
-# The stages a scenario builds (laws, programs, the analysis) are imported by the methods
-# that build them: reading a config, or only its [robot] table, stays light.
 
 T = TypeVar("T", bound=Table)
 
@@ -166,10 +163,6 @@ class Scenario:
 
     def drive(self) -> DriveUnits | None:
         """The drives in SI (``[drive]``), or None without the table."""
-        import math
-
-        from ..program.drive import DriveUnits
-
         t, off = self.drive_table, self.robot_table.encoder_offset_deg
         if not t.given:
             return None
@@ -328,8 +321,6 @@ class Scenario:
 
     def program_request(self) -> ProgramRequest:
         """The program of a task file (``[program]``, ``[[move]]``, ``[motors]``) in SI."""
-        from ..program import ProgramRequest
-
         if not self.moves:
             raise ConfigError("the task has no move: add [[move]] tables")
         m = self.si_model
@@ -344,16 +335,12 @@ class Scenario:
         """A sweep's :class:`~dextar.design.evaluate.Task` and design space: a program task
         (``[program]`` and ``[[move]]``) or a run task (``[path]`` and ``[law]``; a law that
         does not depend on the robot is computed once here), in SI."""
-        from .design_task import design_task
-
         return design_task(self, samples=samples, seed=seed)
 
     def model_file(self, robot_mm: FiveBar, mode: str, inertia: Inertia, comment: str) -> str:
         """A config file of ``inertia`` (SI) on ``robot_mm`` with this scenario's friction
         speed and gravity and its ``[motors]`` and ``[tolerances]`` as the file gives them
         (``identified.toml``, ``best.toml``)."""
-        from ..output.config_file import model_toml
-
         return model_toml(robot_mm, mode, self.assembly, inertia,
                           coulomb_speed_deg_s=self.friction_table.coulomb_speed_deg_s,
                           gravity_mm_s2=self.gravity_table.vector,
@@ -362,10 +349,6 @@ class Scenario:
     def law(self, kind: str | None = None) -> Law:
         """The configured law, or the registered law ``kind`` with its defaults and the
         configured duration. The path is checked first (reach and singularities)."""
-        from ..dynamics.along_path import RobotAlongPath
-        from ..laws import LawRequest, law_type
-        from ..trajectory import check_path
-
         check_path(self.robot, self.path, mode=self.mode, tolerances=self.tolerances,
                    units=self.units)
         table = self.law_table
@@ -382,8 +365,6 @@ class Scenario:
 
     def inputs(self) -> RunInputs:
         """What the analysis of a run needs, in run units (no config beyond this point)."""
-        from ..analysis import RunInputs
-
         p = self.paper
         return RunInputs(self.robot, self.robot_mm, self.path, self.path_spec, self.mode,
                          self.assembly, self.inertia, self.units, self.output.samples,
@@ -392,8 +373,6 @@ class Scenario:
 
     def trajectory(self, law: Law | None = None, samples: int | None = None) -> Trajectory:
         """The law sampled along the path (``[output].samples`` by default)."""
-        from ..trajectory import sample_trajectory
-
         return sample_trajectory(self.robot, self.path, law or self.law(), mode=self.mode,
                                  samples=samples or self.output.samples,
                                  tolerances=self.tolerances, units=self.units)
@@ -451,36 +430,6 @@ def load_scenario(path: str | FilePath | None = None, *,
     if path is None and model is None:
         return scenario_from_dict({})
     return scenario_from_dict(doc, source=source, text=text)
-
-
-def load_robot_table(path: str | FilePath | None) -> RobotTable:
-    """``[robot]`` of a config file (every table's name checked; the DexTAR without a
-    file)."""
-    return load_kinematics(path)[0]
-
-
-def load_kinematics(path: str | FilePath | None
-                    ) -> tuple[RobotTable, InstrumentTable | None]:
-    """``[robot]`` and ``[instrument]`` (None when the file has none) of a config file, the
-    file read once, every table's name checked; the DexTAR without a file."""
-    if path is None:
-        return RobotTable(), None
-    doc, _ = read_config(path)
-    check_tables({k: v for k, v in doc.items() if k != "move"}, set(TABLES) | {"move"})
-    inst = doc.get("instrument")
-    return (RobotTable.from_toml(doc.get("robot", {})),
-            None if inst is None else InstrumentTable.from_toml(inst))
-
-
-def kinematic_model(robot: RobotTable, instrument: InstrumentTable | None = None
-                    ) -> KinematicModel:
-    """The calibration model (SI) of config tables: the geometry, the encoder offsets and
-    the instrument frame."""
-    from ..calibration import KinematicModel
-
-    return KinematicModel.from_config_units(
-        robot.geometry_mm, encoder_offset_deg=robot.encoder_offset_deg,
-        instrument=(instrument or InstrumentTable()).frame)
 
 
 def default_scenario() -> Scenario:

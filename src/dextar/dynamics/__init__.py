@@ -1,7 +1,8 @@
 """Dynamics: inertial parameters, exact inverse and forward dynamics, the paper's model."""
 
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
+from .._lazy import lazy_attributes
 from .exact import (
     Model,
     Reactions,
@@ -20,17 +21,11 @@ from .inertia import Inertia, Rod, paper_inertia
 if TYPE_CHECKING:
     from .along_path import RobotAlongJointLine, RobotAlongPath, time_optimal_law
 
-#: The robot along a path, imported on first use: it plans laws, and the laws bring scipy,
-#: which the model, its inertia and its exact dynamics do not need.
-_ALONG_PATH = ("RobotAlongJointLine", "RobotAlongPath", "time_optimal_law")
-
-
-def __getattr__(name: str) -> Any:
-    if name in _ALONG_PATH:
-        from . import along_path
-
-        return getattr(along_path, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+# The robot along a path plans laws (dextar.laws, dextar.paths): imported when first used,
+# so that the model, its inertia and its exact dynamics (a calibration's model file, an
+# identification) load no law or path module.
+__getattr__, __dir__ = lazy_attributes(__name__, dict.fromkeys(
+    ("RobotAlongJointLine", "RobotAlongPath", "time_optimal_law"), ".along_path"))
 
 
 __all__ = ["Inertia", "Model", "Reactions", "Rod", "bias_forces", "gravity_torques",

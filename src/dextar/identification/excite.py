@@ -70,7 +70,7 @@ import numpy as np
 
 from .._arrays import Array
 from .._lazy import lazy_module
-from ..dynamics.exact import Model, inverse_dynamics
+from ..dynamics.exact import Model, gravity_torques, inverse_dynamics, mass_matrix
 from ..dynamics.regressor import regressor
 from ..errors import ParameterError
 from ..kinematics import direct_kinematics, elbows, inverse_kinematics
@@ -395,8 +395,6 @@ def allowed_motion(model: Model, q0: Array, harmonics: int, base_hz: float,
     * acceleration: the same, ``2 pi^2 (N f)^2 R``, capped at what ``safety`` of the peak
       torque, less the gravity torque at rest, gives the motor's own inertia at ``q0``
       (``M_kk``)."""
-    from ..dynamics.exact import gravity_torques, mass_matrix
-
     R = (np.asarray(region.upper - region.lower, float) if region is not None
          else free_range(model, q0))
     w = math.pi * harmonics * base_hz

@@ -16,8 +16,10 @@ import numpy as np
 
 from .._arrays import Array
 from ..errors import ParameterError
+from ..params import Param
 from ..paths import Path
 from ..units import Units
+from .registry import LawType, register_law
 
 
 def _positive(name: str, value: float) -> float:
@@ -308,9 +310,6 @@ def _fit_trapezoid(r: Any, shortest: Any) -> TrapezoidalLaw:
 
 
 def _register() -> None:
-    from ..params import Param
-    from .registry import LawType, register_law
-
     duration = Param("number", "s", 1.0, "motion time", positive=True)
     register_law(LawType("uniform", {"duration": duration},
                          lambda r: UniformLaw(r.path.length, r.params["duration"]),

@@ -51,9 +51,11 @@ from numpy.polynomial import chebyshev as cheb
 from .._arrays import Array
 from .._lazy import lazy_module
 from ..errors import ConvergenceError, ParameterError
+from ..params import Param
 from ..paths import Path
 from ..units import Units
 from .base import Law, _positive, law_cost
+from .registry import LawType, register_law
 
 integrate = lazy_module("scipy.integrate")
 interpolate = lazy_module("scipy.interpolate")
@@ -849,9 +851,6 @@ def _solve_local(path: Path, S: float, G: float, tol: float) -> _Solution:
 
 
 def _register() -> None:
-    from ..params import Param
-    from .registry import LawType, register_law
-
     register_law(LawType(
         "optimal",
         {"duration": Param("number", "s", 1.0, "motion time", positive=True),

@@ -15,13 +15,15 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..params import Param
 from ..paths import Path
 from ..registry import Registry
 from ..units import Units
-from .base import Law
+
+if TYPE_CHECKING:  # (the laws' modules import this one to register themselves)
+    from .base import Law
 
 
 @dataclass(frozen=True)
@@ -55,7 +57,7 @@ class LawRequest:
 
 #: ``shortest(family, t_min) -> T``: the shortest duration ``T >= t_min`` for which the law
 #: ``family(T)`` stays within the motors (given by the planner that fits a duration).
-Shortest = Callable[[Callable[[float], Law], float], float]
+Shortest = Callable[[Callable[[float], "Law"], float], float]
 
 
 @dataclass(frozen=True)

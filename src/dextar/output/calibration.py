@@ -17,14 +17,15 @@ import numpy as np
 
 from .._arrays import Array
 from .._lazy import lazy_module
-from ..calibration.accuracy import AccuracyMap
+from ..calibration.accuracy import AccuracyMap, accuracy_map
 from ..calibration.data import PoseData, rows_text
-from ..calibration.fit import CalibrationResult, Errors
+from ..calibration.fit import CalibrationResult, Errors, encoder_std
 from ..calibration.model import FRAME, KinematicModel, to_file_units
 from ..calibration.poses import PoseSelection
 from ..errors import NumericalError
 from ..geometry import WORKING_MODES, FiveBar
 from .config_file import toml_number as _num
+from .figures import png_bytes
 from .files import OutputDir
 from .html_page import figures, page
 
@@ -450,10 +451,6 @@ def calibration_files(res: CalibrationResult, *, data: str, config: str = "",
     With ``outliers`` (the rows of a fit that kept them, see :func:`calibration_summary`)
     every file but ``calibrated.toml`` is written: a diagnosis, not a calibration.
     """
-    from ..calibration.accuracy import accuracy_map
-    from ..calibration.fit import encoder_std
-    from .figures import png_bytes
-
     kept = res.data.subset(res.kept)
     reading_std = None if encoder_counts is None else encoder_std(encoder_counts)
     modes = [m for m in WORKING_MODES if m in kept.modes]

@@ -22,7 +22,7 @@ from ..design.sweep import SweepStats
 from ..errors import ConfigError
 from ..geometry import FiveBar
 from ..kinematics import workspace_map
-from .figures import plot_workspace
+from .figures import plot_workspace, png_bytes, svg_bytes
 from .files import OutputDir, write_text
 from .html_page import figures, grid, page, table
 from .tables import number
@@ -295,8 +295,6 @@ def write_sweep_outputs(od: OutputDir, summary: Mapping[str, Any], choice: Choic
     if best_toml is not None:
         od.write_text("best.toml", best_toml)
     if with_figures and choice.best >= 0 and best_figure is not None:
-        from .figures import png_bytes, svg_bytes
-
         X = np.array([[r[k] for k in LENGTHS] for r in rows])
         names = list(summary["objectives"])
         for name, fig in (

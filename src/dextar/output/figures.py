@@ -17,6 +17,7 @@ if TYPE_CHECKING:  # the real modules; at run time matplotlib is imported where 
     import matplotlib.backends.backend_agg as backend_agg
     import matplotlib.figure as mfigure
     from matplotlib.figure import Figure
+    from PIL import Image
 
     from ..analysis import Analysis
     from ..trajectory import Trajectory
@@ -24,6 +25,7 @@ else:
     mpl = lazy_module("matplotlib")
     backend_agg = lazy_module("matplotlib.backends.backend_agg")
     mfigure = lazy_module("matplotlib.figure")
+    Image = lazy_module("PIL.Image")
 
 # Figures are matplotlib.figure.Figure objects drawn without pyplot: no global backend or
 # figure registry is touched, as the Matplotlib docs advise for non-interactive output.
@@ -285,8 +287,6 @@ def _one_palette(packed: list[Array]) -> list[Any]:
     mapping onto a given palette goes through a coarse colour cache: white came out as
     (252, 252, 252).)
     """
-    from PIL import Image
-
     shifts = np.array([0, 8, 16])
     first = ((packed[0][..., None] >> shifts) & 255).astype(np.uint8)  # its RGB pixels
     im0 = Image.fromarray(first).convert("P", palette=Image.Palette.ADAPTIVE)

@@ -18,7 +18,13 @@ from .._lazy import lazy_module
 from ..dynamics import Model, inverse_dynamics
 from ..dynamics.regressor import NAMES
 from ..identification.data import MotionData
-from ..identification.excite import ExcitationResult
+from ..identification.excite import (
+    ACCELERATION_FLOOR,
+    COND_CEILING,
+    RANGE_FLOOR,
+    SPEED_FLOOR,
+    ExcitationResult,
+)
 from ..identification.fit import (
     RESIDUAL_FACTOR,
     UNCERTAINTY_LIMIT,
@@ -27,6 +33,7 @@ from ..identification.fit import (
 )
 from ..identification.fit import validate as validate_fit
 from .config_file import toml_number as _num
+from .figures import png_bytes
 from .files import OutputDir
 from .html_page import figures, page
 
@@ -72,13 +79,6 @@ def excitation_payload(res: ExcitationResult, harmonics: int, base_hz: float, sa
 
 def _coverage(res: ExcitationResult) -> dict[str, Any]:
     """The excitation's coverage against its floors (JSON)."""
-    from ..identification.excite import (
-        ACCELERATION_FLOOR,
-        COND_CEILING,
-        RANGE_FLOOR,
-        SPEED_FLOOR,
-    )
-
     c = res.coverage
     assert c is not None
     return {"floors": {"range": RANGE_FLOOR, "speed": SPEED_FLOOR,
@@ -217,8 +217,6 @@ def write_identification(out: str, rep: IdentificationReport, model_toml: str, *
         od.write_text("identified.toml", model_toml)
         od.write_text("parameters.csv", parameters_csv(rep.result))
         if with_figures:
-            from .figures import png_bytes
-
             png = png_bytes(fit_figure(rep.panels))
             od.write_bytes("fit.png", png)
             od.write_text("report.html", identification_report(rep.summary, {"fit": png}))

@@ -19,10 +19,11 @@ from .._arrays import Array
 from ..geometry import FiveBar
 from ..kinematics import workspace_map
 from ..program import MoveTiming, ProgramResult, RmsFit, Sizing
-from ..program.drive import DriveUnits, PvtPoints
+from ..program.drive import DriveUnits, PvtPoints, csp_columns, pvt_points
 from .figures import new_figure, plot_workspace, png_bytes, svg_bytes, tight_layout, warm_up
 from .files import OutputDir
 from .html_page import figures, grid, page
+from .parallel import Job, render
 from .tables import csv_text
 
 if TYPE_CHECKING:
@@ -143,8 +144,6 @@ def write_program(out: str, res: ProgramResult, summary: ProgramSummary, robot_m
     """Write ``setpoints.csv``, the figures (PNG and SVG), ``report.html`` and
     ``summary.json`` into ``out``, and with ``drive`` ``csp.csv`` and ``pvt.csv`` (the PVT
     points ``pvt``, computed from the drive when not given)."""
-    from ..program.drive import csp_columns, pvt_points
-
     with OutputDir(out, force=force, produces=PROGRAM_FILES) as od:
         od.write_text("setpoints.csv", _counts_csv(setpoint_columns(
             res, summary.encoder_offset_deg)))
@@ -183,8 +182,6 @@ def _figures(res: ProgramResult, summary: ProgramSummary, robot_mm: FiveBar, mod
              ) -> dict[str, tuple[bytes, bytes]]:
     """Each figure's PNG and SVG, drawn on two cores where there are two
     (:mod:`dextar.output.parallel`)."""
-    from .parallel import Job, render
-
     makers: dict[str, Callable[[], Figure]] = {
         "moves": lambda: moves_figure(res, robot_mm, mode), "motion": lambda: motion_figure(res),
         "operating_points": lambda: operating_points_figure(res, summary.sizing)}
