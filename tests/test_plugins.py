@@ -58,14 +58,12 @@ def laws():
 
 
 def commands():
-    register_command(Command("hello", "dextar_toy_hello"))
+    register_command(Command("hello", "dextar_toy_hello", "say hello (a toy plugin's command)"))
 '''
 
 HELLO = '''
 """dextar hello: the toy plugin's command."""
 from dextar.commands.base import Result, json_flag
-
-HELP = "say hello (a toy plugin's command)"
 
 
 def add_arguments(sp):

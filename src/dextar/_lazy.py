@@ -22,7 +22,7 @@ from __future__ import annotations
 import importlib
 from collections.abc import Callable, Mapping
 from types import ModuleType
-from typing import Any
+from typing import Any, cast
 
 
 class _LazyModule(ModuleType):
@@ -37,7 +37,7 @@ class _LazyModule(ModuleType):
         if target is None:
             target = importlib.import_module(self.__name__)
             self.__dict__["_lazy_target"] = target
-        return target  # type: ignore[no-any-return]
+        return cast(ModuleType, target)
 
     def __getattr__(self, attr: str) -> Any:
         return getattr(self._load(), attr)

@@ -15,13 +15,21 @@ import sys
 import threading
 import warnings
 from collections.abc import Mapping, Sequence
-from typing import Any, NoReturn
+from typing import TYPE_CHECKING, Any, NoReturn
 
-from . import __version__
+from . import __version__, config
+from ._lazy import lazy_module
 from .commands import COMMANDS
 from .commands.base import Result
 from .errors import DextarError
 from .geometry import MODE_ALIASES
+
+if TYPE_CHECKING:  # the registries, imported when a help that lists them is shown
+    from . import laws, paths, program
+else:
+    laws = lazy_module("dextar.laws")
+    paths = lazy_module("dextar.paths")
+    program = lazy_module("dextar.program")
 
 #: A working mode's alias (``--mode --`` is read as the alias ``mm``).
 _ALIAS_OF = {v: k for k, v in MODE_ALIASES.items()}
@@ -47,17 +55,12 @@ class _Parser(argparse.ArgumentParser):
 
 def registries_help() -> str:
     """The registered config tables, move types, path types and laws."""
-    from .config import TABLES
-    from .laws import LAW_TYPES
-    from .paths import PATH_TYPES
-    from .program import MOVE_TYPES
-
     def listing(reg: Mapping[str, Any]) -> str:
         return "\n".join(f"  {k:<14} {v.help}" for k, v in reg.items())
 
-    return (f"config tables: {', '.join(f'[{t}]' for t in TABLES)}\n"
-            f"[path].type:\n{listing(PATH_TYPES)}\n[law].type:\n{listing(LAW_TYPES)}\n"
-            f"[[move]] type:\n{listing(MOVE_TYPES)}")
+    return (f"config tables: {', '.join(f'[{t}]' for t in config.TABLES)}\n"
+            f"[path].type:\n{listing(paths.PATH_TYPES)}\n[law].type:\n"
+            f"{listing(laws.LAW_TYPES)}\n[[move]] type:\n{listing(program.MOVE_TYPES)}")
 
 
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:
@@ -98,7 +101,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line ``argv``; returns the exit status (0, 1 or 2; 130 on interrupt)."""
     # negative numbers are values, not options: "dextar ik -10 120"
     argv = list(sys.argv[1:] if argv is None else argv)
-    parser = build_parser(argv[0] if argv and argv[0] in COMMANDS else None)
+    parser = build_parser(argv[0] if argv and argv[0] in COMMANDS else "")
     try:
         args, extra = parser.parse_known_args(_protect_negatives(argv))
         if extra:  # the command's own parser says it, pointing to the command's help

@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 
 import dextar.calibration as cal
+import dextar.calibration.fit as cal_fit
 from dextar.calibration.fit import validation_errors
 from dextar.calibration.poses import candidates
 from dextar.cli import main
@@ -336,7 +337,8 @@ def test_a_fit_that_did_not_converge_writes_no_calibrated_config(story, tmp_path
     code, _, _ = cli(["calibrate", story["measured"], "--config", story["cfg"], "--out", out,
                       "--quiet"], capsys)
     assert code == 0 and (out / "calibrated.toml").exists()
-    monkeypatch.setattr(cal, "calibrate", functools.partial(cal.calibrate, max_nfev=1))
+    # the fit the job calls (dextar.calibration.fit.calibrate), stopped after one evaluation
+    monkeypatch.setattr(cal_fit, "calibrate", functools.partial(cal_fit.calibrate, max_nfev=1))
     code, text, err = cli(["calibrate", story["measured"], "--config", story["cfg"], "--out",
                            out, "--force"], capsys)
     assert code == 1 and "not converged" in err and "no calibrated.toml written" in err, err
@@ -522,3 +524,25 @@ def test_bad_config_regions_exit_2(tmp_path, capsys, value, words):
     cfg.write_text(SMALL_ROBOT + f"\n[instrument]\nregion = {value}\n")
     code, _, err = cli(["poses", cfg, "--count", "40", "--out", tmp_path / "p.csv"], capsys)
     assert code == 2 and err.count("\n") == 1 and words in err, err
+
+
+def test_a_calibration_loads_no_law_path_or_scenario(story, tmp_path):
+    """dextar calibrate reads the robot's own tables and imports no law, path or scenario (a
+    fresh interpreter's modules after a calibration), where dextar program does."""
+    import subprocess
+    import sys
+
+    def loaded(argv):
+        probe = ("import sys; from dextar.cli import main; main(" + repr([str(a) for a in argv])
+                 + "); print(sorted(m for m in sys.modules if m.startswith(('dextar.laws', "
+                 "'dextar.paths', 'dextar.config.scenario', 'dextar.trajectory'))))")
+        r = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                           check=True)
+        return r.stdout.splitlines()[-1]
+
+    assert loaded(["calibrate", story["measured"], "--config", story["cfg"], "--out",
+                   tmp_path / "c", "--quiet"]) == "[]"
+    assert (tmp_path / "c" / "calibrated.toml").exists()
+    # the check can fail: the same config's program loads them
+    assert "dextar.laws" in loaded(["program", story["cfg"], "--out", tmp_path / "p",
+                                    "--no-figures", "--quiet"])

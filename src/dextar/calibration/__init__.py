@@ -39,9 +39,11 @@ from .data import PoseData, poses_from_arrays, read_poses_csv
 from .errors import CouplingError, OutlierError
 from .fit import (
     CalibrationResult,
+    Diagnosis,
     Errors,
     Parameter,
     calibrate,
+    calibrate_or_diagnose,
     check_scale,
     encoder_std,
     register,
@@ -58,6 +60,7 @@ __all__ = [
     "AccuracyMap",
     "CalibrationResult",
     "CouplingError",
+    "Diagnosis",
     "Errors",
     "Identifiability",
     "KinematicModel",
@@ -68,6 +71,7 @@ __all__ = [
     "PoseSelection",
     "accuracy_map",
     "calibrate",
+    "calibrate_or_diagnose",
     "check_scale",
     "encoder_std",
     "identifiability",

@@ -1007,3 +1007,44 @@ def encoder_std(counts: float) -> float:
     if not (math.isfinite(counts) and counts > 0):
         raise ParameterError(f"encoder counts {counts!r} must be a positive number")
     return 2.0 * math.pi / counts / math.sqrt(12.0)
+
+
+@dataclass(frozen=True)
+class Diagnosis:
+    """A calibration, or the diagnosis of data with outliers.
+
+    Attributes
+    ----------
+    result : CalibrationResult
+        The fit: the calibration asked for or, where outliers stopped it, the fit that keeps
+        them (a diagnosis: their distances and arrows, never a calibrated robot).
+    outliers : tuple of int
+        The outliers' rows as the user counts them (empty for a calibration).
+    message : str
+        The outliers' error in words (empty for a calibration).
+    """
+
+    result: CalibrationResult
+    outliers: tuple[int, ...] = ()
+    message: str = ""
+
+
+def calibrate_or_diagnose(data: PoseData, nominal: KinematicModel, *,
+                          frame: str = "instrument", robust: str | None = None,
+                          outlier_factor: float | None = None,
+                          point_std: float | None = None, reading_std: float | None = None,
+                          validation: PoseData | None = None) -> Diagnosis:
+    """:func:`calibrate`; where it finds outliers (without a robust loss), the fit that keeps
+    them with their rows and the error's words instead of the error; where that fit fails
+    its own checks (rows that wreck it), the outliers' error, suggesting a robust loss."""
+    def fit(factor: float) -> CalibrationResult:
+        return calibrate(data, nominal, frame=frame, robust=robust, outlier_factor=factor,
+                         point_std=point_std, reading_std=reading_std, validation=validation)
+
+    try:
+        return Diagnosis(fit(OUTLIER_FACTOR if outlier_factor is None else outlier_factor))
+    except OutlierError as exc:
+        try:
+            return Diagnosis(fit(1e300), exc.rows, str(exc))
+        except DextarError:
+            raise OutlierError(f"{exc} (--robust soft_l1)", exc.rows) from None

@@ -1,21 +1,25 @@
 """What every command shares: its result, the ``--out`` file rules, the options of a command
 that writes a directory, and the words of a law and of the run's units.
 
-A command module (one per command, listed in :data:`dextar.commands.COMMANDS`) holds ``NAME``,
-``HELP``, ``add_arguments(parser)`` and ``run(args) -> Result``; ``run`` only chains config ->
-domain -> output and says what to print. Modules import what their ``run`` needs when it runs,
-so that the command line starts at once.
+A command module (one per command, registered in :data:`dextar.commands.COMMANDS`) holds
+``HELP``, ``add_arguments(parser)`` and ``run(args) -> Result``; ``run`` reads the config,
+calls its job (:mod:`dextar.jobs`: one library call, one typed result), writes its files and
+says what to print. The jobs and the writers are module attributes imported when the command
+runs (:mod:`dextar._lazy`), so that ``--help`` and parsing stay light.
 """
 
 from __future__ import annotations
 
 import argparse
-from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from .. import config
 from ..errors import ConfigError, DextarError
+from ..output.files import write_text
 
 if TYPE_CHECKING:
     from ..config import Scenario
@@ -57,8 +61,6 @@ def out_file(out: str, *suffixes: str) -> Path | None:
 def write_or_hand_back(out: Path | None, text: str) -> tuple[str, str | None]:
     """Write ``text`` atomically to ``out``; for None (stdout) hand it back as data. Returns
     where it went (for the words) and the data."""
-    from ..output.files import write_text
-
     if out is None:
         return "stdout", text
     write_text(out, text)
@@ -151,27 +153,25 @@ def law_warnings(command: str, law: Law) -> list[str]:
 
 
 
-def config_notes(command: str, notes: tuple[str, ...]) -> list[str]:
-    """A scenario's notes (:attr:`dextar.config.Scenario.notes`) as stderr lines."""
-    return [f"dextar {command}: note: {n}" for n in notes]
+def load(args: argparse.Namespace, units: str | None = None) -> Scenario:
+    """The scenario of ``args.config`` (with ``args.model``'s robot, inertia, friction and
+    gravity when given), computed in ``units`` (``--units``; None: as configured)."""
+    sc = config.load_scenario(args.config, model=getattr(args, "model", None))
+    return sc.in_units(units)
 
 
-def with_notes(command: str, args: argparse.Namespace,
-               body: Callable[[argparse.Namespace], Result]) -> Result:
-    """``body(args)`` with the notes of the config ``args.config`` (a robot in metres, an
-    empty file: :attr:`dextar.config.Scenario.notes`) first among its warnings and beside
-    its error, where they are the likely cause (a point out of reach)."""
-    from ..config import load_scenario
-
+@contextmanager
+def noted(sc: Scenario) -> Iterator[None]:
+    """An error raised inside the block carries the config's notes (a robot in metres, an
+    empty file: :attr:`dextar.config.Scenario.notes`), where they are the likely cause."""
     try:
-        notes = load_scenario(args.config, model=getattr(args, "model", None)).notes
-    except DextarError:
-        notes = ()  # the body says what is wrong with the config
-    try:
-        res = body(args)
+        yield
     except DextarError as exc:
-        if not notes:
-            raise
-        raise type(exc)(f"{exc} (note: {'; '.join(notes)})") from None
-    lines = config_notes(command, notes)
-    return res if not lines else replace(res, warnings=[*lines, *res.warnings])
+        if sc.notes and exc.args:
+            exc.args = (f"{exc.args[0]} (note: {'; '.join(sc.notes)})", *exc.args[1:])
+        raise
+
+
+def note_lines(command: str, sc: Scenario) -> list[str]:
+    """The config's notes as stderr lines, first among a command's warnings."""
+    return [f"dextar {command}: note: {n}" for n in sc.notes]

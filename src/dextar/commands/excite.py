@@ -7,17 +7,16 @@ from __future__ import annotations
 import argparse
 from typing import TYPE_CHECKING
 
-from .base import Result, config_argument, json_flag, out_file, write_or_hand_back
+from .. import jobs
+from .._lazy import lazy_module
+from ..identification.excite import ACCELERATION_FLOOR, RANGE_FLOOR, SPEED_FLOOR
+from ..output.tables import csv_text
+from .base import Result, config_argument, json_flag, load, out_file, write_or_hand_back
 
-if TYPE_CHECKING:
-    from .._arrays import Array
-    from ..config import Scenario
-    from ..identification.coverage import JointRegion
-
-NAME = "excite"
-HELP = ("an exciting trajectory for identification (a Fourier series per motor, regressor "
-        "condition number minimised, coverage floors checked) to CSV (exit 1 below its "
-        "floors)")
+if TYPE_CHECKING:  # the writers, imported when the command runs (start-up: dextar._lazy)
+    from ..output import identification as written
+else:
+    written = lazy_module("dextar.output.identification")
 
 
 def add_arguments(sp: argparse.ArgumentParser) -> None:
@@ -39,29 +38,18 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> Result:
-    """Design the motion, sample it at the servo rate, write it."""
-    from ..config import load_scenario
-    from ..identification.excite import (
-        ACCELERATION_FLOOR,
-        RANGE_FLOOR,
-        SPEED_FLOOR,
-        design_excitation,
-    )
-    from ..output.identification import excitation_columns, excitation_payload
-    from ..output.tables import csv_text
-
+    """Design the motion (:func:`dextar.jobs.excite`), sample it at the servo rate, write
+    it."""
     target = out_file(args.out, ".csv")
-    sc = load_scenario(args.config, model=args.model)
-    model = sc.si_model
-    region = None if args.task is None else task_region(args.task, sc)
-    res = design_excitation(model, sc.mode, harmonics=args.harmonics, base_hz=args.base_hz,
-                            duration=args.duration, motors=sc.si_motors, seed=args.seed,
-                            region=region)
+    sc = load(args)
+    job = jobs.excite(sc, harmonics=args.harmonics, base_hz=args.base_hz,
+                      duration=args.duration, seed=args.seed, task=args.task)
+    res, region = job.result, job.region
     rate = sc.output.servo_rate_hz
-    cols = excitation_columns(model, res, rate)
+    cols = written.excitation_columns(sc.si_model, res, rate)
     where, data = write_or_hand_back(target, csv_text(cols))
-    payload = excitation_payload(res, args.harmonics, args.base_hz, len(cols["t_s"]), rate,
-                                 where)
+    payload = written.excitation_payload(res, args.harmonics, args.base_hz, len(cols["t_s"]),
+                                         rate, where)
     text = (f"exciting trajectory: condition number {res.condition_number:.4g} (base "
             f"regressor, unit-norm columns); {res.periods} period(s) of "
             f"{res.trajectory.period:g} s, {args.harmonics} harmonics; peak torques "
@@ -93,28 +81,3 @@ def run(args: argparse.Namespace) -> Result:
                             "identification from it extrapolates on the rest")
     return Result(payload, text, warnings, data=data, code=code)
 
-
-def task_region(path: str, sc: Scenario) -> JointRegion:
-    """The joint region a task visits, with its speeds: its program planned, or its run
-    sampled (SI), on the config's robot."""
-    from ..identification.coverage import JointRegion
-
-    q, dq, _ = task_motion(path, sc)
-    return JointRegion.from_samples(q, dq)
-
-
-def task_motion(path: str, sc: Scenario) -> tuple[Array, Array, Array]:
-    """The joint motion ``(q, dq, ddq)`` (SI) of a task: its program planned, or its run
-    sampled, on the config's robot."""
-    from ..config import load_scenario
-    from ..errors import ConfigError
-
-    task = load_scenario(path)
-    if task.robot_mm != sc.robot_mm:
-        raise ConfigError(f"--task {path!r} is for another robot ({task.robot_mm.as_dict()} "
-                          f"mm) than the config's ({sc.robot_mm.as_dict()} mm)")
-    if task.moves:
-        res = task.program_request().plan()
-        return res.q, res.dq, res.ddq
-    tr = task.in_units("si").trajectory()
-    return tr.q, tr.dq, tr.ddq

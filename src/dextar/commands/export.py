@@ -6,11 +6,17 @@ from __future__ import annotations
 
 import argparse
 
-from .base import Result, config_argument, json_flag, out_file, units_note, write_or_hand_back
-
-NAME = "export"
-HELP = "export the robot model (mjcf: MuJoCo XML)"
-REGISTRIES_HELP = True
+from .. import jobs
+from .base import (
+    Result,
+    config_argument,
+    json_flag,
+    load,
+    noted,
+    out_file,
+    units_note,
+    write_or_hand_back,
+)
 
 
 def add_arguments(sp: argparse.ArgumentParser) -> None:
@@ -25,16 +31,12 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> Result:
-    """Build the model at the motion's first sample and write it."""
-    from ..config import load_scenario
-    from ..output.mjcf import to_mjcf
-
-    sc = load_scenario(args.config, model=args.model).in_units(args.units)
+    """Build the model at the motion's first sample (:func:`dextar.jobs.mjcf`), write it."""
+    sc = load(args, args.units)
     path = out_file(args.out, ".xml")
-    tr = sc.trajectory(samples=2)
-    where, data = write_or_hand_back(path, to_mjcf(sc.model(tr.assembly),
-                                                   start=(tr.q[0], tr.dq[0]),
-                                                   units=units_note(sc)))
+    with noted(sc):
+        xml = jobs.mjcf(sc, units_note(sc))
+    where, data = write_or_hand_back(path, xml)
     return Result({"out": where, "units": sc.units.describe()},
                   f"wrote {where} (MuJoCo model in {units_note(sc)}; keyframe 'start' at the "
                   "motion's start)", data=data)

@@ -9,16 +9,16 @@ from __future__ import annotations
 
 import argparse
 
-from .base import Result, json_flag
+import numpy as np
 
-NAME = "fk"
-HELP = "direct kinematics: end-effector for encoder readings"
+from ..config.kinematic import load_kinematics
+from ..kinematics import direct_kinematics
+from .base import Result, json_flag
+from .kinematics_args import frame_argument, instrument_of, robot_argument
 
 
 def add_arguments(sp: argparse.ArgumentParser) -> None:
     """``phi``, ``psi`` (deg), ``--assembly``, ``--robot``, ``--frame``, ``--json``."""
-    from .kinematics_args import frame_argument, robot_argument
-
     sp.add_argument("phi", type=float, help="phi reading in degrees (motor at A)")
     sp.add_argument("psi", type=float, help="psi reading in degrees (motor at D)")
     sp.add_argument("--assembly", choices=["up", "down"], help="assembly mode")
@@ -29,12 +29,6 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> Result:
     """Add the encoder offsets, solve and word the point."""
-    import numpy as np
-
-    from ..config import load_kinematics
-    from ..kinematics import direct_kinematics
-    from .kinematics_args import instrument_of
-
     rc, inst = load_kinematics(args.robot)
     assembly = args.assembly or rc.assembly_mode
     geo = rc.geometric_deg((args.phi, args.psi))

@@ -4,12 +4,16 @@ config with them (``identified.toml``) loadable by every command."""
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
 
-from .base import Result, into_directory, model_argument, shown
+from .. import jobs
+from .._lazy import lazy_module
+from .base import Result, into_directory, load, model_argument, shown
 
-NAME = "identify"
-HELP = ("identify the base parameters from measured motion and write a config with them "
-        "(exit 1 when poorly determined, not physical or a poor fit)")
+if TYPE_CHECKING:  # the writers, imported when the command runs (start-up: dextar._lazy)
+    from ..output import identification as written
+else:
+    written = lazy_module("dextar.output.identification")
 
 
 def add_arguments(sp: argparse.ArgumentParser) -> None:
@@ -30,35 +34,13 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
-    """Read, identify, validate, write."""
-    import numpy as np
-
-    from ..config import load_scenario
-    from ..errors import ConfigError
-    from ..identification.data import read_motion_csv
-    from ..identification.fit import identify
-    from ..output.identification import IdentificationReport, write_identification
-    from .excite import task_motion
-
-    cutoff = args.cutoff_hz
-    if cutoff is not None and not (np.isfinite(cutoff) and cutoff > 0):
-        raise ConfigError(f"--cutoff-hz {cutoff!r} must be a positive number")
-    sc = load_scenario(args.config, model=args.model)
-    model = sc.si_model
-    data = read_motion_csv(args.data)
-    vdata = read_motion_csv(args.validate) if args.validate else None
-    reference = None if args.task is None else task_motion(args.task, sc)
-    res = identify(data, model, mode=sc.mode, cutoff_hz=cutoff, reference=reference,
-                   reference_name=f"the task {args.task}")
-    rep = IdentificationReport.of(res, data, model, sc.mode, args.data, args.config, vdata,
-                                  args.validate)
-    comment = (f"identified by dextar from {args.data} ({res.method}, condition number "
-               f"{res.condition_number:.4g})\nbase parameters reproduced exactly; the split "
-               "between rods, rotor and payload that the torques cannot see follows "
-               f"{args.config or 'the defaults'}")
-    write_identification(args.out, rep, sc.model_file(sc.robot_mm, sc.mode, res.inertia,
-                                                      comment),
-                         force=args.force, with_figures=figures)
+    """Identify and validate (:func:`dextar.jobs.identify_model`), write, word."""
+    sc = load(args)
+    job = jobs.identify_model(args.data, sc, config=args.config, cutoff_hz=args.cutoff_hz,
+                              task=args.task, validate=args.validate)
+    res, rep = job.result, job.report
+    written.write_identification(args.out, rep, job.model_toml, force=args.force,
+                                 with_figures=figures)
     lines = rep.lines()
     lines.append(f"wrote {shown(args.out, 'identified.toml')}, parameters.csv, summary.json"
                  + (", fit.png, report.html" if figures else ""))

@@ -10,18 +10,20 @@ from __future__ import annotations
 
 import argparse
 
-from .base import Result, json_flag
+import numpy as np
 
-NAME = "ik"
-HELP = "inverse kinematics: encoder readings for a point"
+from ..config.kinematic import load_kinematics
+from ..kinematics import inverse_kinematics, singularity_distances
+from ..kinematics.checker import check_reach
+from .base import Result, json_flag
+from .kinematics_args import frame_argument, instrument_of, mode_argument, robot_argument
+
 #: Normalised distance to a singularity below which the answer carries a warning.
 NEAR_SINGULARITY = 0.05
 
 
 def add_arguments(sp: argparse.ArgumentParser) -> None:
     """``x``, ``y`` (mm), ``--mode``, ``--robot``, ``--frame``, ``--json``."""
-    from .kinematics_args import frame_argument, mode_argument, robot_argument
-
     sp.add_argument("x", type=float, help="x in mm")
     sp.add_argument("y", type=float, help="y in mm")
     mode_argument(sp)
@@ -32,13 +34,6 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> Result:
     """Solve, take the encoder offsets off and word the readings; warn near a singularity."""
-    import numpy as np
-
-    from ..config import load_kinematics
-    from ..kinematics import inverse_kinematics, singularity_distances
-    from ..kinematics.checker import check_reach
-    from .kinematics_args import instrument_of
-
     rc, inst = load_kinematics(args.robot)
     mode = args.mode or rc.working_mode
     given = (args.x, args.y)

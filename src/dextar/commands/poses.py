@@ -7,19 +7,24 @@ working mode asked for has no pose there, named."""
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
 
+from .. import jobs
+from .._lazy import lazy_module
+from ..calibration.poses import DEFAULT_MARGIN, checked_region
+from ..config.kinematic import load_kinematic_config
+from ..errors import DextarError
+from ..geometry import WORKING_MODES, canonical_working_mode
 from .base import Result, config_argument, json_flag, out_file, write_or_hand_back
 
-NAME = "poses"
-HELP = ("measurement poses for a kinematic calibration (D-optimal over the working modes) "
-        "to CSV")
+if TYPE_CHECKING:  # the writers, imported when the command runs (start-up: dextar._lazy)
+    from ..output import calibration as written
+else:
+    written = lazy_module("dextar.output.calibration")
 
 
 def _modes(text: str) -> tuple[str, ...]:
     """``all`` or working modes separated by commas (names or aliases)."""
-    from ..errors import DextarError
-    from ..geometry import WORKING_MODES, canonical_working_mode
-
     text = text.strip()
     if text == "all":
         return WORKING_MODES
@@ -35,9 +40,6 @@ def _modes(text: str) -> tuple[str, ...]:
 
 def _region(text: str) -> tuple[float, float, float, float]:
     """``XMIN,XMAX,YMIN,YMAX`` in mm."""
-    from ..calibration.poses import checked_region
-    from ..errors import DextarError
-
     try:
         values = [float(v) for v in text.split(",")]
     except ValueError:
@@ -75,28 +77,15 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> Result:
-    """Choose the poses, write them, word the observability."""
-    from ..calibration import select_poses
-    from ..calibration.fit import encoder_std
-    from ..calibration.poses import DEFAULT_MARGIN
-    from ..config import load_scenario
-    from ..geometry import WORKING_MODES
-    from ..output.calibration import poses_csv, poses_payload, poses_text, poses_warnings
-
+    """Choose the poses (:func:`dextar.jobs.poses`), write them, word the observability."""
     target = out_file(args.out, ".csv")
-    sc = load_scenario(args.config)
-    rt, inst = sc.robot_table, sc.instrument_table
-    point_std = None if inst.sigma_mm is None else 1e-3 * inst.sigma_mm
-    reading_std = None if rt.encoder_counts is None else encoder_std(rt.encoder_counts)
-    region_mm = args.region if args.region is not None else inst.region_mm
-    sel = select_poses(sc.kinematic_model, args.count, modes=args.modes or WORKING_MODES,
-                       start_mode=rt.working_mode, assembly=rt.assembly_mode,
-                       frame=args.frame,
-                       margin=DEFAULT_MARGIN if args.margin is None else args.margin,
-                       point_std=point_std, reading_std=reading_std, seed=args.seed,
-                       region=None if region_mm is None else [1e-3 * v for v in region_mm])
-    where, data = write_or_hand_back(target, poses_csv(sel))
-    payload = poses_payload(sel, where=where, config=args.config or "", frame=args.frame,
-                            encoder_offset_deg=rt.encoder_offset_deg)
-    return Result(payload, poses_text(sel, where), poses_warnings(sel), data,
+    kc = load_kinematic_config(args.config)
+    sel = jobs.poses(kc, args.count, modes=args.modes or WORKING_MODES, region_mm=args.region,
+                     margin=DEFAULT_MARGIN if args.margin is None else args.margin,
+                     seed=args.seed, frame=args.frame)
+    where, data = write_or_hand_back(target, written.poses_csv(sel))
+    payload = written.poses_payload(sel, where=where, config=args.config or "",
+                                    frame=args.frame,
+                                    encoder_offset_deg=kc.robot.encoder_offset_deg)
+    return Result(payload, written.poses_text(sel, where), written.poses_warnings(sel), data,
                   code=1 if sel.missing_modes else 0)

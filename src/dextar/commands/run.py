@@ -5,15 +5,18 @@ report."""
 from __future__ import annotations
 
 import argparse
-import time
-from typing import Any
+import sys
+from typing import TYPE_CHECKING
 
-from .base import Result, config_argument, into_directory, shown, with_notes
+from .. import jobs
+from .._lazy import lazy_module
+from ..output.files import OutputDir
+from .base import Result, config_argument, into_directory, load, note_lines, noted, shown
 
-NAME = "run"
-HELP = ("reproduce the paper end to end and write a report (exit 1 when a physics check "
-        "fails, the files written)")
-REGISTRIES_HELP = True
+if TYPE_CHECKING:  # the writers, imported when the command runs (start-up: dextar._lazy)
+    from ..output import run as written
+else:
+    written = lazy_module("dextar.output.run")
 
 
 def add_arguments(sp: argparse.ArgumentParser) -> None:
@@ -23,43 +26,26 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> Result:
-    """The command, with the config's notes (:func:`.base.with_notes`)."""
-    return with_notes(NAME, args, _run)
-
-
-def _run(args: argparse.Namespace) -> Result:
-    """Compute through the stages, write every file, word the law and the claims."""
-    import sys
-
-    from ..analysis import analyze, run_summary, validation
-    from ..config import load_scenario
-    from ..output.files import OutputDir
-    from ..output.parallel import Forked
-    from ..output.run import RUN_FILES, Progress, staged, write_run
-
-    sc = load_scenario(args.config, model=args.model)
-    prog = Progress(enabled=not args.quiet and sys.stderr.isatty())
-    stage = staged(prog)
-    inputs = sc.inputs()
-    with OutputDir(args.out, force=args.force, produces=RUN_FILES) as od:
-        an = stage(f"{sc.law_table.type} law, trajectory and torques",
-                   lambda: analyze(inputs, sc.law()))
-        uniform = stage("uniform law (Fig. 3)", lambda: inputs.trajectory(sc.law("uniform")))
-
-        def checked() -> tuple[dict[str, Any], float]:
-            t0 = time.perf_counter()
-            return validation(an), time.perf_counter() - t0
-
-        # the physics checks (scipy's import and an integration: half a second) on the other
-        # core while this one loads matplotlib and draws
-        with Forked(checked) as checks:
-            s = run_summary(an, None, inputs.trajectory(uniform.law, samples=201))
-            write_run(od, an, uniform, s, validation=checks.result, figures=sc.output.figures,
-                      animation_frames=sc.output.animation_frames, stage=stage, progress=prog)
+    """Run (:func:`dextar.jobs.run`; its physics checks on the other core while this one
+    draws), write every file, word the law, the claims and the checks."""
+    sc = load(args)
+    prog = written.Progress(enabled=not args.quiet and sys.stderr.isatty())
+    stage = written.staged(prog)
+    with noted(sc), OutputDir(args.out, force=args.force, produces=written.RUN_FILES) as od:
+        res = jobs.run(sc, stage=stage)
+        try:
+            written.write_run(od, res.analysis, res.uniform, res.summary,
+                              validation=res.validation, figures=sc.output.figures,
+                              animation_frames=sc.output.animation_frames, stage=stage,
+                              progress=prog)
+        finally:  # the checks' process ended, whatever happened to the files
+            res.checks.close()
+    s = res.summary
     law = s["law"]
-    warnings = ([] if law["success"] else
-                [f"dextar run: warning: {law['type']} law status {law['status']}: "
-                 f"{law['message']}"])
+    warnings = note_lines("run", sc)
+    if not law["success"]:
+        warnings.append(f"dextar run: warning: {law['type']} law status {law['status']}: "
+                        f"{law['message']}")
     checks = s["validation"]
     warnings += [f"dextar run: check failed: {why}" for why in checks["failed"]]
     lines = [f"wrote {len(s['files'])} files to {shown(args.out)} (open "
@@ -75,10 +61,11 @@ def _run(args: argparse.Namespace) -> Result:
     fw = checks["forward_resimulation"]
     lines.append(
         f"checks {'passed' if checks['passed'] else 'FAILED'}: power balance "
-        f"{_figure(checks['power_balance_relative'])} (at most {checks['power_balance_threshold']:g}); "
-        f"forward re-simulation in {fw.get('windows', 0)} windows, largest drift "
-        f"{_figure(fw.get('max_drift_rad'))} rad, {_figure(fw.get('max_drift_ratio'))} of the "
-        f"peak acceleration's (at most {fw['threshold']:g})")
+        f"{_figure(checks['power_balance_relative'])} (at most "
+        f"{checks['power_balance_threshold']:g}); forward re-simulation in "
+        f"{fw.get('windows', 0)} windows, largest drift {_figure(fw.get('max_drift_rad'))} "
+        f"rad, {_figure(fw.get('max_drift_ratio'))} of the peak acceleration's (at most "
+        f"{fw['threshold']:g})")
     return Result(s, "\n".join(lines), warnings, code=0 if checks["passed"] else 1)
 
 

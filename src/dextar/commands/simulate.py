@@ -4,13 +4,16 @@ plant; the tracking, the torques against the limit and a summary."""
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
 
-from .base import Result, config_argument, into_directory, shown, with_notes
+from .. import jobs
+from .._lazy import lazy_module
+from .base import Result, config_argument, into_directory, load, note_lines, noted, shown
 
-NAME = "simulate"
-HELP = ("computed-torque tracking against a perturbed plant (exit 1 when the robot leaves "
-        "[control].tolerance_mm, the files written)")
-REGISTRIES_HELP = True
+if TYPE_CHECKING:  # the writers, imported when the command runs (start-up: dextar._lazy)
+    from ..output import simulation as written
+else:
+    written = lazy_module("dextar.output.simulation")
 
 
 def add_arguments(sp: argparse.ArgumentParser) -> None:
@@ -20,30 +23,14 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> Result:
-    """The command, with the config's notes (:func:`.base.with_notes`)."""
-    return with_notes(NAME, args, _run)
-
-
-def _run(args: argparse.Namespace) -> Result:
-    """Simulate, write the files, word the errors and the saturation."""
-    from ..config import load_scenario
-    from ..dynamics import Model
-    from ..output.simulation import TRACKING_FILES, write_tracking
-    from ..simulation import simulate_computed_torque
-
-    sc = load_scenario(args.config, model=args.model)
-    tr = sc.trajectory()
-    c = sc.control
-    plant_inertia = sc.inertia.scaled_masses(1.0 + c["mass_error"])
-    plant_inertia = plant_inertia.with_(payload=plant_inertia.payload + c["payload"])
-    res = simulate_computed_torque(
-        tr, Model(sc.robot, sc.inertia, tr.assembly), Model(sc.robot, plant_inertia,
-                                                            tr.assembly),
-        natural_frequency=c["natural_frequency"], damping=c["damping"],
-        torque_limit=c["torque_limit"], initial_error=c["initial_error"],
-        tolerance=c["tolerance"], time_s=sc.units.time_s, length_mm=sc.units.length_mm)
-    report = write_tracking(args.out, tr, res, sc.units, c, force=args.force)
-    warnings = []
+    """Simulate (:func:`dextar.jobs.simulate`), write the files, word the errors and the
+    saturation."""
+    sc = load(args)
+    with noted(sc):
+        job = jobs.simulate(sc)
+    tr, res, c = job.trajectory, job.result, job.control
+    report = written.write_tracking(args.out, tr, res, sc.units, c, force=args.force)
+    warnings = note_lines("simulate", sc)
     saturated = report["saturated_fraction"]
     if res.status == 1:
         warnings.append(f"dextar simulate: the controlled robot left the motion at "
@@ -58,7 +45,7 @@ def _run(args: argparse.Namespace) -> Result:
         warnings.append(f"dextar simulate: warning: the torque limit {c['torque_limit_nm']:g} "
                         f"N m saturates a motor during {saturated:.1%} of the motion; it was "
                         f"followed within {report['tolerance_mm']:.4g} mm all the same")
-    files = ", ".join(shown(args.out, n) for n in TRACKING_FILES)
+    files = ", ".join(shown(args.out, n) for n in written.TRACKING_FILES)
     verdict = "followed" if res.status == 0 else "NOT FOLLOWED"
     return Result(report, f"wrote {files}: {verdict} (tolerance {report['tolerance_mm']:.4g} "
                   f"mm): max task error {report['max_task_error_mm']:.4g} mm, max joint error "

@@ -5,16 +5,17 @@ from __future__ import annotations
 
 import argparse
 
-from .base import Result, json_flag
-
-NAME = "workspace"
-HELP = "workspace map with singularity curves and dexterity"
+from ..config.kinematic import load_robot_table
+from ..errors import ConfigError
+from ..kinematics import workspace_map
+from ..output.figures import plot_workspace
+from ..output.files import save_figure
+from .base import Result, json_flag, out_file
+from .kinematics_args import mode_argument, robot_argument
 
 
 def add_arguments(sp: argparse.ArgumentParser) -> None:
     """``--mode``, ``--out``, ``--resolution``, ``--robot``, ``--json``."""
-    from .kinematics_args import mode_argument, robot_argument
-
     mode_argument(sp)
     sp.add_argument("--out", default="workspace.png", help="PNG or SVG file")
     sp.add_argument("--resolution", type=int, default=301, help="grid points on the long side")
@@ -24,13 +25,6 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> Result:
     """Map, draw, summarise."""
-    from ..config import load_robot_table
-    from ..errors import ConfigError
-    from ..kinematics import workspace_map
-    from ..output.figures import plot_workspace
-    from ..output.files import save_figure
-    from .base import out_file
-
     rc = load_robot_table(args.robot)
     mode = args.mode or rc.working_mode
     path = out_file(args.out, ".png", ".svg")

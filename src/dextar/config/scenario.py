@@ -169,7 +169,7 @@ class Scenario:
         try:
             return DriveUnits(t.gear_ratio, (int(t.encoder_counts[0]), int(t.encoder_counts[1])),
                               t.rated_torque_Nm, (math.radians(off[0]), math.radians(off[1])),
-                              t.pvt_period_ms * 1e-3)
+                              t.pvt_period_ms * 1e-3, t.max_torque_permille)
         except DextarError as exc:
             raise ConfigError(f"config table [drive]: {exc}") from None
 
@@ -396,10 +396,10 @@ def scenario_from_dict(doc: Mapping[str, Any], *, source: str | None = None,
         sc = Scenario(sc.tables, source, sc.moves, sc.doc, text)
     try:  # build the run's objects now: a bad value fails here, named by its table
         _ = (sc.units, sc.robot, sc.path, sc.inertia)
-    except ConfigError:
-        raise
     except DextarError as exc:
-        raise ConfigError(f"config: {exc}") from None
+        said = str(exc) if isinstance(exc, ConfigError) else f"config: {exc}"
+        raise ConfigError(said + (f" (note: {'; '.join(sc.notes)})" if sc.notes else "")
+                          ) from None
     return sc
 
 
