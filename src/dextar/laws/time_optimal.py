@@ -50,6 +50,7 @@ from ..units import Units
 from .base import Law
 from .constraints import (
     Constraint,
+    DegeneracyCondition,
     PathCoefficients,
     PathDynamics,
     Tangent,
@@ -165,7 +166,12 @@ def solve_time_optimal_law(dynamics: PathDynamics, *,
         :mod:`dextar.laws.constraints`); one of them must limit the torques.
     grid : int or ndarray, shape (N + 1,)
         Number of equal segments in arc length, or the grid's arc lengths (increasing from 0
-        to the path's length; finer where the dynamics change fast, e.g. in a blend).
+        to the path's length; finer where the dynamics change fast, e.g. in a blend). A
+        dynamics with an ``adjust_grid(s)`` method moves grid points where it needs them (a
+        crossing of the parallel singularity curve:
+        :class:`dextar.dynamics.crossing.RobotAcrossPath`), and coefficients with
+        ``conditions`` add :class:`~dextar.laws.constraints.DegeneracyCondition` to the
+        constraints.
     tol : float
         Allowed relative excess of a torque or speed over its limit on the check samples.
     units : Units, optional
@@ -187,9 +193,16 @@ def solve_time_optimal_law(dynamics: PathDynamics, *,
         raise ParameterError(f"tolerance {tol!r} must be in (0, 1)")
     length = float(dynamics.length)
     s_grid = _grid(grid, length)
+    adjust = getattr(dynamics, "adjust_grid", None)  # grid points a dynamics needs (crossings)
+    if adjust is not None:
+        s_grid = adjust(s_grid)
     co = dynamics.coefficients(s_grid)
     tmax = np.asarray(_torque_limit(cons), float)
-    _check_holding(co, tmax, units)
+    if co.conditions:  # a crossing's degeneracy condition: imposed, never left out
+        if not any(isinstance(c, DegeneracyCondition) for c in cons):
+            cons = (*cons, DegeneracyCondition())
+    else:  # (near a crossing the robot cannot be held at rest: its passes decide there)
+        _check_holding(co, tmax, units)
     ds = np.diff(co.s)
     # the tightening of each kind of limit (the message names torque and speed always)
     scales = dict.fromkeys(("torque", "speed", *(c.kind for c in cons)), 1.0)
@@ -264,7 +277,7 @@ def _verdict(law: TimeOptimalLaw, ratio: dict[str, float], scales: dict[str, flo
         "; limits tightened by " + " and ".join(f"{1 - v:.2%} ({k})" for k, v in scales.items())
         + " so that they hold between the grid points")
     extra = "".join(f", {k} ratio {r:.5f}" for k, r in ratio.items()
-                    if k not in ("torque", "speed"))
+                    if k not in ("torque", "speed", "degeneracy"))
     ratios = (f"torque ratio {law.max_torque_ratio:.5f}, speed ratio "
               f"{law.max_speed_ratio:.5f}{extra}")
     if ok:
