@@ -91,3 +91,20 @@ def test_degeneracy_residual_is_the_normal_force():
     f0 = chain_forces(Model(case.robot, case.inertia.with_(gravity=(0.0, 0.0))), c.q, z, z,
                       c.P, z, z)
     assert abs(float(degeneracy_residual(f0))) < 1e-15
+
+
+def test_task_state_on_floats_is_task_dynamics():
+    """The integrators' one-state evaluation gives the vectorised one's numbers."""
+    from dextar.dynamics.closed_chain import task_state
+
+    _, _, _, P, dP, _ = _motion(np.random.default_rng(5), 5)
+    model = Model(ROBOT, INERTIA)
+    td = task_dynamics(model, "+-", P, dP)
+    for i in range(len(P)):
+        st = task_state(model, (1, -1), P[i], dP[i])
+        assert st is not None
+        M, h, E, q, dq = st
+        for got, ref in ((M, td.M[i]), (h, td.h[i]), (E, td.E[i]), (dq, td.dq[i])):
+            assert np.abs(got - ref).max() <= 1e-12 * np.abs(ref).max()
+        assert np.abs(np.angle(np.exp(1j * (q - td.q[i])))).max() < 1e-12
+    assert task_state(model, (1, -1), np.array([0.0, 0.5]), np.zeros(2)) is None  # out of reach

@@ -36,7 +36,9 @@ independent evaluation: the tests compare them away from the singularity).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -98,37 +100,18 @@ class ChainForces:
                         -1)
 
 
-def chain_forces(model: Model, q: object, dq: object, ddq: object, P: object, dP: object,
-                 ddP: object, *, gravity: bool = True, friction: bool = True) -> ChainForces:
-    """The generalised forces ``F_q`` and ``F_P`` of a motion given in full coordinates.
-
-    Parameters
-    ----------
-    q, dq, ddq : array_like, shape (..., 2)
-        Motor angles, rates and accelerations.
-    P, dP, ddP : array_like, shape (..., 2)
-        The end-effector's position, velocity and acceleration (consistent with ``q``: no
-        direct kinematics is solved, so nothing is divided by ``det A``).
-    gravity, friction : bool
-        Include the gravity and the motors' friction.
-
-    Returns
-    -------
-    ChainForces
-    """
-    q, dq, ddq, P, dP, ddP = (as_points(x, n) for x, n in (
-        (q, "q"), (dq, "dq"), (ddq, "ddq"), (P, "P"), (dP, "dP"), (ddP, "ddP")))
+def _forces(model: Model, c1: Any, s1: Any, c2: Any, s2: Any, w1: Any, w2: Any, a1: Any,
+            a2: Any, Px: Any, Py: Any, ddPx: Any, ddPy: Any, gravity: bool,
+            friction: bool) -> tuple[Any, ...]:
+    """The arithmetic of :func:`chain_forces` on arrays or plain floats: ``F_q``, ``F_P``,
+    ``u = P - B``, ``e = P - C`` and ``b`` component by component."""
     r, ine = model.robot, model.inertia
     l1, l2, L1, L2 = r.l1, r.l2, r.L1, r.L2
     half = 0.5 * r.d
-    c1, s1 = cos_sin(q[..., 0])
-    c2, s2 = cos_sin(q[..., 1])
-    w1, w2, a1, a2 = dq[..., 0], dq[..., 1], ddq[..., 0], ddq[..., 1]
-    ux, uy = P[..., 0] - (half + l1 * c1), P[..., 1] - l1 * s1
-    ex, ey = P[..., 0] - (l2 * c2 - half), P[..., 1] - l2 * s2
+    ux, uy = Px - (half + l1 * c1), Py - l1 * s1
+    ex, ey = Px - (l2 * c2 - half), Py - l2 * s2
     ddBx, ddBy = -l1 * (s1 * a1 + c1 * w1 * w1), l1 * (c1 * a1 - s1 * w1 * w1)
     ddCx, ddCy = -l2 * (s2 * a2 + c2 * w2 * w2), l2 * (c2 * a2 - s2 * w2 * w2)
-    ddPx, ddPy = ddP[..., 0], ddP[..., 1]
     gx, gy = ine.gravity if gravity else (0.0, 0.0)
     rod1, rod2 = ine.proximal
     rod3, rod4 = ine.distal
@@ -152,9 +135,39 @@ def chain_forces(model: Model, q: object, dq: object, ddq: object, P: object, dP
     if friction and ine.has_friction:
         Fq1 = Fq1 + friction_torque(w1, ine.viscous[0], ine.coulomb[0], ine.coulomb_speed)
         Fq2 = Fq2 + friction_torque(w2, ine.viscous[1], ine.coulomb[1], ine.coulomb_speed)
+    b1, b2 = l1 * (c1 * uy - s1 * ux), l2 * (c2 * ey - s2 * ex)
+    return Fq1, Fq2, FPx, FPy, ux, uy, ex, ey, b1, b2
+
+
+def chain_forces(model: Model, q: object, dq: object, ddq: object, P: object, dP: object,
+                 ddP: object, *, gravity: bool = True, friction: bool = True) -> ChainForces:
+    """The generalised forces ``F_q`` and ``F_P`` of a motion given in full coordinates.
+
+    Parameters
+    ----------
+    q, dq, ddq : array_like, shape (..., 2)
+        Motor angles, rates and accelerations.
+    P, dP, ddP : array_like, shape (..., 2)
+        The end-effector's position, velocity and acceleration (consistent with ``q``: no
+        direct kinematics is solved, so nothing is divided by ``det A``; ``dP`` enters only
+        through ``dq``, given).
+    gravity, friction : bool
+        Include the gravity and the motors' friction.
+
+    Returns
+    -------
+    ChainForces
+    """
+    q, dq, ddq, P, dP, ddP = (as_points(x, n) for x, n in (
+        (q, "q"), (dq, "dq"), (ddq, "ddq"), (P, "P"), (dP, "dP"), (ddP, "ddP")))
+    c1, s1 = cos_sin(q[..., 0])
+    c2, s2 = cos_sin(q[..., 1])
+    Fq1, Fq2, FPx, FPy, ux, uy, ex, ey, b1, b2 = _forces(
+        model, c1, s1, c2, s2, dq[..., 0], dq[..., 1], ddq[..., 0], ddq[..., 1], P[..., 0],
+        P[..., 1], ddP[..., 0], ddP[..., 1], gravity, friction)
     A = np.stack([np.stack([ux, uy], -1), np.stack([ex, ey], -1)], -2)
-    b = np.stack([l1 * (c1 * uy - s1 * ux), l2 * (c2 * ey - s2 * ex)], -1)
-    return ChainForces(np.stack([Fq1, Fq2], -1), np.stack([FPx, FPy], -1), A, b)
+    return ChainForces(np.stack([Fq1, Fq2], -1), np.stack([FPx, FPy], -1), A,
+                       np.stack([b1, b2], -1))
 
 
 def chain_torques(model: Model, q: object, dq: object, ddq: object, P: object, dP: object,
@@ -234,3 +247,58 @@ def task_dynamics(model: Model, mode: str, P: object, dP: object, *,
     A, b = f.A[..., 0, :, :], f.b[..., 0, :]
     E = np.swapaxes(A, -1, -2) / b[..., None, :]
     return TaskDynamics(M, h, E, q, dq[..., 0, :])
+
+
+def _elbow(x: float, y: float, l: float, L: float, sign: int) -> tuple[float, float] | None:
+    """One leg's inverse kinematics on floats: the proximal rod's ``(cos, sin)`` for the point
+    ``(x, y)`` from its pivot (as :func:`dextar.kinematics.inverse_kinematics`), None out of
+    reach."""
+    rho2 = x * x + y * y
+    k = 0.5 * (rho2 + (l * l - L * L))
+    w2 = (l * l) * rho2 - k * k
+    if not (w2 >= -1e-12 * (l * l) * rho2) or rho2 <= 1e-24 * (l + L) ** 2:
+        return None
+    w = math.sqrt(max(w2, 0.0))
+    if sign > 0:
+        w = -w
+    cx, cy = k * x - w * y, k * y + w * x
+    n = math.hypot(cx, cy)
+    return cx / n, cy / n
+
+
+def task_state(model: Model, signs: tuple[int, int], P: Any, dP: Any
+               ) -> tuple[Array, Array, Array, Array, Array] | None:
+    """:func:`task_dynamics` at one state on plain floats (fast enough for an integrator's
+    step): ``M (2, 2), h (2,), E (2, 2), q (2,), dq (2,)`` in the working mode of ``signs``;
+    None where the end-effector is out of reach or at a serial singularity (where the working
+    mode ends)."""
+    r = model.robot
+    half = 0.5 * r.d
+    Px, Py, vx, vy = float(P[0]), float(P[1]), float(dP[0]), float(dP[1])
+    e1 = _elbow(Px - half, Py, r.l1, r.L1, signs[0])
+    e2 = _elbow(Px + half, Py, r.l2, r.L2, signs[1])
+    if e1 is None or e2 is None:
+        return None
+    (c1, s1), (c2, s2) = e1, e2
+    ux, uy = Px - (half + r.l1 * c1), Py - r.l1 * s1
+    ex, ey = Px - (r.l2 * c2 - half), Py - r.l2 * s2
+    b1, b2 = r.l1 * (c1 * uy - s1 * ux), r.l2 * (c2 * ey - s2 * ex)
+    if abs(b1) <= 1e-9 * r.l1 * r.L1 or abs(b2) <= 1e-9 * r.l2 * r.L2:
+        return None
+    w1, w2 = (ux * vx + uy * vy) / b1, (ex * vx + ey * vy) / b2
+    # the velocity-product terms of A Pddot - B qddot = bias
+    gx1, gy1 = vx + r.l1 * w1 * s1, vy - r.l1 * w1 * c1
+    gx2, gy2 = vx + r.l2 * w2 * s2, vy - r.l2 * w2 * c2
+    bias1 = -(gx1 * gx1 + gy1 * gy1) - r.l1 * w1 * w1 * (ux * c1 + uy * s1)
+    bias2 = -(gx2 * gx2 + gy2 * gy2) - r.l2 * w2 * w2 * (ex * c2 + ey * s2)
+    W = []
+    for ax, ay in ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0)):
+        a1, a2 = (ux * ax + uy * ay - bias1) / b1, (ex * ax + ey * ay - bias2) / b2
+        f = _forces(model, c1, s1, c2, s2, w1, w2, a1, a2, Px, Py, ax, ay, True, True)
+        g1, g2 = f[0] / b1, f[1] / b2
+        W.append((f[2] + ux * g1 + ex * g2, f[3] + uy * g1 + ey * g2))
+    h = np.array(W[0])
+    M = np.array([[W[1][0] - h[0], W[2][0] - h[0]], [W[1][1] - h[1], W[2][1] - h[1]]])
+    E = np.array([[ux / b1, ex / b2], [uy / b1, ey / b2]])
+    q = np.array([math.atan2(s1, c1), math.atan2(s2, c2)])
+    return M, h, E, q, np.array([w1, w2])

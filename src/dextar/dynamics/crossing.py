@@ -35,6 +35,7 @@ Where it does not hold (a law that ignores it) nothing is smoothed: the exact to
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -225,19 +226,11 @@ class RobotAcrossPath:
         nodes' times (module doc)."""
         t = np.asarray(times, float)
         _, dq, ddq, tau, _ = self._exact(law, t)
-        for tc, h_t in self._windows(law):
-            if h_t is None:
-                continue
-            near = np.abs(t - tc) < h_t
-            if near.any():
-                nodes = tc + h_t * _NODES
-                tau_n = self._exact(law, nodes)[3]
-                tau[near] = _lagrange((t[near] - tc) / h_t) @ tau_n
-        return JointSamples(tau, dq, ddq, t)
+        return JointSamples(PlannedTorques(self, law).smooth(t, tau), dq, ddq, t)
 
-    def _windows(self, law: Law) -> list[tuple[float, float | None]]:
-        """Per crossing, its time and the nodes' step in time (None where the condition does
-        not hold: nothing is smoothed)."""
+    def windows(self, law: Law) -> tuple[tuple[float, float | None], ...]:
+        """Per crossing, its time along ``law`` and the nodes' step in time (None where the
+        condition does not hold: nothing is smoothed there)."""
         out: list[tuple[float, float | None]] = []
         bp = law.breakpoints()
         s_bp = law.evaluate(bp)[0] if bp.size else np.empty(0)
@@ -251,7 +244,41 @@ class RobotAcrossPath:
             near = float(far.min()) if far.size else self.length
             near = min(near, c.s, self.length - c.s)
             out.append((tc, self._step(c, near) / v))
-        return out
+        return tuple(out)
+
+
+@dataclass(frozen=True)
+class PlannedTorques:
+    """The torques of ``law`` along ``dynamics`` as a function of time, its crossings'
+    windows found once (a feedforward for a controller, a torque function for the forward
+    dynamics): :meth:`RobotAcrossPath.samples`'s torques, one call per time."""
+
+    dynamics: RobotAcrossPath
+    law: Law
+
+    @cached_property
+    def _windows(self) -> tuple[tuple[float, float | None], ...]:
+        return self.dynamics.windows(self.law)
+
+    def smooth(self, t: Array, tau: Array) -> Array:
+        """``tau`` (n, 2), the exact torques at times ``t`` (n,), with the samples within a
+        crossing's window replaced by the cubic through its nodes."""
+        tau = np.array(tau, float)
+        for tc, h_t in self._windows:
+            if h_t is None:
+                continue
+            near = np.abs(t - tc) < h_t
+            if near.any():
+                tau_n = self.dynamics._exact(self.law, tc + h_t * _NODES)[3]
+                tau[near] = _lagrange((t[near] - tc) / h_t) @ tau_n
+        return tau
+
+    def __call__(self, t: object) -> Array:
+        """The torques (..., 2) at times ``t`` (...,), clipped to the law's duration."""
+        ta = np.asarray(t, float)
+        tt = np.clip(np.atleast_1d(ta), 0.0, self.law.duration)
+        tau = self.smooth(tt, self.dynamics._exact(self.law, tt)[3])
+        return tau.reshape(ta.shape + (2,))
 
 
 @dataclass(frozen=True)
