@@ -95,6 +95,10 @@ class PathCoefficients:
         Equalities the motion must meet at some grid points (the degeneracy conditions of
         crossings of the parallel singularity curve); :class:`DegeneracyCondition` imposes
         them.
+    holdable : ndarray of bool, shape (N + 1,), optional
+        The grid points where holding the robot still is a meaningful check (None: all);
+        near a crossing of the parallel singularity curve no finite torque holds it there,
+        and the motion passes.
     """
 
     s: Array
@@ -108,6 +112,7 @@ class PathCoefficients:
     d2q_ds2: Array | None = None
     coulomb_speed: float = 1.0
     conditions: tuple[ConditionRow, ...] = ()
+    holdable: Array | None = None
 
     @property
     def ddq_ds(self) -> Array:

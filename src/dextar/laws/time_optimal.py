@@ -198,11 +198,9 @@ def solve_time_optimal_law(dynamics: PathDynamics, *,
         s_grid = adjust(s_grid)
     co = dynamics.coefficients(s_grid)
     tmax = np.asarray(_torque_limit(cons), float)
-    if co.conditions:  # a crossing's degeneracy condition: imposed, never left out
-        if not any(isinstance(c, DegeneracyCondition) for c in cons):
-            cons = (*cons, DegeneracyCondition())
-    else:  # (near a crossing the robot cannot be held at rest: its passes decide there)
-        _check_holding(co, tmax, units)
+    if co.conditions and not any(isinstance(c, DegeneracyCondition) for c in cons):
+        cons = (*cons, DegeneracyCondition())  # a crossing's condition: never left out
+    _check_holding(co, tmax, units)
     ds = np.diff(co.s)
     # the tightening of each kind of limit (the message names torque and speed always)
     scales = dict.fromkeys(("torque", "speed", *(c.kind for c in cons)), 1.0)
@@ -341,15 +339,20 @@ def _torque(units: Units | None, value: float) -> str:
 
 
 def _check_holding(co: PathCoefficients, tmax: Array, units: Units | None) -> None:
-    """Gravity alone must be within the limits everywhere on the path."""
+    """Gravity alone must be within the limits everywhere on the path (where holding the
+    robot still means something: :attr:`PathCoefficients.holdable`)."""
     ratio = np.abs(co.g) / tmax
+    if co.holdable is not None:
+        ratio = np.where(co.holdable[:, None], ratio, 0.0)
     if ratio.max() > 1.0:
         k, i = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
         motor = "A" if i == 0 else "D"
-        raise InfeasibleError(
+        exc = InfeasibleError(
             f"no motion within the limits: the motor at {motor} needs "
             f"{_torque(units, abs(co.g[k, i]))} to hold the robot still against gravity at "
             f"{_describe(co, int(k), units)}, above its limit {_torque(units, tmax[i])}")
+        exc.holding = True  # type: ignore[attr-defined]  # (gravity alone, not the motion)
+        raise exc
 
 
 def _rows(co: PathCoefficients, ds: Array, constraints: Sequence[Constraint],

@@ -1,0 +1,125 @@
+"""Moves across the parallel (type 2) singularity curve (issue 31): ``assembly_mode`` on a
+line or an arc, planned time-optimal under the degeneracy condition; the crossing's time,
+residual and torque peak in summary.json; what cannot cross refused by name."""
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from dextar.cli import main
+from dextar.errors import AssemblyError, InfeasibleError, ParameterError
+from dextar.motors import MotorLimits
+from dextar.output.program import crossing_points
+from dextar.program import Move, plan_program
+
+from ..crossing_cases import CASES
+from .test_program import read
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+
+
+@pytest.fixture(scope="module")
+def example(tmp_path_factory):
+    out = tmp_path_factory.mktemp("x") / "out"
+    assert main(["program", str(EXAMPLES / "type2_crossing.toml"), "--out", str(out),
+                 "--quiet"]) == 0
+    head, data = read(out / "setpoints.csv")
+    return (dict(zip(head, data.T, strict=True)), json.loads((out / "summary.json").read_text()),
+            out)
+
+
+def test_the_example_crosses_down_and_back_within_the_motors(example):
+    cols, summ, out = example
+    assert summ["status"] == "fits"
+    modes = [m["assembly_mode"] for m in summ["moves"]]
+    assert modes == ["down", "down", "down", "up"]
+    (down,), (up,) = summ["moves"][0]["crossings"], summ["moves"][3]["crossings"]
+    for c in (down, up):
+        # the condition holds to rounding (measured 5e-15 and 9e-15 of its terms)
+        assert c["condition_holds"] and c["residual_ratio"] < 1e-10
+        assert max(c["torque_peak_ratio"]) <= 1 + 1e-3
+        assert c["neighbourhood_s"][0] < c["time_s"] < c["neighbourhood_s"][1]
+        assert abs(c["point_mm"][1] - 44.0) < 0.5  # the rods horizontal, y = 44 mm
+    assert (down["assembly_before"], up["assembly_after"]) == ("up", "up")
+    tau = np.stack([cols["tau1_Nm"], cols["tau2_Nm"]], -1)
+    assert np.isfinite(tau).all() and np.abs(tau).max() <= 0.5 * (1 + 1e-3)
+    # the setpoints pass the crossing's time, and the report says it
+    t = cols["t_s"]
+    assert t.min() < down["time_s"] < t.max()
+    assert "Crossings of the parallel singularity curve" in (out / "report.html").read_text()
+    assert (out / "moves.png").stat().st_size > 0 and (out / "motion.png").stat().st_size > 0
+
+
+def _moves(case, **extra):
+    return [Move("line", {"to": case.end, **extra}), Move("dwell", {"time": 0.05})]
+
+
+@pytest.mark.parametrize("name", sorted(CASES))
+def test_the_python_api_plans_the_crossing_on_both_robots(name):
+    case = CASES[name]
+    res = plan_program(case.robot, case.inertia, _moves(case, assembly_mode="down"),
+                       start=case.start, working_mode="+-", motors=case.motors)
+    pm = res.moves[0]
+    assert (pm.assembly, pm.end_assembly) == ("up", "down") and len(pm.crossings) == 1
+    assert np.abs(res.tau).max() <= case.peak * (1 + 1e-3)
+    (c,) = case.crossings
+    assert np.allclose(crossing_points(res), 1e3 * c.P, atol=1e-9)
+    # the dwell holds the robot in assembly mode down (its torques are the down pose's)
+    assert res.timeline()[1].assembly_mode == "down"
+
+
+def test_assembly_mode_without_a_crossing_is_refused_by_name():
+    case = CASES["dextar"]
+    with pytest.raises(AssemblyError, match=r"move 0 \(line\): assembly_mode = \"down\", but "
+                                            r"its path .* does not cross"):
+        plan_program(case.robot, case.inertia, [Move("line", {"to": (0.010, 0.060),
+                                                              "assembly_mode": "down"})],
+                     start=case.start, working_mode="+-", motors=case.motors)
+    # asking for the mode it is already in is no change: planned
+    plan_program(case.robot, case.inertia, [Move("line", {"to": (0.010, 0.060),
+                                                          "assembly_mode": "up"})],
+                 start=case.start, working_mode="+-", motors=case.motors)
+
+
+def test_a_crossing_without_the_key_is_refused_as_before():
+    case = CASES["dextar"]
+    with pytest.raises(Exception, match="parallel"):
+        plan_program(case.robot, case.inertia, [Move("line", {"to": case.end})],
+                     start=case.start, working_mode="+-", motors=case.motors)
+
+
+def test_a_law_that_ignores_the_condition_is_refused_by_name():
+    case = CASES["dextar"]
+    with pytest.raises(ParameterError, match="needs law = \"time-optimal\".*min-jerk"):
+        plan_program(case.robot, case.inertia,
+                     [Move("line", {"to": case.end, "assembly_mode": "down"}, law="min-jerk",
+                           duration=0.3)],
+                     start=case.start, working_mode="+-", motors=case.motors)
+
+
+def test_a_joint_move_keeps_its_assembly_mode():
+    case = CASES["dextar"]
+    with pytest.raises(AssemblyError, match="a joint move stays in assembly mode up"):
+        plan_program(case.robot, case.inertia,
+                     [Move("joint", {"to": case.end, "assembly_mode": "down"})],
+                     start=case.start, working_mode="+-", motors=case.motors)
+
+
+def test_a_crossing_the_motors_cannot_make_is_refused_with_the_reason():
+    """Back up across the curve against gravity at 0.3 N m: the condition asks the effector
+    to decelerate at about g there, which no motion within 0.3 N m reaches; at 0.5 N m it
+    plans."""
+    case = CASES["dextar"]
+    moves = [Move("line", {"to": case.start, "assembly_mode": "up"})]
+    start = (0.0, 0.030)
+    from dataclasses import replace
+    weak = replace(case.motors, peak_torque=(0.3, 0.3))
+    with pytest.raises(InfeasibleError, match="the crossing of the parallel .* cannot be made "
+                                              "within the motors' limits"):
+        plan_program(case.robot, case.inertia, moves, start=start, working_mode="+-",
+                     assembly="down", motors=weak)
+    res = plan_program(case.robot, case.inertia, moves, start=start, working_mode="+-",
+                       assembly="down", motors=MotorLimits((0.5, 0.5)))
+    assert res.moves[0].end_assembly == "up"
