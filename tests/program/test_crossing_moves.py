@@ -123,3 +123,26 @@ def test_a_crossing_the_motors_cannot_make_is_refused_with_the_reason():
     res = plan_program(case.robot, case.inertia, moves, start=start, working_mode="+-",
                        assembly="down", motors=MotorLimits((0.5, 0.5)))
     assert res.moves[0].end_assembly == "up"
+
+
+def test_a_blended_chain_and_an_arc_cross_where_their_members_ask():
+    """The member of a blended chain that asks for "down" crosses (the chain is one motion),
+    and an arc brings the robot back up; every torque within the motors."""
+    case = CASES["dextar"]
+    moves = [Move("line", {"to": (-0.005, 0.060)}, blend=0.003),
+             Move("line", {"to": (0.005, 0.025), "assembly_mode": "down"}),
+             Move("arc", {"via": (0.0, 0.055), "to": case.start, "assembly_mode": "up"})]
+    res = plan_program(case.robot, case.inertia, moves, start=case.start, working_mode="+-",
+                       motors=case.motors)
+    tl = res.timeline()
+    assert [m.assembly_mode for m in tl] == ["up", "down", "up"]
+    assert [len(m.crossings) for m in tl] == [0, 1, 1]
+    for m in tl[1:]:
+        (c,) = m.crossings
+        assert m.start_s < c["time_s"] < m.start_s + m.duration_s and c["condition_holds"]
+    assert np.abs(res.tau).max() <= case.peak * (1 + 1e-3)
+    # a chain whose member asks for a mode its piece does not reach is refused, naming it
+    bad = [moves[0], Move("line", {"to": (0.005, 0.050), "assembly_mode": "down"})]
+    with pytest.raises(AssemblyError, match=r"move 1 \(line\): assembly_mode"):
+        plan_program(case.robot, case.inertia, bad, start=case.start, working_mode="+-",
+                     motors=case.motors)
