@@ -167,7 +167,8 @@ def main() -> None:
         tau = PlannedTorques(dyn, law)(t[:-1] + 0.5 * dt)
         P, dP = path_motion(path, law, t)[6:8]
         t0 = time.perf_counter()
-        fw = forward_task_dynamics(model, "+-", lambda tt, q, dq: tau[int(tt // dt)], P[0],
+        fw = forward_task_dynamics(model, "+-",
+                                   lambda tt, q, dq, tau=tau, dt=dt: tau[int(tt // dt)], P[0],
                                    dP[0], t, substeps=2)
         err = np.linalg.norm(fw.P - P, axis=-1)
         print(f"  forward dynamics (end-effector coordinates), planned torques held at 10 kHz: "
