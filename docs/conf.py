@@ -31,6 +31,7 @@ exclude_patterns = ["_build", "Thumbs.db", ".DS_Store"]
 # the API reference (pages written by dextar_docs into reference/api/ at build time)
 # numpydoc loads autosummary; nothing here asks it to generate pages
 autosummary_generate = False
+add_module_names = False  # (each page and section says its module)
 autodoc_default_options = {"member-order": "bysource"}
 autodoc_typehints = "signature"
 # (preserving the defaults' source text and reading type comments parse every function's

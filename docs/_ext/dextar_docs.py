@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import hashlib
 import html
+import importlib
 import inspect
 import os
 import subprocess
@@ -109,6 +110,35 @@ def skip_member(app: Sphinx, what: str, name: str, obj: Any, skip: bool,
         if what == "module" and not mod.startswith("dextar"):
             return True
     return None
+
+
+def resolve_reexport(app: Sphinx, env: Any, node: Any, contnode: nodes.Element) -> Any:
+    """A reference to a name a package re-exports (``dextar.program.plan_program``) goes to
+    where it is documented (``dextar.program.plan.plan_program``). A Python reference of a
+    hand-written page that resolves nowhere is a warning (so an error under ``-W``); the
+    docstrings' references to other libraries' types stay plain text."""
+    if node.get("refdomain") != "py":
+        return None
+    target = node["reftarget"]
+    found = None
+    if target.startswith("dextar."):
+        where, _, name = target.rpartition(".")
+        try:
+            package = importlib.import_module(where)
+        except ImportError:
+            package = None
+        obj = getattr(package, name, None)
+        if inspect.isclass(obj) or inspect.isfunction(obj):
+            canonical: str | None = f"{obj.__module__}.{obj.__qualname__}"
+        else:
+            canonical = dextar_reference._defined_in(package, name) if package else None
+        if canonical and canonical != target:
+            found = env.get_domain("py").resolve_xref(env, node["refdoc"], app.builder,
+                                                      node["reftype"], canonical, node,
+                                                      contnode)
+    if found is None and not node["refdoc"].startswith("reference/api/"):
+        logger.warning("reference to %s found nowhere", target, location=node)
+    return found
 
 
 # -- numpydoc, with its template compiled once ------------------------------------------------
@@ -420,6 +450,7 @@ def setup(app: Sphinx) -> dict[str, Any]:
     app.connect("builder-inited", write_api_pages)
     app.connect("builder-inited", start_runs)
     app.connect("autodoc-skip-member", skip_member)
+    app.connect("missing-reference", resolve_reexport)
     app.connect("doctree-resolved", fill_runs)
     app.connect("build-finished", check_runs)
     return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": False}

@@ -273,6 +273,8 @@ def _public_modules(package: Any) -> list[tuple[str, bool]]:
 
 
 def _first_line(module_name: str) -> str:
+    """The first paragraph of a module's docstring, on one line (reStructuredText as the
+    docstring writes it)."""
     doc = inspect.getdoc(importlib.import_module(module_name)) or ""
     return " ".join(doc.split("\n\n")[0].split())
 
@@ -312,7 +314,7 @@ def _package_page(name: str) -> list[str]:
                 "   * - module", "     - what it holds"]
         for m, _ in modules:
             out += [f"   * - :mod:`{m}`",
-                    f"     - {text(_first_line(m))}"]
+                    f"     - {_first_line(m)}"]
         out += [""]
     for sub, _ in modules:
         out += _section_page(sub, 1)
@@ -352,7 +354,7 @@ def api_pages() -> dict[str, str]:
              "   * - module", "     - what it holds"]
     for name in order:
         index += [f"   * - :doc:`{name} <{name}>`",
-                  f"     - {text(_first_line(name))}"]
+                  f"     - {_first_line(name)}"]
     index += ["", ".. toctree::", "   :hidden:", "", *[f"   {n}" for n in order], ""]
     pages["index"] = "\n".join(index) + "\n"
     return pages
