@@ -199,9 +199,10 @@ def command_parsers() -> Iterator[tuple[str, argparse.ArgumentParser]]:
     from dextar.cli import build_parser
     from dextar.commands import COMMANDS
 
-    parsers = build_parser().get_default("parsers")
+    top = build_parser()
+    sub = next(a for a in top._actions if isinstance(a, argparse._SubParsersAction))
     for name in COMMANDS:
-        yield name, parsers[name]
+        yield name, sub.choices[name]
 
 
 def arguments(parser: argparse.ArgumentParser) -> Iterator[tuple[str, str]]:
@@ -275,7 +276,10 @@ def _public_modules(package: Any) -> list[tuple[str, bool]]:
 def _first_line(module_name: str) -> str:
     """The first paragraph of a module's docstring, on one line (reStructuredText as the
     docstring writes it)."""
-    doc = inspect.getdoc(importlib.import_module(module_name)) or ""
+    module = importlib.import_module(module_name)
+    doc = inspect.getdoc(module) or ""
+    if not doc and hasattr(module, "__path__"):  # a folder of modules without __init__.py
+        return "Its modules: " + ", ".join(f":mod:`{m}`" for m, _ in _public_modules(module))
     return " ".join(doc.split("\n\n")[0].split())
 
 
