@@ -381,6 +381,32 @@ def _placeholder(run: str, what: str,
     return node
 
 
+def _note_runs(env: Any) -> None:
+    """The page being read shows what a run made: it is read again at every build (what a
+    run prints changes with the package, not with the page)."""
+    if not hasattr(env, "dextar_run_docs"):
+        env.dextar_run_docs = set()
+    env.dextar_run_docs.add(env.docname)
+
+
+def outdated_runs(app: Sphinx, env: Any, added: set[str], changed: set[str],
+                  removed: set[str]) -> list[str]:
+    """The pages that show runs, to be read and written again."""
+    return sorted(getattr(env, "dextar_run_docs", set()) - removed)
+
+
+def purge_runs(app: Sphinx, env: Any, docname: str) -> None:
+    """Forget a page that is read again (it notes itself again)."""
+    getattr(env, "dextar_run_docs", set()).discard(docname)
+
+
+def merge_runs(app: Sphinx, env: Any, docnames: set[str], other: Any) -> None:
+    """Parallel reading: the pages the other process noted."""
+    if not hasattr(env, "dextar_run_docs"):
+        env.dextar_run_docs = set()
+    env.dextar_run_docs |= getattr(other, "dextar_run_docs", set()) & docnames
+
+
 class RunFigure(SphinxDirective):
     """``.. dextar-figure:: RUN FILE`` with the caption as content: a figure a run wrote."""
 
@@ -389,6 +415,7 @@ class RunFigure(SphinxDirective):
 
     def run(self) -> list[nodes.Node]:
         """The directive\'s nodes."""
+        _note_runs(self.env)
         node = _placeholder(self.arguments[0], "figure", [(self.arguments[1], "")])
         caption = nodes.paragraph(classes=["dextar-caption"])
         caption += self.parse_inline(" ".join(self.content), lineno=self.lineno)[0]
@@ -403,6 +430,7 @@ class RunOutput(SphinxDirective):
 
     def run(self) -> list[nodes.Node]:
         """The directive\'s nodes."""
+        _note_runs(self.env)
         return [_placeholder(self.arguments[0], "text")]
 
 
@@ -412,6 +440,7 @@ class Gallery(SphinxDirective):
 
     def run(self) -> list[nodes.Node]:
         """The directive\'s nodes."""
+        _note_runs(self.env)
         out: list[nodes.Node] = []
         for run in example_runs():
             assert run.source is not None
@@ -452,5 +481,8 @@ def setup(app: Sphinx) -> dict[str, Any]:
     app.connect("autodoc-skip-member", skip_member)
     app.connect("missing-reference", resolve_reexport)
     app.connect("doctree-resolved", fill_runs)
+    app.connect("env-get-outdated", outdated_runs)
+    app.connect("env-purge-doc", purge_runs)
+    app.connect("env-merge-info", merge_runs)
     app.connect("build-finished", check_runs)
     return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": False}
