@@ -35,7 +35,7 @@ add_module_names = False  # (each page and section says its module)
 autodoc_default_options = {"member-order": "bysource"}
 autodoc_typehints = "signature"
 # (preserving the defaults' source text and reading type comments parse every function's
-# source again: a third of the build)
+# source again: a tenth of the build)
 autodoc_preserve_defaults = False
 autodoc_use_type_comments = False
 numpydoc_show_class_members = False

@@ -145,8 +145,8 @@ def resolve_reexport(app: Sphinx, env: Any, node: Any, contnode: nodes.Element) 
 
 
 def _cache_numpydoc_template() -> None:
-    """Numpydoc compiles its Jinja template for every docstring (3,000 times here, 40 % of
-    the build); this gives it the template compiled once per builder."""
+    """Numpydoc compiles its Jinja template for every docstring (3,000 times here, a fifth
+    of the build); this gives it the template compiled once per builder."""
     try:
         from numpydoc import docscrape_sphinx as ds
         from numpydoc import numpydoc as nd
