@@ -278,8 +278,7 @@ def _execute(run: Run, stamp: str) -> tuple[int, str, str]:
 
 def start_runs(app: Sphinx) -> None:
     """Start every run (two at a time) while the sources are read."""
-    if app.builder.format != "html":
-        app.env.dextar_runs = {}  # type: ignore[attr-defined]
+    if app.builder.format != "html":  # (the pages show the runs' files as HTML)
         return
     runs = {r.name: r for r in example_runs()}
     for name, (argv, shown) in app.config.dextar_runs.items():
@@ -334,6 +333,9 @@ def fill_runs(app: Sphinx, doctree: nodes.document, docname: str) -> None:
     """Replace each placeholder by the run's figures or printed text."""
     up = "../" * docname.count("/")
     for node in list(doctree.findall(RunPlaceholder)):
+        if app.builder.format != "html":
+            node.replace_self([])
+            continue
         run = finished(app, node["run"])
         if run is None:
             logger.warning("no docs run named %r", node["run"], location=node)

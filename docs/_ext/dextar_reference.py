@@ -224,20 +224,21 @@ def cli_reference() -> str:
     """The command-line reference: ``dextar``'s commands, each with its usage and every
     argument, from the parser; reStructuredText."""
     from dextar.cli import build_parser
-    from dextar.commands import COMMANDS
 
     top = build_parser()
+    parsers = dict(command_parsers())
     out = ["Generated from the parser when the docs are built: what ``dextar COMMAND "
            "--help`` prints, every command on one page.", "",
            ".. list-table::", "   :header-rows: 1", "   :widths: 20 80", "",
            "   * - command", "     - what it does"]
-    for name, cmd in COMMANDS.items():
-        out += [f"   * - :ref:`dextar {name} <cli-{name}>`", f"     - {text(cmd.help)}"]
+    for name, parser in parsers.items():
+        out += [f"   * - :ref:`dextar {name} <cli-{name}>`",
+                f"     - {text(parser.description or '')}"]
     out += ["", "Options of ``dextar`` itself:", "", ".. code-block:: text", "",
             *_indent(top.format_usage().strip().splitlines()), ""]
-    for name, parser in command_parsers():
+    for name, parser in parsers.items():
         out += _section(f"dextar {name}", "-", f"cli-{name}")
-        out += [text(COMMANDS[name].help), "", ".. code-block:: text", "",
+        out += [text(parser.description or ""), "", ".. code-block:: text", "",
                 *_indent(parser.format_usage().strip().splitlines()), ""]
         for invocation, words in arguments(parser):
             out += [f"``{invocation}``", *_indent([text(words) or "(no help)"]), ""]
