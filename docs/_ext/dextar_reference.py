@@ -250,12 +250,29 @@ def cli_reference() -> str:
 
 # -- the API reference's pages ------------------------------------------------------------
 
-#: The order of the pipeline (geometry -> ... -> cli); a module not listed comes after, by
-#: name, so that a new one appears without an edit here.
+#: The order of the pipeline (geometry -> ... -> cli) where ``pyproject.toml`` has no layers
+#: contract (:func:`pipeline`); a module in neither comes after, by name, so that a new one
+#: appears without an edit here.
 PIPELINE = ("errors", "units", "params", "registry", "geometry", "motors", "kinematics",
             "paths", "laws", "trajectory", "dynamics", "simulation", "program",
             "identification", "calibration", "design", "analysis", "output", "config",
             "commands", "cli")
+
+
+def pipeline() -> tuple[str, ...]:
+    """The top-level modules in the pipeline's order, lowest first: the layers of the
+    import contract in ``pyproject.toml`` (``[tool.importlinter]``, ``type = "layers"``,
+    listed highest first), else :data:`PIPELINE`."""
+    import tomllib
+
+    pyproject = Path(__file__).resolve().parents[2] / "pyproject.toml"
+    config = tomllib.loads(pyproject.read_text()) if pyproject.exists() else {}
+    for contract in config.get("tool", {}).get("importlinter", {}).get("contracts", []):
+        if contract.get("type") == "layers":
+            names = [n.strip() for layer in reversed(contract["layers"])
+                     for n in layer.split("|")]
+            return tuple(n.removeprefix("dextar.") for n in names if n.startswith("dextar."))
+    return PIPELINE
 
 
 def _public_modules(package: Any) -> list[tuple[str, bool]]:
@@ -289,10 +306,37 @@ def _automodule(name: str) -> list[str]:
             "   :ignore-module-all:", ""]
 
 
+def _private_exports(package: Any) -> list[str]:
+    """The names a package exports that are defined in its private modules
+    (``dextar.jobs.run`` from ``dextar.jobs._run``): documented in the package itself."""
+    out = []
+    for name in getattr(package, "__all__", ()):
+        mod = getattr(getattr(package, name, None), "__module__", "") or ""
+        if mod.startswith(f"{package.__name__}._"):
+            out.append(name)
+    return out
+
+
+def _private_export_directives(package: Any) -> list[str]:
+    out = []
+    for name in _private_exports(package):
+        obj = getattr(package, name)
+        full = f"{package.__name__}.{name}"
+        if inspect.isclass(obj):
+            out += [f".. autoclass:: {full}", "   :members:", "   :show-inheritance:", ""]
+        elif callable(obj):
+            out += [f".. autofunction:: {full}", ""]
+        else:
+            out += [f".. autodata:: {full}", ""]
+    return out
+
+
 def _defined_in(package: Any, name: str) -> str | None:
-    """Where a name a package exports is defined (for its link)."""
+    """Where a name a package exports is documented (for its link)."""
     obj = getattr(package, name, None)
     mod = getattr(obj, "__module__", None)
+    if name in _private_exports(package):
+        return f"{package.__name__}.{name}"
     if inspect.isclass(obj) or inspect.isfunction(obj):
         return f"{mod}.{obj.__qualname__}" if mod else None
     for sub, _ in _public_modules(package):
@@ -305,7 +349,8 @@ def _defined_in(package: Any, name: str) -> str | None:
 def _package_page(name: str) -> list[str]:
     package = importlib.import_module(name)
     title = f"``{name}``"
-    out = [f".. _api-{name}:", "", title, "=" * len(title), "", *_automodule(name)]
+    out = [f".. _api-{name}:", "", title, "=" * len(title), "", *_automodule(name),
+           *_private_export_directives(package)]
     exported = [n for n in getattr(package, "__all__", ()) if not n.startswith("_")]
     if exported:
         links = []
@@ -346,7 +391,7 @@ def api_pages() -> dict[str, str]:
     import dextar
 
     found = dict(_public_modules(dextar))
-    order = [f"dextar.{n}" for n in PIPELINE if f"dextar.{n}" in found]
+    order = [f"dextar.{n}" for n in pipeline() if f"dextar.{n}" in found]
     order += sorted(n for n in found if n not in order)
     pages = {name: "\n".join(_package_page(name)) + "\n" for name in order}
     index = ["API reference", "=============", "",

@@ -65,9 +65,8 @@ class RobotTable(Table):
 
     NAME: ClassVar[str] = "robot"
     PARAMS: ClassVar[dict[str, Param]] = {
-        "preset": Param("text", "", None, "a named geometry: dextar (no preset and no "
-                        "length: the DexTAR; no preset: all five lengths)"),
-        **{k: Param("number", "mm", None, f"length {k} (default: the preset's)", positive=True)
+        "preset": Param("text", "", None, "a named geometry: dextar"),
+        **{k: Param("number", "mm", None, f"length {k}", positive=True)
            for k in ("l1", "l2", "L1", "L2", "d")},
         "working_mode": Param("text", "", "+-", "++, +-, -+ or -- (aliases pp, pm, mp, mm)"),
         "assembly_mode": Param("choice", "", "up", "up or down", choices=("up", "down")),
