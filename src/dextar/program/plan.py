@@ -16,7 +16,7 @@ Path moves joined by a blend (``blend > 0``) are one motion: each corner is repl
 quintic of continuous curvature that stays within ``blend`` of the corner
 (:mod:`dextar.paths.composite`), and the law of the first move of the chain runs over the
 whole of it, without stopping at the corners. Other moves start and end at rest. A move's law
-is any registered law (:mod:`.laws`). Everything is in SI (m, kg, s, N m, rad).
+is any registered law (:mod:`dextar.program.laws`). Everything is in SI (m, kg, s, N m, rad).
 """
 
 from __future__ import annotations
