@@ -29,6 +29,7 @@ def test_paper_toml_is_the_default():
     assert a.law_table == b.law_table and a.units == b.units and a.paper == b.paper
 
 
+@pytest.mark.slow
 def test_identification_script_runs(capsys):
     runpy.run_path(str(EXAMPLES / "identify_synthetic.py"), run_name="__main__")
     assert "identification checks passed" in capsys.readouterr().out

@@ -78,6 +78,7 @@ def sweep2(tmp_path_factory, scheduler):
     return task, out
 
 
+@pytest.mark.slow
 def test_rows_are_the_single_design_function(sweep2):
     task_path, out = sweep2
     rows = rows_of(out)
@@ -98,6 +99,7 @@ def test_rows_are_the_single_design_function(sweep2):
     assert all(r["reason"] for r in rows if not r["feasible"])
 
 
+@pytest.mark.slow
 def test_pareto_set_by_brute_force(sweep2):
     _, out = sweep2
     rows = [r for r in rows_of(out) if r["feasible"]]
@@ -122,6 +124,7 @@ def test_pareto_helpers_on_a_known_front():
     assert closest_to_ideal(F[[0, 1, 2]]) == 1
 
 
+@pytest.mark.slow
 def test_one_worker_gives_the_same_file(sweep2, tmp_path):
     task, out2 = sweep2
     out1 = tmp_path / "one"
@@ -130,6 +133,7 @@ def test_one_worker_gives_the_same_file(sweep2, tmp_path):
     assert (out1 / "pareto.csv").read_bytes() == (out2 / "pareto.csv").read_bytes()
 
 
+@pytest.mark.slow
 def test_a_killed_sweep_resumes_to_the_same_file(sweep2, tmp_path, scheduler):
     task, out2 = sweep2
     out = tmp_path / "killed"
@@ -173,6 +177,7 @@ def test_bad_design_tables_exit_2(tmp_path, capsys, design, message):
     assert not (tmp_path / "o").exists()
 
 
+@pytest.mark.slow
 def test_geometries_that_cannot_assemble_are_rows(tmp_path, scheduler):
     """Rods too short for the base: every design is a row with its reason, no crash."""
     task = write_task(tmp_path, design='[design]\nl = [5.0, 10.0]\nL = [5.0, 10.0]\n'
@@ -186,6 +191,7 @@ def test_geometries_that_cannot_assemble_are_rows(tmp_path, scheduler):
     assert s["feasible"] == 0 and s["best"] is None
 
 
+@pytest.mark.slow
 def test_unreachable_scheduler_is_named_within_10_s(tmp_path, capsys, monkeypatch):
     from dextar.design import sweep
 
@@ -208,6 +214,7 @@ def test_without_dask_the_extra_is_named(tmp_path, capsys, monkeypatch):
     assert "pip install -e '.[design]'" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_resume_refuses_another_sweep(sweep2, tmp_path, capsys):
     task, out2 = sweep2
     import shutil
@@ -220,6 +227,7 @@ def test_resume_refuses_another_sweep(sweep2, tmp_path, capsys):
     assert "--resume" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_a_run_task_sweeps_its_path_and_law(tmp_path, scheduler):
     """A dextar run config (one path, one law) is a task too: geometry and torque metrics
     along its path; its rows are the single-design function's."""
@@ -310,6 +318,7 @@ def test_random_design_tables_are_read_or_refused_by_name(tmp_path_factory):
     check()
 
 
+@pytest.mark.slow
 def test_a_running_cluster_by_address_gives_the_same_file(sweep2, tmp_path):
     """`dask scheduler` and `dask worker` started as the README shows; --scheduler uses them."""
     import shutil
@@ -344,6 +353,7 @@ def test_a_running_cluster_by_address_gives_the_same_file(sweep2, tmp_path):
             p.wait()
 
 
+@pytest.mark.slow
 def test_a_worker_that_dies_is_replaced_and_the_rows_are_complete(sweep2):
     """One of two workers is killed after the first chunk: Dask reruns its chunks elsewhere
     and the sweep ends with every row, equal to the uninterrupted sweep's."""
@@ -371,6 +381,7 @@ def test_a_worker_that_dies_is_replaced_and_the_rows_are_complete(sweep2):
         assert got[i] == expected[i]
 
 
+@pytest.mark.slow
 def test_sweeps_one_after_another_on_one_cluster(tmp_path, scheduler):
     """Two sweeps in a row on the same two workers (as a script or the benchmark does): the
     second one's task is not lost while the first one's copy is being released."""
