@@ -17,6 +17,7 @@ from dextar.cli import main
 from dextar.config import load_scenario
 from dextar.design.evaluate import Task, evaluate_design
 from dextar.design.pareto import closest_to_ideal, pareto_mask
+from dextar.design.space import METRICS
 from dextar.output.design import parse_line
 
 pytest.importorskip("distributed")
@@ -122,6 +123,19 @@ def test_pareto_helpers_on_a_known_front():
     F = np.array([[1, 5], [2, 2], [5, 1], [3, 3], [2, 2], [6, 6]], float)
     assert pareto_mask(F).tolist() == [True, True, True, False, True, False]
     assert closest_to_ideal(F[[0, 1, 2]]) == 1
+
+
+def test_one_design_is_a_row_without_a_cluster(tmp_path):
+    """What each worker runs, on its own: the DexTAR plans the task within its motors (its
+    metrics finite); rods too short for the start are a row with the reason and no metric."""
+    task, _ = load_scenario(write_task(tmp_path)).design_task()
+    row = evaluate_design(task, (72.0, 72.0, 87.0, 87.0, 60.0))
+    assert row["feasible"] and row["reason"] == "" and row["footprint_mm"] == 72 + 87 + 30
+    assert all(np.isfinite(row[k]) for k in METRICS) and row["cycle_time_s"] > 0
+    assert max(row["peak_torque_A_Nm"], row["peak_torque_D_Nm"]) <= 3.4  # [motors]
+    short = evaluate_design(task, (20.0, 20.0, 30.0, 30.0, 60.0))  # reach 50 mm: start at 130
+    assert not short["feasible"] and "out of reach of leg 1" in short["reason"]
+    assert short["cycle_time_s"] is None and short["footprint_mm"] == 80.0
 
 
 @pytest.mark.slow
