@@ -18,6 +18,8 @@ from dextar.geometry import DEXTAR_MM
 from dextar.laws import solve_optimal_law
 from dextar.paths import Arc
 
+pytestmark = pytest.mark.slow
+
 FIGS = [f"fig{k}" for k in range(3, 10)]
 #: The run's CSV columns in paper units (names carry the unit, see dextar.output.tables).
 RUN_COLUMNS = ["t_T", "p", "dp_per_T", "ddp_per_T2", "x_L", "y_L", "dx_L_T", "dy_L_T",

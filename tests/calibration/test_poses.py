@@ -97,6 +97,7 @@ def test_dextar_design_unchanged_by_the_share(four_modes):
     assert counts == {"++": 20, "+-": 18, "-+": 3, "--": 19}
 
 
+@pytest.mark.slow
 def test_every_pose_inside_the_region_and_the_modes_missing_named():
     # above the motor axis, where a tracker beside the robot sees it: every pose inside and
     # the 4 modes (-+ has its 4 candidates at y = 21-29 mm)

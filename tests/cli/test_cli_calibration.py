@@ -26,6 +26,8 @@ from dextar.config import load_scenario
 
 from ..calibration.conftest import COUNT, MODES, NOMINAL, true_robot
 
+pytestmark = pytest.mark.slow
+
 SIGMA = 0.02e-3                      # m per axis
 NOISE = math.sqrt(2) * SIGMA         # RMS distance of the instrument's noise
 CONFIG = """\

@@ -14,6 +14,8 @@ from dextar.identification.base import base_parameters
 
 from ..program.test_program import EXAMPLES, read
 
+pytestmark = pytest.mark.slow
+
 CONFIG = str(EXAMPLES / "pick_place.toml")
 COLUMNS = ["t_s", "phi_rad", "psi_rad", "dphi_rad_s", "dpsi_rad_s", "ddphi_rad_s2",
            "ddpsi_rad_s2", "tau1_Nm", "tau2_Nm"]

@@ -80,6 +80,7 @@ def test_workspace_writes_png(tmp_path, capsys):
     assert code == 0 and out.read_bytes()[:4] == b"\x89PNG"
 
 
+@pytest.mark.slow
 def test_real_process_no_traceback():
     r = subprocess.run([sys.executable, "-m", "dextar.cli", "fk", "0", "180"],
                        capture_output=True, text=True)

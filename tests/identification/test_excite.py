@@ -47,6 +47,7 @@ def _cond(model, base, tr, t):
     return sv[0] / sv[-1]
 
 
+@pytest.mark.slow
 def test_design_rests_at_the_ends_and_keeps_its_margins_and_motors(prior, designed):
     """Checked here on a grid of its own (7919 samples a period), not the design's."""
     model, mode, motors = prior
@@ -66,6 +67,7 @@ def test_design_rests_at_the_ends_and_keeps_its_margins_and_motors(prior, design
     assert designed.duration == pytest.approx(10.0)
 
 
+@pytest.mark.slow
 def test_design_uses_the_headroom_and_covers_the_region(designed, region):
     """Measured 73-80 % of the limits (bound 60 %; the former design: 4-7 % of the torque,
     30-60 % of the speed) and 85-98 % of the region (bound 70 %)."""
@@ -80,6 +82,7 @@ def test_design_uses_the_headroom_and_covers_the_region(designed, region):
     assert designed.coverage is not None and designed.coverage.met, designed.coverage.missed
 
 
+@pytest.mark.slow
 def test_design_is_well_conditioned_and_beats_random_starts(prior, base, designed):
     """Condition number 5.2-7.4 measured (bound 20). Random feasible motions drawn as the
     optimiser draws its starts (coefficients N(0, 0.3^2)): over 200 of them, 5th percentile
@@ -134,6 +137,7 @@ def test_coverage_floors_tell_a_small_motion(prior):
     assert check_coverage(tr, allowed, 50.0).missed == ("condition number 50 above 20",)
 
 
+@pytest.mark.slow
 def test_a_design_short_of_its_floors_is_designed_again_and_says_so(prior, base, monkeypatch):
     """A floor no motion meets (1000 % of the range): a second design from new
     deterministic starts, then status 2 naming the floor; the same result twice."""

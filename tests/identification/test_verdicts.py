@@ -44,6 +44,7 @@ def _shrunk(tr, f):
     return FourierTrajectory(tr.q0, f * tr.a, f * tr.b, tr.base_hz)
 
 
+@pytest.mark.slow
 def test_a_motion_too_small_for_the_task_is_poorly_determined(prior, base, task):
     """The stored excitation at a quarter of its size, 20 mN m of noise: the program's
     torques predicted within 44-99 % (1 sigma, measured on the three stored excitations),
@@ -66,6 +67,7 @@ def test_a_motion_too_small_for_the_task_is_poorly_determined(prior, base, task)
     assert good.uncertainty.max() < UNCERTAINTY_LIMIT / 2, good.uncertainty
 
 
+@pytest.mark.slow
 def test_a_residual_noise_does_not_explain_is_a_poor_fit(prior, base):
     """Gravity tilted by 9.4 deg in the data, vertical in the config (5 mN m of noise): fit
     quality 5.5 / 4.3, 10 / 21, 11 / 6.7 % on the three stored excitations, where the noise
@@ -92,6 +94,7 @@ def test_a_residual_noise_does_not_explain_is_a_poor_fit(prior, base):
     assert not any(r.startswith("poor fit") for r in noisy.reasons)
 
 
+@pytest.mark.slow
 def test_a_fit_physics_cannot_explain_is_not_physically_consistent(prior, base):
     """The time stretched 30x (20 ms steps, 30x slower: above the time-base check's 20 Hz):
     the least-squares estimate lies 26-63 standard deviations from any physical set

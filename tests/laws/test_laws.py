@@ -19,7 +19,8 @@ def paper_law(eta=0.1):
     return solve_optimal_law(SEMI, duration=1.0, eta=eta, mass=1.0)
 
 
-@pytest.mark.parametrize("eta", [1e-5, 1e-3, 0.1, 10.0, 1e3, 1e5])
+@pytest.mark.parametrize("eta", [pytest.param(1e-5, marks=pytest.mark.slow), 1e-3, 0.1, 10.0,
+                                 1e3, 1e5])
 def test_semicircle_satisfies_paper_ode_15(eta):
     law = paper_law(eta)
     R = SEMI.radius
@@ -178,6 +179,7 @@ def euler_lagrange_residual(path, law, n=1001):
     return np.abs(s4 - rhs).max() / (1 + np.abs(s4).max())
 
 
+@pytest.mark.slow
 def test_spline_law_by_pieces_is_spectrally_accurate():
     """A spline's law comes from one Chebyshev element per spline piece: the Euler-Lagrange
     residual on 1001 times reaches 5e-12 (bound 1e-9), the law agrees with solve_bvp's at tol

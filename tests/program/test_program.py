@@ -32,6 +32,7 @@ def pick_place(tmp_path_factory):
     return dict(zip(head, data.T, strict=True)), json.loads((out / "summary.json").read_text())
 
 
+@pytest.mark.slow
 def test_figures_and_report_are_written(tmp_path):
     from html.parser import HTMLParser
 
@@ -102,6 +103,7 @@ def test_dwell_holds_still_against_gravity(pick_place):
     assert np.ptp(cols["tau1_Nm"][sel]) < 1e-12 and abs(cols["tau1_Nm"][sel][0]) > 1e-3
 
 
+@pytest.mark.slow
 def test_pd_loop_on_our_forward_dynamics_tracks_the_setpoints(tmp_path):
     """A drive with the setpoints' feedforward torques and a soft PD loop (which cannot hide
     a wrong feedforward) tracks the mode-change program on our forward dynamics; the same

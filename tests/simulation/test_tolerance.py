@@ -12,6 +12,8 @@ from dextar.cli import main
 from dextar.geometry import DEXTAR_MM
 from dextar.simulation import TRACKING_TOLERANCE, tracking_tolerance
 
+pytestmark = pytest.mark.slow
+
 #: The issue's robot and task: 0.4 kg at the effector, gravity, friction; its motors hold
 #: 1.5 N m, at 0.3 N m it falls (before: max task error 272.6 mm, saturated 100 %, exit 0).
 ROBOT = """
