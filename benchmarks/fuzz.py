@@ -37,6 +37,7 @@ from tests.robustness.strategies import (  # noqa: E402
     dry_friction_runs,
     falling_simulations,
     kinematics_argv,
+    long_animated_runs,
     metre_configs,
     motion_files,
     programs,
@@ -74,7 +75,8 @@ def main() -> int:
     n_metres = int(args.cases * 0.03)
     n_falling = int(args.cases * 0.03)
     n_dry = int(args.cases * 0.01)
-    n_cfg = int(args.cases * 0.65) - n_metres - n_falling - n_dry
+    n_long = int(args.cases * 0.01)  # review 28: long motions with the animation drawn
+    n_cfg = int(args.cases * 0.65) - n_metres - n_falling - n_dry - n_long
 
     @settings(max_examples=n_cfg, deadline=None, database=None, derandomize=False,
               suppress_health_check=list(HealthCheck))
@@ -134,6 +136,14 @@ def main() -> int:
         outcome, detail = run_run_case(doc)
         record(outcome, detail, f"run with\n{toml_text(doc)}", time.perf_counter() - t0)
 
+    @settings(max_examples=n_long, deadline=None, database=None,
+              suppress_health_check=list(HealthCheck))
+    @given(doc=long_animated_runs())
+    def fuzz_long_runs(doc: dict) -> None:
+        t0 = time.perf_counter()
+        outcome, detail = run_run_case(doc)
+        record(outcome, detail, f"run with\n{toml_text(doc)}", time.perf_counter() - t0)
+
     import random
 
     random.seed(args.seed)
@@ -144,6 +154,7 @@ def main() -> int:
     fuzz_metres()
     fuzz_falling()
     fuzz_dry_runs()
+    fuzz_long_runs()
     fuzz_argv()
     total = sum(counts.values())
     print(f"{total} cases in {time.perf_counter() - t_start:.0f} s: " + ", ".join(
