@@ -28,6 +28,7 @@ from tests.robustness.harness import (  # noqa: E402
     run_config_case,
     run_identify_case,
     run_program_case,
+    run_robot_config_case,
     run_run_case,
     toml_text,
 )
@@ -114,10 +115,14 @@ def main() -> int:
     @settings(max_examples=n_metres, deadline=None, database=None,
               suppress_health_check=list(HealthCheck))
     @given(doc=metre_configs(),
-           command=st.sampled_from(["plan", "torques", "simulate", "export"]))
+           command=st.sampled_from(["plan", "torques", "simulate", "export", "ik", "fk",
+                                    "workspace", "poses", "excite"]))
     def fuzz_metres(doc: dict, command: str) -> None:
         t0 = time.perf_counter()
-        outcome, detail = run_config_case(doc, command)
+        if command in ("ik", "fk", "workspace", "poses", "excite"):
+            outcome, detail = run_robot_config_case(doc, command)
+        else:
+            outcome, detail = run_config_case(doc, command)
         record(outcome, detail, f"{command} with\n{toml_text(doc)}", time.perf_counter() - t0)
 
     @settings(max_examples=n_falling, deadline=None, database=None,

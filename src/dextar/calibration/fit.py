@@ -46,6 +46,7 @@ from .._arrays import Array
 from .._lazy import lazy_module
 from ..errors import AssemblyError, DextarError, ParameterError, ReachError
 from ..geometry import parse_working_mode
+from ..params import number_words
 from .data import PoseData, rows_text
 from .errors import CouplingError, OutlierError, OutOfReachError
 from .model import (
@@ -616,7 +617,8 @@ def _options(frame: str, fit: Sequence[str] | None, robust: str | None,
     if robust is not None and robust not in ROBUST_LOSSES:
         raise ParameterError(f"robust loss {robust!r} is not one of {', '.join(ROBUST_LOSSES)}")
     if not (math.isfinite(outlier_factor) and outlier_factor > 1.0):
-        raise ParameterError(f"outlier factor {outlier_factor!r} must be a number above 1")
+        raise ParameterError(f"outlier factor {number_words(outlier_factor)} must be a number "
+                             "above 1")
     for name, v in (("point_std", point_std), ("reading_std", reading_std)):
         if v is not None and not (math.isfinite(v) and v > 0):
             raise ParameterError(f"{name} = {v!r} must be positive and finite")
