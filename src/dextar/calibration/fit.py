@@ -710,12 +710,25 @@ def _blame(p: Array, p_nom: Array, data: PoseData, assembly: Array, sigma: Array
              for i in out[:5]]
     more = f" and {len(out) - 5} more" if len(out) > 5 else ""
     them = "it" if len(out) == 1 else "them"
+    # the rows the robust solves set aside too, which the fit of the others predicts within
+    # the bound: named, so that the rows counted add up (row 21 named alone beside a fit over
+    # 37 rows of 40)
+    named = {int(i) for i in out}
+    aside = [int(i) for i in np.flatnonzero(~g.kept_rows(data)) if int(i) not in named]
+    also = ""
+    if aside:
+        near = [f"{int(data.rows[i])} ({_mm(_row_distance(q, data, i, int(g.data.assembly[i])))} "
+                "from its prediction)" for i in aside[:5]]
+        listed = (", ".join(near) + f" and {len(aside) - 5} more" if len(aside) > 5 else
+                  " and ".join([", ".join(near[:-1]), near[-1]] if len(near) > 1 else near))
+        also = (f"; that fit also left out row{'s' if len(aside) > 1 else ''} {listed}, within "
+                "the bound")
     raise OutlierError(
         f"{data.source}: row{'s' if len(out) > 1 else ''} {', '.join(words)}{more} "
         f"disagree{'s' if len(out) == 1 else ''} with the others, which calibrate without "
         f"{them} (RMS error {_mm(_rms(np.hypot(*r.e.T)))} over {len(r.d)} rows, outlier "
-        f"bound {_mm(bound)}): correct or remove {them}, or calibrate with a robust loss",
-        tuple(int(data.rows[i]) for i in out))
+        f"bound {_mm(bound)}{also}): correct or remove {them}, or calibrate with a robust "
+        "loss", tuple(int(data.rows[i]) for i in out))
 
 
 def _row_distance(p: Array, data: PoseData, i: int, a: int) -> float:
