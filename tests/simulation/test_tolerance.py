@@ -73,12 +73,25 @@ def test_motors_strong_enough_follow_within_the_default(tmp_path, capsys):
     assert rep["max_task_error_mm"] < 0.2 * rep["tolerance_mm"] and err == ""
 
 
+def test_tracking_json_gives_the_tolerance_used_in_both_places(tmp_path, capsys):
+    """Review 28 finding 16: without [control].tolerance_mm, tracking.json gave
+    control.tolerance_mm null beside the top-level tolerance_mm of the default used; now the
+    value used in both (9 mm: 3 % of this robot's 300 mm reach)."""
+    code, rep, _, out = _simulate(tmp_path, "torque_limit = 1.5\n", capsys)
+    written = json.loads((out / "tracking.json").read_text())
+    for r in (rep, written):
+        assert r["tolerance_mm"] == pytest.approx(9.0)
+        assert r["control"]["tolerance_mm"] == r["tolerance_mm"]
+        assert r["control"]["tolerance"] == pytest.approx(9e-3)  # SI: m
+
+
 @pytest.mark.parametrize("tol, code", [(0.1, 1), (5.0, 0)])
 def test_the_tolerance_is_the_users(tmp_path, capsys, tol, code):
     """The same motion (0.62 mm off) is not followed within 0.1 mm and followed within 5."""
     got, rep, err, _ = _simulate(tmp_path, f"torque_limit = 1.5\ntolerance_mm = {tol}\n",
                                  capsys)
     assert got == code and rep["followed"] is (code == 0) and rep["tolerance_mm"] == tol
+    assert rep["control"]["tolerance_mm"] == tol
     if code:
         assert f"left the tolerance {tol:g} mm" in err
 
