@@ -28,6 +28,7 @@ from tests.robustness.harness import (  # noqa: E402
     run_config_case,
     run_identify_case,
     run_program_case,
+    run_robot_config_case,
     run_run_case,
     toml_text,
 )
@@ -37,6 +38,7 @@ from tests.robustness.strategies import (  # noqa: E402
     dry_friction_runs,
     falling_simulations,
     kinematics_argv,
+    long_animated_runs,
     metre_configs,
     motion_files,
     programs,
@@ -74,7 +76,8 @@ def main() -> int:
     n_metres = int(args.cases * 0.03)
     n_falling = int(args.cases * 0.03)
     n_dry = int(args.cases * 0.01)
-    n_cfg = int(args.cases * 0.65) - n_metres - n_falling - n_dry
+    n_long = int(args.cases * 0.01)  # review 28: long motions with the animation drawn
+    n_cfg = int(args.cases * 0.65) - n_metres - n_falling - n_dry - n_long
 
     @settings(max_examples=n_cfg, deadline=None, database=None, derandomize=False,
               suppress_health_check=list(HealthCheck))
@@ -112,10 +115,14 @@ def main() -> int:
     @settings(max_examples=n_metres, deadline=None, database=None,
               suppress_health_check=list(HealthCheck))
     @given(doc=metre_configs(),
-           command=st.sampled_from(["plan", "torques", "simulate", "export"]))
+           command=st.sampled_from(["plan", "torques", "simulate", "export", "ik", "fk",
+                                    "workspace", "poses", "excite"]))
     def fuzz_metres(doc: dict, command: str) -> None:
         t0 = time.perf_counter()
-        outcome, detail = run_config_case(doc, command)
+        if command in ("ik", "fk", "workspace", "poses", "excite"):
+            outcome, detail = run_robot_config_case(doc, command)
+        else:
+            outcome, detail = run_config_case(doc, command)
         record(outcome, detail, f"{command} with\n{toml_text(doc)}", time.perf_counter() - t0)
 
     @settings(max_examples=n_falling, deadline=None, database=None,
@@ -134,6 +141,14 @@ def main() -> int:
         outcome, detail = run_run_case(doc)
         record(outcome, detail, f"run with\n{toml_text(doc)}", time.perf_counter() - t0)
 
+    @settings(max_examples=n_long, deadline=None, database=None,
+              suppress_health_check=list(HealthCheck))
+    @given(doc=long_animated_runs())
+    def fuzz_long_runs(doc: dict) -> None:
+        t0 = time.perf_counter()
+        outcome, detail = run_run_case(doc)
+        record(outcome, detail, f"run with\n{toml_text(doc)}", time.perf_counter() - t0)
+
     import random
 
     random.seed(args.seed)
@@ -144,6 +159,7 @@ def main() -> int:
     fuzz_metres()
     fuzz_falling()
     fuzz_dry_runs()
+    fuzz_long_runs()
     fuzz_argv()
     total = sum(counts.values())
     print(f"{total} cases in {time.perf_counter() - t_start:.0f} s: " + ", ".join(

@@ -1,3 +1,5 @@
+import math
+
 import numpy as np
 import pytest
 
@@ -128,6 +130,22 @@ def test_simple_laws():
     tz = TrapezoidalLaw(S, vmax=1.0, amax=2.0)
     assert tz.duration == pytest.approx(S / 1.0 + 1.0 / 2.0)
     assert np.abs(tz.evaluate(np.linspace(0, tz.duration, 999))[1]).max() <= 1.0 + 1e-12
+
+
+@pytest.mark.parametrize("S, a, T", [(1.39, 1.15e19, 1.0), (0.123, 1.0, 1e9), (2.0, 4.0, 1.5),
+                                     (1.0, 1.0, 2.0)])
+def test_a_trapezoid_of_a_long_duration_moves_at_its_cruise_speed(S, a, T):
+    """Found by the long-motion fuzz shape (review 28): a 1e9 s trapezoid over 123 mm had a
+    cruise speed of exactly 0 (the cancellation of (a T - sqrt(a^2 T^2 - 4 a S)) / 2): the
+    law never moved, and the run's summary divided by its zero energy. The cruise speed is
+    the root of v^2 - a T v + a S = 0 (the distance covered in T), to rounding; the law
+    arrives."""
+    law = TrapezoidalLaw(S, math.inf, a, T)
+    v = law.cruise
+    assert v > 0 and v * v - a * T * v + a * S == pytest.approx(0.0, abs=1e-12 * a * S)
+    assert v * (T - v / a) == pytest.approx(S, rel=1e-12)  # cruise + the two ramps
+    s = law.evaluate(np.array([0.0, 0.5 * T, T]))[0]
+    assert s[0] == 0.0 and s[1] == pytest.approx(0.5 * S, rel=1e-9) and s[2] == pytest.approx(S)
 
 
 def test_law_errors():

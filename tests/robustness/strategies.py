@@ -336,3 +336,36 @@ def dry_friction_runs(draw: st.DrawFn) -> dict[str, Any]:
         "output": {"units": draw(st.sampled_from(["si", "paper"])), "samples": 201,
                    "figures": []},
     }
+
+
+# --- review 28 finding 2: long motions with the figures and the animation on --------------
+
+@st.composite
+def long_animated_runs(draw: st.DrawFn) -> dict[str, Any]:
+    """A `dextar run` of a motion from a minute to 1e9 s (about the 40-frame, 60 s-a-frame
+    limit of a real-time animation, and far past it) with the animation and figures drawn:
+    the animation must stay within its frames (a 1e9 s motion had asked for 1.7e7)."""
+    law = draw(st.sampled_from(["min-jerk", "uniform", "optimal", "trapezoid"]))
+    doc: dict[str, Any] = {
+        "law": {"type": law,
+                "duration": draw(st.sampled_from([60.0, 2400.0, 2460.0, 2461.0, 3600.0, 1e5,
+                                                  1e7, 1e9]))},
+        "output": {"units": draw(st.sampled_from(["si", "paper"])),
+                   "samples": draw(st.sampled_from([101, 201, 1001])),
+                   "animation_frames": draw(st.sampled_from([2, 41, 200]))},
+    }
+    figures = draw(st.sampled_from([None, ["animation"], ["animation", "fig4", "fig9"]]))
+    if figures is not None:
+        doc["output"]["figures"] = figures
+    if draw(st.booleans()):
+        doc["path"] = draw(st.sampled_from([
+            {"type": "line", "start": [-60.0, 90.0], "end": [60.0, 115.0]},
+            {"type": "arc", "radius": 30.0, "center": [0.0, 110.0], "start_deg": 0.0,
+             "end_deg": 360.0 * draw(st.sampled_from([1, 20]))}]))
+    if law == "trapezoid":
+        doc["law"]["vmax"] = draw(st.sampled_from([1e-3, 1.0, 1000.0]))
+        doc["law"]["amax"] = draw(st.sampled_from([1e-3, 1000.0]))
+    if draw(st.booleans()):
+        doc["friction"] = {"coulomb": 0.002}
+        doc["gravity"] = {"vector": [0.0, -9810.0]}
+    return doc

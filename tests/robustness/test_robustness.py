@@ -29,6 +29,7 @@ from .strategies import (
     dry_friction_runs,
     falling_simulations,
     kinematics_argv,
+    long_animated_runs,
     metre_configs,
     motion_files,
     programs,
@@ -145,5 +146,13 @@ def test_falling_simulations_never_crash(doc):
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
 @given(doc=dry_friction_runs())
 def test_long_runs_with_dry_friction_never_crash(doc):
+    outcome, detail = run_run_case(doc)
+    assert outcome not in DEFECTS, f"{outcome}: {detail}\nconfig:\n{toml_text(doc)}"
+
+
+@settings(max_examples=2, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@given(doc=long_animated_runs())
+def test_long_runs_with_the_animation_never_hang(doc):
     outcome, detail = run_run_case(doc)
     assert outcome not in DEFECTS, f"{outcome}: {detail}\nconfig:\n{toml_text(doc)}"

@@ -11,7 +11,7 @@ from .. import jobs
 from .._lazy import lazy_module
 from ..identification.excite import ACCELERATION_FLOOR, RANGE_FLOOR, SPEED_FLOOR
 from ..output.tables import csv_text
-from .base import Result, config_argument, json_flag, load, out_file, write_or_hand_back
+from .base import Result, config_argument, json_flag, load, note_lines, out_file, write_or_hand_back
 
 if TYPE_CHECKING:  # the writers, imported when the command runs (start-up: dextar._lazy)
     from ..output import identification as written
@@ -79,5 +79,6 @@ def run(args: argparse.Namespace) -> Result:
                             f"{res.region_coverage:.1%} of the task's poses and reaches "
                             f"{res.region_speed_ratio.min():.2f} of its peak speed: an "
                             "identification from it extrapolates on the rest")
+    warnings[:0] = note_lines("excite", sc)  # the config's notes (a robot in metres), first
     return Result(payload, text, warnings, data=data, code=code)
 

@@ -35,7 +35,7 @@ from ..units import SI, Units
 from .base import TABLES, Table
 from .design import DesignTable
 from .design_task import design_task
-from .kinematic import InstrumentTable, RobotTable, kinematic_model
+from .kinematic import InstrumentTable, RobotTable, config_notes, kinematic_model
 from .program import ProgramTable, read_moves
 from .tables import (
     ControlTable,
@@ -57,10 +57,6 @@ T = TypeVar("T", bound=Table)
 #: Where a scenario of no file comes from.
 DEFAULT_SOURCE = "defaults (the paper's example)"
 
-#: A robot whose longest length is below this (mm) looks written in metres: the DexTAR in
-#: metres is 0.087 at most, the smallest five-bars built are tens of millimetres.
-METRES_LIKE_MM = 1.0
-
 
 @dataclass(frozen=True)
 class Scenario:
@@ -81,7 +77,7 @@ class Scenario:
     """
 
     tables: Mapping[str, Table]
-    source: str = "defaults (the paper's example)"  # DEFAULT_SOURCE
+    source: str = DEFAULT_SOURCE
     moves: tuple[Move, ...] = ()
     doc: Mapping[str, Any] = field(default_factory=dict)
     text: bytes = b""
@@ -94,20 +90,13 @@ class Scenario:
     @property
     def notes(self) -> tuple[str, ...]:
         """What the user may not have meant, in words (each command says them on stderr and
-        beside its error): a config file with no table runs the paper's example; a robot
-        whose lengths are all below :data:`METRES_LIKE_MM` looks written in metres."""
-        out = []
-        if not self.doc and self.source != DEFAULT_SOURCE:
-            out.append(f"{self.source} has no table: this runs the paper's example (the "
-                       "DexTAR, the 120 mm semicircle, the optimal law)")
-        g = self.robot_table.geometry_mm
-        longest = max(g.l1, g.l2, g.L1, g.L2, g.d)
-        if longest < METRES_LIKE_MM:
-            shown = ", ".join(f"{k} = {getattr(g, k):g}" for k in ("l1", "l2", "L1", "L2", "d"))
-            out.append(f"the robot's lengths ({shown}) are read in mm: its longest, "
-                       f"{longest:g} mm, looks like metres ({longest:g} m = "
-                       f"{longest * 1e3:g} mm); config lengths are in mm")
-        return tuple(out)
+        beside its error; computed by :func:`~dextar.config.kinematic.config_notes`): a
+        config file with no table runs the paper's example; a robot that looks written in
+        metres."""
+        return config_notes(None if self.source == DEFAULT_SOURCE else self.source, self.doc,
+                            self.robot_table.geometry_mm,
+                            "this runs the paper's example (the DexTAR, the 120 mm semicircle, "
+                            "the optimal law)")
 
     def _get(self, cls: type[T]) -> T:
         t = self.tables[cls.NAME]
