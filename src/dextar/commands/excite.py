@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 
 from .. import jobs
 from .._lazy import lazy_module
-from ..identification.excite import ACCELERATION_FLOOR, RANGE_FLOOR, SPEED_FLOOR
+from ..identification.excite import coverage_floors
 from ..output.tables import csv_text
 from .base import Result, config_argument, json_flag, load, out_file, write_or_hand_back
 
@@ -64,7 +64,7 @@ def run(args: argparse.Namespace) -> Result:
                  f"and motors allow, motor A / D: range {fr['range'][0]:.0%} / "
                  f"{fr['range'][1]:.0%}, speed {fr['speed'][0]:.0%} / {fr['speed'][1]:.0%}, "
                  f"acceleration {fr['acceleration'][0]:.0%} / {fr['acceleration'][1]:.0%} "
-                 f"(floors {RANGE_FLOOR:.0%}, {SPEED_FLOOR:.0%}, {ACCELERATION_FLOOR:.0%}; "
+                 f"(floors {', '.join(f'{v:.0%}' for v in coverage_floors().values())}; "
                  f"{res.attempts} design{'s' if res.attempts > 1 else ''})")
     code = 1 if res.status == 2 else 0  # written, but short of its floors
     warnings = ([] if res.status == 0 else

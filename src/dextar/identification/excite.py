@@ -409,6 +409,12 @@ def allowed_motion(model: Model, q0: Array, harmonics: int, base_hz: float,
     return Allowed(np.asarray(R, float), np.asarray(speed, float), np.asarray(acc, float))
 
 
+def coverage_floors() -> dict[str, float]:
+    """The coverage floors by name (``range``, ``speed``, ``acceleration``): the module's
+    constants, read when called."""
+    return {"range": RANGE_FLOOR, "speed": SPEED_FLOOR, "acceleration": ACCELERATION_FLOOR}
+
+
 def check_coverage(tr: FourierTrajectory, allowed: Allowed, cond: float) -> ExcitationCoverage:
     """The excitation's range, peak speed and acceleration (on a fine grid of a period)
     against :data:`RANGE_FLOOR`, :data:`SPEED_FLOOR`, :data:`ACCELERATION_FLOOR` of the
@@ -419,7 +425,7 @@ def check_coverage(tr: FourierTrajectory, allowed: Allowed, cond: float) -> Exci
            "acceleration": np.abs(ddq).max(axis=0)}
     ref = {"range": allowed.range, "speed": allowed.speed,
            "acceleration": allowed.acceleration}
-    floors = {"range": RANGE_FLOOR, "speed": SPEED_FLOOR, "acceleration": ACCELERATION_FLOOR}
+    floors = coverage_floors()
     units = {"range": "deg", "speed": "rad/s", "acceleration": "rad/s^2"}
     fractions: dict[str, Array] = {}
     missed: list[str] = []
@@ -442,8 +448,7 @@ def check_coverage(tr: FourierTrajectory, allowed: Allowed, cond: float) -> Exci
 def _score(cov: ExcitationCoverage, cond: float) -> tuple[int, float, float]:
     """Ranks designs: fewer floors missed, then the smallest shortfall, then the condition
     number."""
-    floors = {"range": RANGE_FLOOR, "speed": SPEED_FLOOR, "acceleration": ACCELERATION_FLOOR}
-    short = min(float((cov.fractions[k] / f).min()) for k, f in floors.items())
+    short = min(float((cov.fractions[k] / f).min()) for k, f in coverage_floors().items())
     return len(cov.missed), -min(short, 1.0), cond
 
 

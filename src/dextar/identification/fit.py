@@ -106,8 +106,8 @@ from .verdict import check_time_base, envelope, prediction_uncertainty, torque_n
 optimize = lazy_module("scipy.optimize")
 
 __all__ = ["COND_WARNING", "Conditioned", "Filters", "IdentificationResult", "POOR_FIT",
-           "STATUS", "Validation", "check_modes", "check_working_mode", "condition",
-           "default_cutoff", "identify", "physical_set", "realise", "validate"]
+           "STATUS", "Validation", "check_modes", "condition", "default_cutoff", "identify",
+           "physical_set", "realise", "validate"]
 
 #: Condition number above which the summary warns that the data excite badly.
 COND_WARNING = 1e3
@@ -136,9 +136,6 @@ PHYSICAL_SIGMAS = 5.0
 #: The status codes of :class:`IdentificationResult` and their names (as summaries print them).
 STATUS = {0: "identified", 1: "poorly determined", 2: "not physically consistent",
           3: "poor fit"}
-
-#: Former name of :func:`check_modes` (which also checks the assembly mode).
-check_working_mode = check_modes
 
 
 @dataclass(frozen=True)

@@ -18,13 +18,7 @@ from .._lazy import lazy_module
 from ..dynamics import Model, inverse_dynamics
 from ..dynamics.regressor import NAMES
 from ..identification.data import MotionData
-from ..identification.excite import (
-    ACCELERATION_FLOOR,
-    COND_CEILING,
-    RANGE_FLOOR,
-    SPEED_FLOOR,
-    ExcitationResult,
-)
+from ..identification.excite import COND_CEILING, ExcitationResult, coverage_floors
 from ..identification.fit import (
     RESIDUAL_FACTOR,
     UNCERTAINTY_LIMIT,
@@ -81,8 +75,7 @@ def _coverage(res: ExcitationResult) -> dict[str, Any]:
     """The excitation's coverage against its floors (JSON)."""
     c = res.coverage
     assert c is not None
-    return {"floors": {"range": RANGE_FLOOR, "speed": SPEED_FLOOR,
-                       "acceleration": ACCELERATION_FLOOR, "condition_number": COND_CEILING},
+    return {"floors": {**coverage_floors(), "condition_number": COND_CEILING},
             "range_deg": [float(v) for v in np.degrees(c.range)],
             "allowed_range_deg": [float(v) for v in np.degrees(c.allowed.range)],
             "peak_speed_rad_s": [float(v) for v in c.speed],
