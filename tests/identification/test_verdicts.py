@@ -126,3 +126,22 @@ def test_time_in_milliseconds_is_named(prior, base):
                                              r"milliseconds\? Read as milliseconds, the "
                                              r"data run at 1000 Hz"):
         identify(ms, model, mode=mode, base=base)
+
+
+@pytest.mark.parametrize("factor, said", [
+    (1e6, r"sample rate of 0.001 Hz.*Is the time in microseconds\? Read as microseconds, the "
+          r"data run at 1000 Hz and 2.\d+ rad/s; if so, divide t_s by 1000000$"),
+    (1e4, r"Is the time in milliseconds\? Read as milliseconds, the data run at 100 Hz"),
+    # 10 ms steps at 1 kHz: read as milliseconds, 10 kHz (a drive's rate: named, with it)
+    (1e2, r"Is the time in milliseconds\? Read as milliseconds, the data run at 10000 Hz"),
+    # no power of 1000 brings 1/30 Hz to 100 Hz - 10 kHz: every reading named
+    (3e4, r"No power of 1000 brings it to a drive's rate \(as milliseconds, 33.3333 Hz .*; "
+          r"as microseconds, 33333.3 Hz .*\): give t_s in seconds$"),
+])
+def test_the_time_unit_named_brings_the_rate_to_a_drives(prior, factor, said):
+    """The unit named is the power of 1000 that brings the rate into 100 Hz - 10 kHz (the
+    former message said milliseconds whatever the unit: t * 1e6 "divide t_s by 1000")."""
+    model, mode, _ = prior
+    d = synthetic(model, EXCITATIONS[0], 10.0, seed=3)
+    with pytest.raises(ParameterError, match=said):
+        check_time_base(dataclasses.replace(d, t=factor * d.t))
