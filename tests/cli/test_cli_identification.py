@@ -128,6 +128,37 @@ def test_a_poor_fit_is_exit_1_with_its_files_and_causes(excite_csv, tmp_path, ca
     assert head.endswith(",poorly_determined")
 
 
+def test_a_model_not_identified_says_so_first_and_model_refuses_it(excite_csv, tmp_path,
+                                                                   capsys):
+    """identified.toml's first line names the status as calibrated.toml's does; a model
+    whose first line says it is not identified is refused by --model (exit 2, named). The
+    former file began "# identified by dextar from DATA (constrained, ...)" whatever the
+    status, and program --model took it: exit 0, "fits"."""
+    poor, ok = tmp_path / "poor", tmp_path / "ok"
+    assert main(["identify", str(excite_csv), "--out", str(poor), "--quiet"]) == 1
+    first = (poor / "identified.toml").read_text().splitlines()[0]
+    assert first.startswith(f"# identified by dextar from {excite_csv} (poor fit: "), first
+    assert "gravity left out" in first and first.endswith("refuses this file as --model)")
+    capsys.readouterr()
+    assert main(["plan", CONFIG, "--model", str(poor / "identified.toml"), "--out",
+                 str(tmp_path / "p.csv")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "with the status 'poor fit', not 'identified'" in err
+    assert str(poor / "identified.toml") in err and not (tmp_path / "p.csv").exists()
+    # the first line deleted (the way out the message names): the model is taken (this one,
+    # the DexTAR's fit to another robot's data, is unfit for planning: loaded only)
+    edited = tmp_path / "edited.toml"
+    edited.write_text("\n".join((poor / "identified.toml").read_text().splitlines()[1:]))
+    assert load_scenario(CONFIG, model=edited).source.endswith(f"the model of {edited}")
+    # an identified model: its first line says so, and --model takes it
+    assert main(["identify", str(excite_csv), "--config", CONFIG, "--out", str(ok),
+                 "--quiet"]) == 0
+    first = (ok / "identified.toml").read_text().splitlines()[0]
+    assert first.startswith(f"# identified by dextar from {excite_csv} (identified: "), first
+    assert main(["plan", CONFIG, "--model", str(ok / "identified.toml"), "--out",
+                 str(tmp_path / "q.csv")]) == 0
+
+
 def test_validation_reports_the_excited_region(excite_csv, tmp_path, capsys):
     """The paper's semicircle on the same robot is outside what the excitation visited: the
     validation says what fraction is inside and warns that the prediction extrapolates."""

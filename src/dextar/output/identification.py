@@ -197,6 +197,25 @@ class IdentificationReport:
         return lines
 
 
+def model_comment(res: IdentificationResult, data_path: str, config: str | None) -> str:
+    """The comment at the top of ``identified.toml``: its first line names the status as
+    ``dextar calibrate``'s ``calibrated.toml`` does, ``identified by dextar from DATA
+    (STATUS: ...)``, with every reason when the status is not "identified" (``--model``
+    refuses such a file: :func:`dextar.config.scenario.load_scenario`)."""
+    if res.success:
+        what = (f"identified: {res.method}, condition number {res.condition_number:.4g}; "
+                f"predicted torques along {res.reference} uncertain by "
+                f"{100 * res.uncertainty[0]:.3g} / {100 * res.uncertainty[1]:.3g} % of their "
+                "RMS, motor A / D")
+    else:
+        said = res.message.replace("\n", " ")  # every reason, the worst first
+        what = (said if said.startswith(f"{res.status_text}:")
+                else f"{res.status_text}: {said}") + "; dextar refuses this file as --model"
+    return (f"identified by dextar from {data_path} ({what})\nbase parameters reproduced "
+            "exactly; the split between rods, rotor and payload that the torques cannot see "
+            f"follows {config or 'the defaults'}")
+
+
 #: Every file an identification may write.
 IDENTIFICATION_FILES = ("identified.toml", "parameters.csv", "summary.json", "fit.png",
                         "report.html")
