@@ -18,7 +18,12 @@ from .._lazy import lazy_module
 from ..dynamics import Model, inverse_dynamics
 from ..dynamics.regressor import NAMES
 from ..identification.data import MotionData
-from ..identification.excite import COND_CEILING, ExcitationResult, coverage_floors
+from ..identification.excite import (
+    COND_CEILING,
+    REFERENCE_WORDS,
+    ExcitationResult,
+    coverage_floors,
+)
 from ..identification.fit import (
     RESIDUAL_FACTOR,
     UNCERTAINTY_LIMIT,
@@ -72,22 +77,52 @@ def excitation_payload(res: ExcitationResult, harmonics: int, base_hz: float, sa
 
 
 def _coverage(res: ExcitationResult) -> dict[str, Any]:
-    """The excitation's coverage against its floors (JSON)."""
+    """The excitation's coverage against its advisory floors (JSON)."""
     c = res.coverage
     assert c is not None
+    ref = c.reference
     return {"floors": {**coverage_floors(), "condition_number": COND_CEILING},
+            "advisory": True,
             "range_deg": [float(v) for v in np.degrees(c.range)],
-            "allowed_range_deg": [float(v) for v in np.degrees(c.allowed.range)],
+            "reference_range_deg": [float(v) for v in np.degrees(ref.range)],
             "peak_speed_rad_s": [float(v) for v in c.speed],
-            "allowed_speed_rad_s": [float(v) for v in c.allowed.speed],
+            "reference_speed_rad_s": [float(v) for v in ref.speed],
+            "rated_speed_rad_s": [_finite(v) for v in ref.rated_speed],
+            "speed_of_rated": [_finite(v) for v in c.rated_fraction],
             "peak_acceleration_rad_s2": [float(v) for v in c.acceleration],
-            "allowed_acceleration_rad_s2": [float(v) for v in c.allowed.acceleration],
+            "reference_acceleration_rad_s2": [float(v) for v in ref.acceleration],
             "fractions": {k: [float(x) for x in v] for k, v in c.fractions.items()},
             "met": c.met, "missed": list(c.missed),
-            "note": "each motor's range, peak speed and peak acceleration over what the "
-                    "task region (or the free range from the rest pose) and the motors "
-                    "allow; a design that misses a floor is made again from new "
-                    "deterministic starts"}
+            "note": f"each motor's range, peak speed and peak acceleration over a reference "
+                    f"(the range: {ref.range_of}; the speed and acceleration: the top "
+                    "harmonic sweeping that range, capped by the motors), which a motion of "
+                    "both motors may exceed; the peak speed also over the motors' rated "
+                    "speed. The floors are advisory (a design below them is made again from "
+                    "new deterministic starts, then kept with a warning): identify's verdict "
+                    "tells whether the data fix the model"}
+
+
+def coverage_text(res: ExcitationResult, task: bool) -> str:
+    """The excitation's coverage in words (``dextar excite``'s summary)."""
+    c = res.coverage
+    assert c is not None
+    fr, ref = c.fractions, c.reference
+
+    def two(x: Array, fmt: str) -> str:
+        return " / ".join(format(float(v), fmt) for v in x)
+
+    rated = ("" if not np.isfinite(c.rated_fraction).all() else
+             f"; {two(100 * c.rated_fraction, '.3g')} % of the rated "
+             f"{two(ref.rated_speed, '.3g')} rad/s")
+    floors = " / ".join(f"{100 * v:g}" for v in coverage_floors().values())
+    return (f"coverage, motor A / D: range {two(np.degrees(c.range), '.3g')} deg "
+            f"({two(100 * fr['range'], '.3g')} % of {'the task' if task else 'each motor'}'s "
+            f"{'range' if task else 'free range from the rest pose, the other at rest'}), "
+            f"peak speed {two(c.speed, '.3g')} rad/s ({two(100 * fr['speed'], '.3g')} % of "
+            f"{REFERENCE_WORDS['speed']}{rated}), peak acceleration "
+            f"{two(c.acceleration, '.3g')} rad/s^2 ({two(100 * fr['acceleration'], '.3g')} % "
+            f"of {REFERENCE_WORDS['acceleration']}); advisory floors {floors} %, "
+            f"{res.attempts} design{'s' if res.attempts > 1 else ''}")
 
 
 def _finite(v: float) -> float | None:
