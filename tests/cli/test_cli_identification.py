@@ -148,6 +148,8 @@ def test_a_poor_fit_is_exit_1_with_its_files_and_causes(excite_csv, tmp_path, ca
                  str(tmp_path / "ok"), "--quiet"]) == 0
     s = json.loads((tmp_path / "ok" / "summary.json").read_text())
     assert s["status"] == "identified" and max(s["fit_quality"]) < 0.01
+    # without --task the verdict is along the recorded motion, its poses and speeds named
+    assert s["prediction_uncertainty_reference"].startswith("the recorded motion (motor A ")
     assert {"rel_std", "poorly_determined"} <= set(s["base_parameters"][0])
     head = (tmp_path / "ok" / "parameters.csv").read_text().splitlines()[0]
     assert head.endswith(",poorly_determined")

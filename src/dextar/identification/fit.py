@@ -29,9 +29,10 @@ Steps of :func:`identify` (each a small function below):
    figures): status 0 "identified" only when
 
    a. the **predicted-torque uncertainty** (the parameter covariance propagated to a
-      reference motion: the task given, else the excitation's envelope; RMS standard
-      deviation over RMS torque) is at most :data:`UNCERTAINTY_LIMIT` on both motors, and
-      the condition number at most :data:`COND_WARNING`; else 1 "poorly determined";
+      reference motion: the task given, else the recorded motion itself, so that the verdict
+      covers motions like it; RMS standard deviation over RMS torque) is at most
+      :data:`UNCERTAINTY_LIMIT` on both motors, and the condition number at most
+      :data:`COND_WARNING`; else 1 "poorly determined";
    b. the **residual is what noise and filters explain**: ``fit_quality`` (RMS residual /
       RMS torque) at most :data:`RESIDUAL_FACTOR` times ``explained_quality``, the torque
       noise after the parallel filter (from the torques' spectrum floor) over the RMS
@@ -101,7 +102,13 @@ from .coverage import Coverage, coverage
 from .data import MotionData
 from .filtering import Conditioned, Filters, condition, default_cutoff
 from .modes import check_modes
-from .verdict import check_time_base, envelope, prediction_uncertainty, torque_noise
+from .verdict import (
+    check_time_base,
+    describe_motion,
+    prediction_uncertainty,
+    recorded_motion,
+    torque_noise,
+)
 
 optimize = lazy_module("scipy.optimize")
 
@@ -198,8 +205,9 @@ class IdentificationResult:
         deviation of the predicted torques over their RMS (:func:`~dextar.identification.
         verdict.prediction_uncertainty`).
     reference : str
-        The motion ``uncertainty`` is measured on: the task given, or the excitation's
-        envelope (:func:`~dextar.identification.verdict.envelope`).
+        The motion ``uncertainty`` is measured on: the task given, or the recorded motion
+        (:func:`~dextar.identification.verdict.recorded_motion`), its poses and speeds
+        named.
     torque_noise : ndarray, shape (2,)
         Standard deviation of each motor's torque noise after the parallel filter (N m).
     explained_quality : ndarray, shape (2,)
@@ -238,7 +246,7 @@ class IdentificationResult:
     rows_used: Array = field(default_factory=lambda: np.zeros(2, int))
     covariance: Array = field(default_factory=lambda: np.zeros((0, 0)))
     uncertainty: Array = field(default_factory=lambda: np.zeros(2))
-    reference: str = "the excitation's envelope"
+    reference: str = "the recorded motion"
     torque_noise: Array = field(default_factory=lambda: np.zeros(2))
     explained_quality: Array = field(default_factory=lambda: np.zeros(2))
     reasons: tuple[str, ...] = ()
@@ -312,7 +320,8 @@ def identify(data: MotionData, model: Model, *, mode: str, cutoff_hz: float | No
         Precomputed base parameters of ``model``.
     reference : (q, dq, ddq), optional
         The motion the model is for (each (n, 2), SI): the predicted-torque uncertainty is
-        measured along it (default: the excitation's envelope).
+        measured along it (default: the recorded motion, the rows the fit used: the verdict
+        then covers motions like it).
     reference_name : str
         How messages name ``reference``.
 
@@ -372,7 +381,8 @@ def identify(data: MotionData, model: Model, *, mode: str, cutoff_hz: float | No
     explained = np.sqrt((noise / np.where(rms_tau > 0, rms_tau, math.inf)) ** 2
                         + RESIDUAL_FLOOR ** 2)
     if reference is None:
-        ref, ref_name = envelope(c), "the excitation's envelope"
+        ref = recorded_motion(c)
+        ref_name = f"the recorded motion ({describe_motion(ref[0], ref[1])})"
     else:
         ref, ref_name = reference, reference_name
     u_std, u_rms = prediction_uncertainty(model, base, beta, cov, *ref)

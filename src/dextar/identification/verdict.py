@@ -4,10 +4,10 @@ residual should be, and whether the time base is plausible.
 * :func:`prediction_uncertainty`: the parameter covariance propagated to a reference motion,
   ``sqrt(mean_s Y_b(s) C Y_b(s)^T)`` per motor over the RMS torque the model predicts along
   it. The reference is the task the model is for (``dextar identify --task``) or, without
-  one, the excitation's own envelope (:func:`envelope`): the poses the data visited, with
-  speeds and accelerations drawn within each motor's peaks, independently of the pose, so
-  that a parameter the data confirm only in one combination of pose and motion shows its
-  spread.
+  one, the recorded motion itself (:func:`recorded_motion`: the rows the fit used), so that
+  the verdict then covers motions like the recorded one, whose poses and speeds
+  :func:`describe_motion` names (a motion elsewhere extrapolates: ``--task`` measures the
+  uncertainty along it, ``--validate`` names the samples outside).
 * :func:`torque_noise`: the standard deviation of the measured torques' noise after the
   parallel filter, from the torques' spectrum floor (the median density over the top 40 %
   of the band, where no motion is) through the filter's noise gain: the residual a perfect
@@ -38,8 +38,6 @@ from .base import BaseParameters
 from .data import MotionData
 from .filtering import Conditioned, filtered_noise, noise_floor
 
-#: Samples of the excitation's envelope (a fixed seed: the same reference for the same data).
-ENVELOPE_SAMPLES = 2000
 #: Below this sample rate (Hz) with joints slower than :data:`SLOW_SPEED` the time column is
 #: questioned (drives log at 100 Hz to 10 kHz).
 MIN_RATE_HZ = 20.0
@@ -55,18 +53,19 @@ TIME_UNITS = ((1e3, "milliseconds"), (1e6, "microseconds"), (1e9, "nanoseconds")
 SLOW_SPEED = 0.05
 
 
-def envelope(c: Conditioned, *, samples: int = ENVELOPE_SAMPLES, seed: int = 0
-             ) -> tuple[Array, Array, Array]:
-    """The excitation's envelope: ``samples`` states ``(q, dq, ddq)`` (each (n, 2)), the poses
-    drawn from the conditioned rows, each motor's speed and acceleration uniform within its
-    peak over those rows."""
-    rng = np.random.default_rng(seed)
-    i = rng.integers(0, len(c.q), size=samples)
-    vmax = np.abs(c.dq).max(axis=0)
-    amax = np.abs(c.ddq).max(axis=0)
-    dq = rng.uniform(-1.0, 1.0, size=(samples, 2)) * vmax
-    ddq = rng.uniform(-1.0, 1.0, size=(samples, 2)) * amax
-    return np.asarray(c.q[i]), dq, ddq
+def recorded_motion(c: Conditioned) -> tuple[Array, Array, Array]:
+    """The recorded motion as the fit saw it: ``(q, dq, ddq)`` (each (n, 2), SI) of the
+    conditioned rows either motor's fit used."""
+    keep = c.used.any(axis=1)
+    return np.asarray(c.q[keep]), np.asarray(c.dq[keep]), np.asarray(c.ddq[keep])
+
+
+def describe_motion(q: Array, dq: Array) -> str:
+    """A motion's poses and speeds in words: each motor's range (deg) and peak speed."""
+    lo, hi = np.degrees(q.min(axis=0)), np.degrees(q.max(axis=0))
+    v = np.abs(dq).max(axis=0)
+    return (f"motor A {lo[0]:.4g} to {hi[0]:.4g} deg, D {lo[1]:.4g} to {hi[1]:.4g} deg, up "
+            f"to {v[0]:.3g} / {v[1]:.3g} rad/s")
 
 
 def prediction_uncertainty(model: Model, base: BaseParameters, beta: Array, cov: Array,

@@ -88,7 +88,7 @@ def identify_model(data_path: str, sc: Scenario, *, config: str | None = None,
                    cutoff_hz: float | None = None, task: str | None = None,
                    validate: str | None = None) -> Identified:
     """Identify the scenario's robot (its prior model, SI) from the CSV ``data_path``; the
-    prediction uncertainty along the task file ``task`` (default: the data's envelope); with
+    prediction uncertainty along the task file ``task`` (default: the recorded motion); with
     ``validate`` (a second recording) its prediction measured. ``config`` names the config
     in the outputs."""
     if cutoff_hz is not None and not (math.isfinite(cutoff_hz) and cutoff_hz > 0):

@@ -173,7 +173,11 @@ class IdentificationReport:
             "prediction_uncertainty_limit": UNCERTAINTY_LIMIT,
             "prediction_uncertainty_note": (
                 "RMS standard deviation of the torques predicted along the reference over "
-                "their RMS, per motor (the parameters' covariance propagated)"),
+                "their RMS, per motor (the parameters' covariance propagated; 1 sigma). "
+                "Without --task the reference is the recorded motion, its poses and speeds "
+                "named: the verdict covers motions like it; elsewhere a prediction "
+                "extrapolates (--task measures the uncertainty along the motion the model "
+                "is for, --validate names the samples of another motion outside)"),
             "reasons": list(res.reasons),
             "unphysical_distance_sigmas": res.unphysical_distance,
             "poorly_determined": list(res.poorly_determined),
