@@ -42,6 +42,7 @@ from tests.robustness.strategies import (  # noqa: E402
     metre_configs,
     motion_files,
     programs,
+    time_scaled_motion_files,
 )
 
 PICK_PLACE = ROOT / "examples" / "pick_place.toml"
@@ -77,7 +78,8 @@ def main() -> int:
     n_falling = int(args.cases * 0.03)
     n_dry = int(args.cases * 0.01)
     n_long = int(args.cases * 0.01)  # review 28: long motions with the animation drawn
-    n_cfg = int(args.cases * 0.65) - n_metres - n_falling - n_dry - n_long
+    n_time = int(args.cases * 0.02)  # issue 28's time scales
+    n_cfg = int(args.cases * 0.65) - n_metres - n_falling - n_dry - n_long - n_time
 
     @settings(max_examples=n_cfg, deadline=None, database=None, derandomize=False,
               suppress_health_check=list(HealthCheck))
@@ -149,6 +151,20 @@ def main() -> int:
         outcome, detail = run_run_case(doc)
         record(outcome, detail, f"run with\n{toml_text(doc)}", time.perf_counter() - t0)
 
+    @settings(max_examples=n_time, deadline=None, database=None,
+              suppress_health_check=list(HealthCheck))
+    @given(case=time_scaled_motion_files(), config=st.sampled_from([None, str(PICK_PLACE)]))
+    def fuzz_time_scales(case: tuple[str, list[str], float], config: str | None) -> None:
+        text, options, factor = case
+        t0 = time.perf_counter()
+        outcome, detail = run_identify_case(text, options, config)
+        unit = {1e3: "milliseconds", 1e6: "microseconds"}.get(factor)
+        if unit is not None and outcome not in DEFECTS and (
+                outcome != "refused" or f"Is the time in {unit}?" not in detail):
+            outcome, detail = "bad-exit", f"time in {unit} not named: {outcome}: {detail}"
+        record(outcome, detail, f"identify {options} config {config}, t_s x {factor:g}, on\n"
+               f"{text[:300]}", time.perf_counter() - t0)
+
     import random
 
     random.seed(args.seed)
@@ -160,6 +176,7 @@ def main() -> int:
     fuzz_falling()
     fuzz_dry_runs()
     fuzz_long_runs()
+    fuzz_time_scales()
     fuzz_argv()
     total = sum(counts.values())
     print(f"{total} cases in {time.perf_counter() - t_start:.0f} s: " + ", ".join(

@@ -369,3 +369,33 @@ def long_animated_runs(draw: st.DrawFn) -> dict[str, Any]:
         doc["friction"] = {"coulomb": 0.002}
         doc["gravity"] = {"vector": [0.0, -9810.0]}
     return doc
+
+
+# --- issue 28: time scales ---------------------------------------------------------------
+
+#: Factors a time column is multiplied by: seconds written as milliseconds, microseconds, or
+#: as kiloseconds (the motion 1000 times faster).
+TIME_SCALES = (1e-3, 1.0, 1e3, 1e6)
+
+
+@st.composite
+def time_scaled_motion_files(draw: st.DrawFn) -> tuple[str, list[str], float]:
+    """A clean measured-motion CSV (a small motion of the DexTAR in working mode +-, 1000
+    or 500 Hz) whose time column is multiplied by a factor of :data:`TIME_SCALES`; returns
+    the text, extra ``dextar identify`` options and the factor."""
+    import numpy as np
+
+    n = draw(st.sampled_from([4000, 2000, 600]))
+    rate = draw(st.sampled_from([1000.0, 500.0]))
+    t = np.arange(n) / rate
+    w = 2 * np.pi * draw(st.sampled_from([0.3, 1.0, 2.0]))
+    amp = draw(st.sampled_from([0.2, 0.05, 0.0]))
+    # (0, 100) mm in working mode +- is phi = 54.7, psi = 125.3 deg for the DexTAR
+    q = np.stack([0.955 + amp * np.sin(w * t), 2.187 + amp * np.sin(1.7 * w * t + 1)], -1)
+    tau = np.stack([0.1 * np.sin(w * t) + 0.05, 0.08 * np.cos(w * t)], -1)
+    factor = draw(st.sampled_from(TIME_SCALES))
+    rows = np.column_stack([factor * t, q, tau])
+    text = "\n".join(["t_s,phi_rad,psi_rad,tau1_Nm,tau2_Nm",
+                      *(",".join(repr(float(v)) for v in r) for r in rows)]) + "\n"
+    opts = ["--cutoff-hz", "5"] if draw(st.integers(0, 3)) == 1 else []
+    return text, opts, factor

@@ -25,7 +25,8 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
     sp.add_argument("--task", metavar="TASK.toml",
                     help="a program or run config the model is for (its robot must be the "
                     "config's): the predicted-torque uncertainty is measured along it "
-                    "(default: along the data's own envelope)")
+                    "(default: along the recorded motion: the verdict then covers motions "
+                    "like it)")
     sp.add_argument("--validate", metavar="DATA2.csv",
                     help="data not used in the fit: predicted against measured torques")
     sp.add_argument("--cutoff-hz", type=float, default=None,

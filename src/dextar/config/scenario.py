@@ -8,6 +8,7 @@ happens here, once, as the objects are built.
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from functools import cached_property
@@ -397,15 +398,37 @@ def scenario_from_dict(doc: Mapping[str, Any], *, source: str | None = None,
 MODEL_TABLES = ("robot", "inertia", "friction", "gravity")
 
 
+#: The first line dextar writes at the top of a model it fitted to data (``identified.toml``,
+#: and ``calibrated.toml`` alike): ``# identified by dextar from DATA (STATUS: ...)``; the
+#: status is the verb when the fit succeeded.
+_FITTED_BY = re.compile(r"# (?P<verb>\w+) by dextar from (?P<data>.*?) \((?P<status>[^():]+): ")
+
+
+def check_model_status(model: str | FilePath, text: bytes) -> None:
+    """Refuse (:class:`ConfigError`) a model file whose first line says dextar's fit of it did
+    not succeed (``# identified by dextar from DATA (poor fit: ...)``): its status names
+    what to fix, and the user may delete that line to use the model anyway."""
+    first = text.split(b"\n", 1)[0].decode("utf-8", errors="replace").rstrip("\r")
+    m = _FITTED_BY.match(first)
+    if m is None or m["status"] == m["verb"]:
+        return
+    raise ConfigError(f"--model {str(model)!r} is a model dextar {m['verb']} from {m['data']} "
+                      f"with the status {m['status']!r}, not {m['verb']!r} (its first line "
+                      "gives the reasons): it is not used. Fit it again from better data, or "
+                      "delete that first line to use it anyway")
+
+
 def load_scenario(path: str | FilePath | None = None, *,
                   model: str | FilePath | None = None) -> Scenario:
     """Read a config file (or none: the paper's example) into a :class:`Scenario`; the file
     is read once. ``model``: a model file whose robot, inertia, friction and gravity replace
-    the config's (its other tables kept): what ``--model identified.toml`` does."""
+    the config's (its other tables kept): what ``--model identified.toml`` does; a model file
+    whose first line says its fit did not succeed is refused (:func:`check_model_status`)."""
     doc, text = ({}, b"") if path is None else read_config(path)
     source = None if path is None else str(path)
     if model is not None:
         mdoc, mtext = read_config(model)
+        check_model_status(model, mtext)
         missing = [t for t in ("robot", "inertia") if t not in mdoc]
         if missing:
             raise ConfigError(f"--model {str(model)!r} has no [{missing[0]}] table: a model "
