@@ -1,11 +1,12 @@
 """The crossings of the parallel singularity curve the tests plan (issue 31): a line across
 the DexTAR's curve and one across an unequal robot's, both in working mode "+-" from assembly
-mode "up" to "down", with a vertical robot's gravity and the pick-and-place's masses (SI)."""
+mode "up" to "down", with a vertical robot's gravity and the pick-and-place's masses (SI).
+The cases' model, crossings and path dynamics are computed once and shared (all frozen)."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import cache
+from functools import cache, cached_property
 
 import numpy as np
 
@@ -32,15 +33,15 @@ class Case:
     def path(self) -> Line:
         return Line(self.start, self.end)
 
-    @property
+    @cached_property
     def model(self) -> Model:
         return Model(self.robot, self.inertia, "up", tol=0.0)
 
-    @property
+    @cached_property
     def crossings(self) -> tuple[Crossing, ...]:
         return find_crossings(self.robot, self.path, mode="+-")
 
-    @property
+    @cached_property
     def dynamics(self) -> RobotAcrossPath:
         return RobotAcrossPath(self.model, self.path, "+-", self.crossings)
 

@@ -64,6 +64,7 @@ def drive(case, law, truth, *, feedback=True, hz=30.0, every=5, hold=0.02):
     return max(err), float(np.linalg.norm(P - np.asarray(case.end))), signs, end
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(CASES))
 def test_mujoco_follows_the_crossing_into_the_other_assembly_mode(name):
     """Within 1 mm: 4.4e-6 and 6.6e-6 m measured on the DexTAR and the unequal robot with

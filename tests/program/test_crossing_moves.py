@@ -2,16 +2,20 @@
 line or an arc, planned time-optimal under the degeneracy condition; the crossing's time,
 residual and torque peak in summary.json; what cannot cross refused by name."""
 
+import io
 import json
+from contextlib import redirect_stdout
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from dextar import jobs
 from dextar.cli import main
+from dextar.config import load_scenario
 from dextar.errors import AssemblyError, InfeasibleError, ParameterError
 from dextar.motors import MotorLimits
-from dextar.output.program import crossing_points
+from dextar.output.program import crossing_points, motion_figure, moves_figure, program_report
 from dextar.program import Move, plan_program
 
 from ..crossing_cases import CASES
@@ -22,16 +26,21 @@ EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 @pytest.fixture(scope="module")
 def example(tmp_path_factory):
+    """``dextar program`` on the example without its figures (they are checked below, drawn
+    and not rendered): the setpoints, summary.json and what it printed."""
     out = tmp_path_factory.mktemp("x") / "out"
-    assert main(["program", str(EXAMPLES / "type2_crossing.toml"), "--out", str(out),
-                 "--quiet"]) == 0
+    printed = io.StringIO()
+    with redirect_stdout(printed):
+        assert main(["program", str(EXAMPLES / "type2_crossing.toml"), "--out", str(out),
+                     "--no-figures"]) == 0
     head, data = read(out / "setpoints.csv")
     return (dict(zip(head, data.T, strict=True)), json.loads((out / "summary.json").read_text()),
-            out)
+            printed.getvalue())
 
 
+@pytest.mark.slow
 def test_the_example_crosses_down_and_back_within_the_motors(example):
-    cols, summ, out = example
+    cols, summ, printed = example
     assert summ["status"] == "fits"
     modes = [m["assembly_mode"] for m in summ["moves"]]
     assert modes == ["down", "down", "down", "up"]
@@ -45,11 +54,33 @@ def test_the_example_crosses_down_and_back_within_the_motors(example):
     assert (down["assembly_before"], up["assembly_after"]) == ("up", "up")
     tau = np.stack([cols["tau1_Nm"], cols["tau2_Nm"]], -1)
     assert np.isfinite(tau).all() and np.abs(tau).max() <= 0.5 * (1 + 1e-3)
-    # the setpoints pass the crossing's time, and the report says it
+    # the setpoints pass the crossing's time, and the printed lines say both crossings
     t = cols["t_s"]
     assert t.min() < down["time_s"] < t.max()
-    assert "Crossings of the parallel singularity curve" in (out / "report.html").read_text()
-    assert (out / "moves.png").stat().st_size > 0 and (out / "motion.png").stat().st_size > 0
+    assert "move 0 crosses the parallel singularity curve" in printed
+    assert "move 3 crosses the parallel singularity curve" in printed
+    assert "assembly mode up -> down" in printed and "assembly mode down -> up" in printed
+
+
+@pytest.mark.slow
+def test_the_examples_figures_and_report_mark_its_crossings():
+    """moves.png stars both crossings where summary.json puts them; every panel of
+    motion.png has a red dash-dot line at each crossing's time; the report has their table
+    (the figures drawn, not rendered: what is drawn is what is checked)."""
+    sc = load_scenario(EXAMPLES / "type2_crossing.toml")
+    job = jobs.program(sc)
+    points = [c["point_mm"] for m in job.summary.as_json()["moves"] for c in m["crossings"]]
+    times = [c["time_s"] for m in job.summary.as_json()["moves"] for c in m["crossings"]]
+    assert len(points) == 2
+    fig = moves_figure(job.result, sc.robot_mm, sc.program_mode)
+    (stars,) = [ln for ln in fig.axes[0].get_lines() if ln.get_label() == "type-2 crossing"]
+    assert np.allclose(np.column_stack(stars.get_data()), points, atol=1e-6)
+    fig = motion_figure(job.result)
+    for ax in fig.axes:
+        marks = [ln.get_xdata()[0] for ln in ax.get_lines()
+                 if ln.get_linestyle() == "-." and ln.get_color() == "red"]
+        assert np.allclose(marks, times, atol=1e-9), ax.get_ylabel()
+    assert "Crossings of the parallel singularity curve" in program_report(job.summary, {})
 
 
 def _moves(case, **extra):

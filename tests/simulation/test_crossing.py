@@ -1,6 +1,8 @@
 """Forward dynamics and tracking through a crossing of the parallel singularity curve
 (dextar.dynamics.forward.forward_task_dynamics, dextar.simulation.crossing)."""
 
+import re
+
 import numpy as np
 import pytest
 
@@ -23,6 +25,7 @@ def dextar():
     return case, law, tr
 
 
+@pytest.mark.slow
 def test_forward_dynamics_through_the_crossing(dextar):
     """The planned torques, held over 0.2 ms as a servo holds them, drive the forward
     dynamics in the end-effector's coordinates across the curve to the planned end (within
@@ -39,23 +42,30 @@ def test_forward_dynamics_through_the_crossing(dextar):
     assert err.max() < 1e-4
     assert list(assembly_mode(case.robot, res.q[[0, -1]], res.P[[0, -1]])) == [1, -1]
     # the motor angles' forward dynamics, from the plan 1 ms before the crossing, stop at it
-    k = int((crossing_time(law, case.crossings[0].s) - 1e-3) // dt)
+    # (at 0.0517723 s, 12 us before it, measured; rtol 1e-4: at 1e-6 the solver's steps
+    # shrink towards the singularity for 30 times as long and it stops at the same time)
+    tc = crossing_time(law, case.crossings[0].s)
+    k = int((tc - 1e-3) // dt)
     sk = sample_trajectory(case.robot, case.path, law, mode="+-", times=t[k:k + 2],
                            crossings=case.crossings)
-    with pytest.raises(SingularityError, match="parallel"):
+    with pytest.raises(SingularityError, match="parallel") as stop:
         forward_dynamics(Model(case.robot, case.inertia, "up"),
                          torques_from_samples(t[k:-1] + 0.5 * dt, tau[k:]), sk.q[0], sk.dq[0],
-                         t[k:k + 10], rtol=1e-6, atol=1e-9)
+                         t[k:k + 10], rtol=1e-4, atol=1e-7)
+    assert abs(float(re.search(r"t = ([\d.e+-]+)", str(stop.value))[1]) - tc) < 1e-4
     # the check can fail: the same torques on a robot with a heavier payload miss the plan
+    # (by 4.8 mm over the first half, measured)
     heavy = Model(case.robot, case.inertia.with_(payload=0.1), tol=0.0)
+    half = len(t) // 2
     try:
         off = forward_task_dynamics(heavy, "+-", lambda tt, q, dq: tau[int(tt // dt)], P[0],
-                                    tr.dP[0], t, substeps=2)
-        assert np.linalg.norm(off.P - P, axis=-1).max() > 1e-3
+                                    tr.dP[0], t[:half], substeps=2)
+        assert np.linalg.norm(off.P - P[:half], axis=-1).max() > 1e-3
     except SingularityError:
         pass  # (or it leaves the workspace)
 
 
+@pytest.mark.slow
 def test_tracking_across_the_crossing_with_a_wrong_model(dextar):
     """Masses 20 % off and an unknown payload: the singularity-robust loop follows the
     crossing into the other assembly mode (1.19 mm measured, 10 Hz) with torques near the
@@ -73,6 +83,7 @@ def test_tracking_across_the_crossing_with_a_wrong_model(dextar):
     assert np.abs(plain.tau).max() > 3 * case.peak
 
 
+@pytest.mark.slow
 def test_tracking_fails_without_the_torque_it_needs(dextar):
     """Saturated at half the planned peak the robot falls behind: not followed."""
     case, _, tr = dextar
@@ -108,6 +119,7 @@ samples = 201
 """
 
 
+@pytest.mark.slow
 def test_dextar_simulate_follows_a_crossing_config(tmp_path, capsys):
     """``[path].assembly_mode``: plan and simulate cross the curve (the default controller
     settings: masses 20 % off, 10 Hz: 1.19 mm measured against the 4.77 mm tolerance); run
