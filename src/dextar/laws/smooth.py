@@ -339,17 +339,25 @@ class _Mesh:
     def h(self) -> Array:
         return np.diff(self.f)
 
-    @cached_property
-    def knots(self) -> tuple[Array, Array, Array]:
-        """``Ea, Ev, Es`` (M + 1, M): ``alpha, w, sigma`` at the knots from the normalised
-        jerks (the exact integration of a piecewise-constant jerk from rest)."""
+    def states(self, J: Array) -> tuple[Array, Array, Array]:
+        """``alpha, w, sigma`` at the knots (M + 1,) from the normalised jerks ``J`` (M,):
+        the exact integration of a piecewise-constant jerk from rest, knot to knot."""
+        h = self.h
+        hJ = h * J
+        alpha = np.concatenate([[0.0], np.cumsum(hJ)])
+        a0 = alpha[:-1]
+        w = np.concatenate([[0.0], np.cumsum(h * (a0 + hJ / 2))])
+        sigma = np.concatenate([[0.0], np.cumsum(h * (w[:-1] + h * (a0 / 2 + hJ / 6)))])
+        return alpha, w, sigma
+
+    def rows_at(self, p: Array) -> tuple[Array, Array, Array]:
+        """The rows of the linear maps from the jerks to ``alpha, w, sigma`` at the knots
+        ``p`` (n,): three arrays (n, M)."""
         f, h = self.f, self.h
-        D = f[:, None] - f[None, :-1]             # time since each interval's start
-        inside = np.clip(D, 0.0, h[None, :])      # of it, within the interval
-        after = np.maximum(D - h[None, :], 0.0)   # since the interval's end
-        Ev = inside * inside / 2 + inside * after
-        Es = inside**3 / 6 + inside * inside * after / 2 + inside * after * after / 2
-        return inside, Ev, Es
+        after = np.maximum(f[np.asarray(p, int)][:, None] - f[None, 1:], 0.0)
+        inside = np.where(f[np.asarray(p, int)][:, None] >= f[None, 1:], h[None, :], 0.0)
+        return (inside, inside * (inside / 2 + after),
+                inside * (inside * inside / 6 + inside * after / 2 + after * after / 2))
 
 
 def _mesh(f: Array, pin_f: Array, pin_s: Array) -> _Mesh:
@@ -381,13 +389,12 @@ class _Motion:
 
 
 def _motion(mesh: _Mesh, J: Array, T: float, length: float) -> _Motion:
-    Ea, Ev, Es = mesh.knots
-    sigma = np.clip(Es @ J, 0.0, length)
+    alpha, w, sigma = mesh.states(J)
+    sigma = np.clip(sigma, 0.0, length)
     sigma[mesh.pins] = mesh.pin_s
     sigma[0], sigma[-1] = 0.0, length
-    alpha = Ea @ J
     alpha[-1] = 0.0
-    return _Motion(np.asarray(J, float), float(T), sigma, Ev @ J, alpha)
+    return _Motion(np.asarray(J, float), float(T), sigma, w, alpha)
 
 
 @dataclass(frozen=True)
@@ -592,9 +599,8 @@ def _ends(mesh: _Mesh, length: float) -> tuple[Array, Array]:
     """The end conditions and the pinned knots as equalities ``E J = e`` on the jerks:
     ``alpha_M = 0``, ``w_M = 0``, ``sigma_M = S`` and ``sigma = s_j`` at the pinned
     knots."""
-    Ea, Ev, Es = mesh.knots
-    M = mesh.M
-    E = np.vstack([Ea[M], Ev[M], Es[M], Es[mesh.pins]])
+    Ea, Ev, Es = mesh.rows_at(np.concatenate([[mesh.M], mesh.pins]))
+    E = np.vstack([Ea[:1], Ev[:1], Es])
     return E, np.concatenate([[0.0, 0.0, length], mesh.pin_s])
 
 
@@ -919,8 +925,8 @@ def _part(js: JointSamples, a: int, b: int) -> JointSamples:
 
 def _law(run: _Run, mesh: _Mesh, length: float, base: Any) -> JerkLimitedLaw:
     T = run.T
-    Ea, Ev, Es = mesh.knots
-    s, v, a = Es @ run.J, Ev @ run.J / T, Ea @ run.J / (T * T)
+    a, v, s = mesh.states(run.J)
+    v, a = v / T, a / (T * T)
     s[0], v[0], a[0] = 0.0, 0.0, 0.0
     s[-1], v[-1], a[-1] = length, 0.0, 0.0
     return JerkLimitedLaw(length, float(T), mesh.f * T, s, v, a, run.J / T**3,
@@ -1094,3 +1100,4 @@ def _register() -> None:
 
 
 _register()
+
