@@ -1,0 +1,205 @@
+"""The limits as rows of the transcription, at any motion, with their gradients in the states
+at the knots and the duration (the linearisation each linear programme takes)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..._arrays import Array
+from ..constraints import (
+    Constraint,
+    JerkLimit,
+    PointRows,
+    Tangent,
+    TorqueRateLimit,
+    point_rows,
+    speed_cap,
+)
+from .mesh import Mesh, Motion
+from .table import DA, DB, DG, Q1, Q2, Q3, A, B, Table, interp
+
+
+@dataclass(frozen=True)
+class Rows:
+    """The rows ``F <= 0`` (R,) at a motion, each at a point of an interval ``k`` (R,), and
+    their gradients in the LP's variables of that interval: ``C`` (R, 5) in ``sigma_k, w_k,
+    alpha_k, alpha_k+1, T`` (the jerk of the interval is ``(alpha_k+1 - alpha_k) / h``)."""
+
+    F: Array
+    k: Array
+    C: Array
+    kinds: tuple[tuple[str, int], ...] = ()  # (what, how many) per block (development)
+
+    def kind_of(self, i: int) -> str:
+        """The block row ``i`` belongs to (for the log)."""
+        for name, n in self.kinds:
+            if i < n:
+                return name
+            i -= n
+        return "?"
+
+    def powers(self) -> Array:
+        """How each row's use scales with ``1 / T`` for a fixed normalised motion (about:
+        the speed cap 1, the torques and accelerations 2, the third-order limits 3; 0 for
+        the rows that do not scale)."""
+        p = {"second-order": 2.0, "cap": 1.0, "w>=0": 0.0}
+        return np.concatenate([np.full(n, p.get(name, 3.0)) for name, n in self.kinds])
+
+    def linear(self, d_sigma: Array, d_w: Array, d_alpha: Array, d_T: float) -> Array:
+        """The rows' linear model after a change of the knots' states and of ``T``."""
+        k, C = self.k, self.C
+        return np.asarray(self.F + C[:, 0] * d_sigma[k] + C[:, 1] * d_w[k]
+                          + C[:, 2] * d_alpha[k] + C[:, 3] * d_alpha[k + 1] + C[:, 4] * d_T)
+
+
+def local(h: Array, k: Array, theta: Array, gs: Array, gw: Array, ga: Array, gj: Array,
+           gT: Array) -> Array:
+    """A row's gradient ``C`` (n, 5) from its derivatives in the point's ``sigma, w,
+    alpha``, the interval's jerk ``J`` and ``T`` (each (n,)), the point ``theta`` into the
+    interval ``k``."""
+    cJ = gs * theta**3 / 6 + gw * theta**2 / 2 + ga * theta + gj
+    ca = gs * theta**2 / 2 + gw * theta + ga
+    hk = h[k]
+    return np.stack([gs, gs * theta + gw, ca - cJ / hk, cJ / hk, gT], axis=1)
+
+
+class Model:
+    """The rows of the transcription at any motion (see the module doc)."""
+
+    def __init__(self, mesh: Mesh, table: Table, second: Sequence[Constraint],
+                 third: Sequence[Constraint], length: float) -> None:
+        self.mesh, self.table, self.length = mesh, table, length
+        self.second, self.third = list(second), list(third)
+        M, h = mesh.M, mesh.h
+        k = np.arange(M)
+        # the points of the second-order rows: the inner knots and every interval's middle
+        self.k2 = np.concatenate([k[1:], k])
+        self.t2 = np.concatenate([np.zeros(M - 1), h / 2])
+        # the third-order rows: every interval at its start, middle and end
+        self.t3 = (np.zeros(M), h / 2, h)
+        cap = speed_cap(second, table.co)
+        self.root_cap = (None if not np.isfinite(cap).any()
+                         else np.sqrt(np.where(np.isfinite(cap), cap, 1e300)))
+
+    def tangent(self, mo: Motion) -> Array:
+        """The tangent points of the speed-dependent bounds on the grid: the motion's squared
+        speeds (floored at 1e-4 of the largest: a tangent above the speed is still an upper
+        bound, and near rest the viscous torque it bounds is small)."""
+        x = np.maximum(mo.w, 0.0) ** 2 / (mo.T * mo.T)
+        x0 = np.interp(self.table.s, mo.sigma, x)
+        return np.asarray(np.maximum(x0, 1e-4 * float(x0.max()) + 1e-300))
+
+    def rows(self, mo: Motion) -> Rows:
+        """All rows at the motion, normalised by their limits (at its ``T``)."""
+        mesh, tab, S, T = self.mesh, self.table, self.length, mo.T
+        h = mesh.h
+        x0 = self.tangent(mo)
+        pr = point_rows(self.second, Tangent(tab.moving, np.concatenate([x0[:1], x0,
+                                                                           x0[-1:]])))
+        pr = PointRows(pr.pu[1:-1], pr.px[1:-1], pr.ph[1:-1])
+        m = pr.pu.shape[1]
+        k, th = self.k2, self.t2
+        sig, w, al = mo.at(mesh, k, th)
+        finite = np.isfinite(pr.ph)
+        vals, slopes = interp(tab.s, np.concatenate([pr.pu, pr.px, np.where(finite, pr.ph,
+                                                                             0.0)], axis=1),
+                               sig)
+        pu, px, ph = vals[:, :m], vals[:, m:2 * m], vals[:, 2 * m:]
+        dpu, dpx, dph = slopes[:, :m], slopes[:, m:2 * m], slopes[:, 2 * m:]
+        keep = (interp(tab.s, finite.astype(float), sig)[0] > 1 - 1e-12).reshape(-1)
+        a_, w_ = al[:, None], w[:, None]
+        c = np.maximum(np.abs(ph), 1e-9 * float(np.abs(ph).max()) + 1e-300) * T * T
+        F = (pu * a_ + px * w_ * w_ - ph * T * T) / c
+        kk, tt = np.repeat(k, m), np.repeat(th, m)
+        zero = np.zeros(len(kk))
+
+        def flat(v: Array) -> Array:
+            return np.asarray(v.reshape(-1))
+
+        Cs = [local(h, kk, tt, flat((dpu * a_ + dpx * w_ * w_ - dph * T * T) / c),
+                     flat(2 * px * w_ / c), flat(pu / c), zero, flat(-2 * ph * T / c))[keep]]
+        Fs, ks, names = [flat(F)[keep]], [kk[keep]], ["second-order"]
+        n2 = len(k)
+        if self.root_cap is not None:  # w <= sqrt(cap) T
+            rv, rs = interp(tab.s, self.root_cap[:, None], sig)
+            rv, rs = rv[:, 0], rs[:, 0]
+            c2 = np.maximum(rv, 1e-300) * T
+            Fs.append((w - rv * T) / c2)
+            Cs.append(local(h, k, th, -rs * T / c2, 1.0 / c2, np.zeros(n2), np.zeros(n2),
+                             -rv / c2))
+            ks.append(k)
+            names.append("cap")
+        Fs.append(-w / S)  # the speed stays >= 0
+        Cs.append(local(h, k, th, np.zeros(n2), np.full(n2, -1.0 / S), np.zeros(n2),
+                         np.zeros(n2), np.zeros(n2)))
+        ks.append(k)
+        names.append("w>=0")
+        kM = np.arange(mesh.M)
+        for th3, before in zip(self.t3, (False, False, True), strict=True):
+            sig, w, al = mo.at(mesh, kM, th3)
+            v, d = tab.at(sig, before)
+            F3, C3, k3 = self._third_at(mo, kM, th3, v, d, w, al)
+            Fs.append(F3)
+            Cs.append(C3)
+            ks.append(k3)
+            names.append("third")
+        return Rows(np.concatenate(Fs), np.concatenate(ks), np.concatenate(Cs),
+                     tuple((n, len(f)) for n, f in zip(names, Fs, strict=True)))
+
+    def _third_at(self, mo: Motion, k: Array, theta: Array, v: Array, d: Array, w: Array,
+                  al: Array) -> tuple[Array, Array, Array]:
+        """The joint jerk and torque-rate rows, on both sides of each limit, at offsets
+        ``theta`` into the intervals ``k`` (n,), with the table's columns ``v`` and slopes
+        ``d`` (n, 18) and the states ``w, al`` (n,) there: rows, gradients, intervals."""
+        T = mo.T
+        h = self.mesh.h
+        q1, q2, q3 = v[:, Q1], v[:, Q2], v[:, Q3]
+        dq1, dq2, dq3 = d[:, Q1], d[:, Q2], d[:, Q3]
+        jj, ww, aa = mo.J[k][:, None], w[:, None], al[:, None]
+        Fs: list[Array] = []
+        Cs: list[Array] = []
+        for c in self.third:
+            if isinstance(c, JerkLimit):
+                lim = np.asarray(c.max_jerk, float)
+                val = q1 * jj + 3 * q2 * ww * aa + q3 * ww**3
+                gs = dq1 * jj + 3 * dq2 * ww * aa + dq3 * ww**3
+                gw = 3 * q2 * aa + 3 * q3 * ww * ww
+                ga = 3 * q2 * ww
+                gj = q1
+                gT = np.zeros_like(val)
+            elif isinstance(c, TorqueRateLimit):
+                lim = np.asarray(c.max_torque_rate, float)
+                a, b = v[:, A], v[:, B]
+                da, db, dg = v[:, DA], v[:, DB], v[:, DG]
+                co = self.table.co
+                vs = co.coulomb_speed
+                # the friction's slope in the joint speed at the motion's speed (held in the
+                # linearisation: near a reversal the regularised Coulomb torque's is steep)
+                cf = co.viscous + co.coulomb / vs / np.cosh(np.clip(q1 * ww / T / vs,
+                                                                    -300, 300)) ** 2
+                acc = q1 * aa + q2 * ww * ww  # T^2 qddot
+                val = (a * jj + (da + 2 * b) * ww * aa + db * ww**3 + dg * ww * T * T
+                       + cf * acc * T)
+                gs = (d[:, A] * jj + (d[:, DA] + 2 * d[:, B]) * ww * aa
+                      + d[:, DB] * ww**3 + d[:, DG] * ww * T * T
+                      + cf * (dq1 * aa + dq2 * ww * ww) * T)
+                gw = (da + 2 * b) * aa + 3 * db * ww * ww + dg * T * T + cf * 2 * q2 * ww * T
+                ga = (da + 2 * b) * ww + cf * q1 * T
+                gj = a
+                gT = 2 * dg * ww * T + cf * acc
+            else:
+                continue
+            scale = lim * T**3
+            kk, tt = np.repeat(k, 2), np.repeat(theta, 2)
+            for sign in (1.0, -1.0):
+                Fs.append(((sign * val - scale) / scale).reshape(-1))
+                g_s, g_w, g_a, g_j = ((sign * x / scale).reshape(-1) for x in (gs, gw, ga, gj))
+                Cs.append(local(h, kk, tt, g_s, g_w, g_a, g_j,
+                                 ((sign * gT - 3 * lim * T * T) / scale).reshape(-1)))
+        if not Fs:
+            return np.zeros(0), np.zeros((0, 5)), np.zeros(0, int)
+        n = len(Fs)
+        return np.concatenate(Fs), np.concatenate(Cs), np.tile(np.repeat(k, 2), n)
