@@ -2,15 +2,15 @@
 Newton systems are banded: memory and work per iteration linear in the number of knots.
 
 The programme (:class:`StagedLP`) has the structure of a discrete-time control problem: the
-variables are the states ``x_k = (sigma_k, w_k, alpha_k)`` at the knots ``k = 0..M``
-(stored knot by knot) and a *border* of ``P = 2`` variables shared by all (the duration and
-the slack of the penalty); every inequality row couples the states of one interval (knots
-``k`` and ``k + 1``) with the border, every equality (``Q = 2`` per interval, the exact
-integration) the states of one interval. In the Newton system of the interior-point method,
-with the variables of each knot followed by the multipliers of its interval's equalities,
-the matrix is a band of half-width ``2 D + Q - 1 = 7`` bordered by ``P`` dense columns: one
-LU factorisation of the band (LAPACK ``dgbtrf``) and a ``P x P`` Schur complement solve it
-in ``O(M)``.
+variables are the states ``x_k = (sigma_k, w_k, alpha_k, T_k)`` at the knots ``k = 0..M``
+(stored knot by knot) and a *border* of ``P = 1`` variable shared by all (the slack of the
+penalty); every inequality row couples the states of one interval (knots ``k`` and
+``k + 1``) with the border, every equality (``Q = 3`` per interval: the exact integration,
+the duration's continuity) the states of one interval. In the Newton system of the
+interior-point method, with the variables of each knot followed by the multipliers of its
+interval's equalities, the matrix is a band of half-width ``2 D + Q - 1 = 10`` bordered by
+``P`` dense columns: one LU factorisation of the band (LAPACK ``dgbtrf``) and a ``P x P``
+Schur complement solve it in ``O(M)``.
 
 Method: Mehrotra's predictor-corrector (Nocedal & Wright, *Numerical Optimization*, 2nd ed.,
 Springer 2006, sec. 14.2; Wright, *Primal-Dual Interior-Point Methods*, SIAM 1997, ch. 10) on
@@ -37,39 +37,47 @@ from scipy.linalg import lapack
 
 from ..._arrays import Array
 
-#: States per knot, equalities per interval, border variables.
-D, Q, P = 3, 2, 2
+#: States per knot (arc length, speed, acceleration, duration), equalities per interval
+#: (the exact integration and the duration's continuity), border variables (the slack).
+D, Q, P = 4, 3, 1
 #: Band positions per knot (its states, then its interval's equalities).
 BLOCK = D + Q
-#: A row's band positions relative to its interval's first: sigma_k, w_k, alpha_k and
-#: alpha_k+1 (the rows of the transcription do not involve sigma_k+1 or w_k+1).
-ROW_POS = np.array([0, 1, 2, BLOCK + 2])
+#: A row's variables relative to its interval's first knot: sigma_k, w_k, alpha_k, T_k,
+#: alpha_k+1 and T_k+1 (the rows of the transcription do not involve sigma_k+1 or w_k+1),
+#: as indices of x and as band positions.
+ROW_X = np.array([0, 1, 2, 3, D + 2, D + 3])
+ROW_POS = np.array([0, 1, 2, 3, BLOCK + 2, BLOCK + 3])
+NR = len(ROW_POS)
 #: An equality's band positions: the states of both knots of its interval.
-EQ_POS = np.array([0, 1, 2, BLOCK, BLOCK + 1, BLOCK + 2])
+EQ_POS = np.concatenate([np.arange(D), BLOCK + np.arange(D)])
 #: The band's half-widths (below and above the diagonal).
 KL = KU = 2 * D + Q - 1
 #: Regularisation of the Newton matrix (primal +, dual -): far below the barrier terms.
 REG = 1e-11
 #: Fraction of the step to the boundary.
 ETA = 0.99
+#: The start's multipliers: on the central path of this complementarity.
+MU0 = 1e-2
 
 
 @dataclass(frozen=True)
 class StagedLP:
-    """``min c x`` subject to ``ra[r] . (sigma, w, alpha)_k, alpha_k+1 + rg[r] . border <=
-    rb[r]`` (``k = rk[r]``), ``E[k] . (x_k, x_k+1) = 0`` for every interval ``k`` and
-    ``lo <= x <= hi`` (``lo == hi``: fixed).
+    """``min c x`` subject to ``ra[r] . (sigma_k, w_k, alpha_k, T_k, alpha_k+1, T_k+1) +
+    rg[r] . border <= rb[r]`` (``k = rk[r]``), ``E[k] . (x_k, x_k+1) = e[k]`` for every
+    interval ``k`` and ``lo <= x <= hi`` (``lo == hi``: fixed).
 
     Attributes
     ----------
-    c, lo, hi : ndarray, shape (3 (M + 1) + 2,)
-        The knots' states (``sigma, w, alpha`` of knot 0, then of knot 1, ...), then the
+    c, lo, hi : ndarray, shape (4 (M + 1) + 1,)
+        The knots' states (``sigma, w, alpha, T`` of knot 0, then of knot 1, ...), then the
         border. ``lo`` may be ``-inf``, ``hi`` ``inf``.
     rk : ndarray of int, shape (R,)
-    ra : ndarray, shape (R, 4)
-    rg : ndarray, shape (R, 2)
+    ra : ndarray, shape (R, 6)
+        On ``sigma_k, w_k, alpha_k, T_k, alpha_k+1, T_k+1``.
+    rg : ndarray, shape (R, 1)
     rb : ndarray, shape (R,)
-    E : ndarray, shape (M, 2, 6)
+    E : ndarray, shape (M, 3, 8)
+    e : ndarray, shape (M, 3)
     """
 
     c: Array
@@ -78,6 +86,7 @@ class StagedLP:
     rg: Array
     rb: Array
     E: Array
+    e: Array
     lo: Array
     hi: Array
 
@@ -101,6 +110,7 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9,
     right-hand side and cost) and the total complementarity (the duality gap) below
     ``tol (1 + |c x|)``."""
     c, rk, ra, rg, rb, E, lo, hi = (lp.c, lp.rk, lp.ra, lp.rg, lp.rb, lp.E, lp.lo, lp.hi)
+    e = np.asarray(lp.e, float).reshape(-1)
     nx = len(c)
     K = (nx - P) // D
     M = K - 1
@@ -113,7 +123,7 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9,
     hasl = np.isfinite(lo) & free
     k = np.arange(M)
     # the variables of each row and equality (x numbering), and their band positions
-    xi = (D * rk)[:, None] + np.array([0, 1, 2, D + 2])[None, :]
+    xi = (D * rk)[:, None] + ROW_X[None, :]
     xi_flat = xi.reshape(-1)
     exi = (D * k)[:, None] + np.arange(2 * D)[None, :]
     exi_flat = np.repeat(exi[:, None, :], Q, axis=1).reshape(-1)
@@ -126,7 +136,7 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9,
     Em = E * free[exi][:, None, :]
     # band storage for dgbtrf: A[i, j] at ab[KL + KU + i - j, j]
     nrow = 2 * KL + KU + 1
-    ii, jj = np.repeat(bpos, 4, axis=1), np.tile(bpos, (1, 4))
+    ii, jj = np.repeat(bpos, NR, axis=1), np.tile(bpos, (1, NR))
     flat_rows = ((KL + KU + ii - jj) * nb + jj).reshape(-1)
     ei = np.repeat(yband.reshape(M, Q)[:, :, None], 2 * D, axis=2)
     ej = np.repeat(((BLOCK * k)[:, None] + EQ_POS[None, :])[:, None, :], Q, axis=1)
@@ -137,146 +147,125 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9,
     static[(KL + KU) * nb + yband] -= REG
     diag_x = (KL + KU) * nb + xband
 
-    def Gx(x: Array) -> Array:
-        return np.asarray(np.einsum("ij,ij->i", ra, x[xi]) + rg @ x[nk:])
+    iu, il = np.flatnonzero(hasu), np.flatnonzero(hasl)
+    nu, nl = len(iu), len(il)
+    m_all = R + nu + nl
+    # every inequality as g . x <= h: the rows, then x <= hi, then -x <= -lo
+    h_all = np.concatenate([rb, hi[iu], -lo[il]])
+    bnd = np.concatenate([iu, il])
+    sgn = np.concatenate([np.ones(nu), -np.ones(nl)])
 
-    def GTz(z: Array) -> Array:
+    def G(x: Array) -> Array:
+        """Every inequality's ``g . x``."""
+        return np.concatenate([np.einsum("ij,ij->i", ra, x[xi]) + rg @ x[nk:],
+                               sgn * x[bnd]])
+
+    def GT(z: Array) -> Array:
+        """``sum z g`` over the inequalities (fixed variables' entries zero)."""
         out = np.empty(nx)
-        out[:nk] = np.bincount(xi_flat, (ra * z[:, None]).reshape(-1), minlength=nk)
-        out[nk:] = rg.T @ z
+        zr = z[:R]
+        out[:nk] = np.bincount(xi_flat, (ra * zr[:, None]).reshape(-1), minlength=nk)
+        out[nk:] = rg.T @ zr
+        out += np.bincount(bnd, sgn * z[R:], minlength=nx)
+        out[fixed] = 0.0
         return out
 
     def Ex(x: Array) -> Array:
-        return np.asarray(np.einsum("kqj,kj->kq", E, x[exi]).reshape(-1))
+        return np.asarray(np.einsum("kqj,kj->kq", E, x[exi]).reshape(-1) - e)
 
     def ETy(y: Array) -> Array:
         out = np.zeros(nx)
         out[:nk] = np.bincount(exi_flat, (E * y.reshape(M, Q)[:, :, None]).reshape(-1),
                                minlength=nk)
+        out[fixed] = 0.0
         return out
 
     # the start: x0 as given (fixed variables at their values), the slacks at least a small
     # margin, the multipliers on the central path of MU0
     x = np.where(fixed, lo, np.asarray(x0, float))
-    gx = Gx(x)
     width = np.where(hasu & hasl, hi - lo, np.abs(x) + 1.0)
-    sr = np.maximum(rb - gx, 1e-2 * (1.0 + np.abs(rb)))
-    su = np.maximum(hi - x, 1e-3 * width)[hasu]
-    sl = np.maximum(x - lo, 1e-3 * width)[hasl]
-    mu0 = 1e-2
-    zr, zu, zl = mu0 / sr, mu0 / su, mu0 / sl
+    floor = np.concatenate([1e-2 * (1.0 + np.abs(rb)), 1e-3 * width[iu], 1e-3 * width[il]])
+    sl = np.maximum(h_all - G(x), floor)
+    z = MU0 / sl
     y = np.zeros(Q * M)
-    m_all = R + su.size + sl.size
     scale_p = 1.0 + float(np.abs(rb).max(initial=0.0))
     scale_d = 1.0 + float(np.abs(c).max(initial=0.0))
     status, it = 1, 0
     for it in range(maxiter + 1):
-        rd = c + GTz(zr) + ETy(y)
-        rd[hasu] += zu
-        rd[hasl] -= zl
+        rd = c + GT(z) + ETy(y)
         rd[fixed] = 0.0
-        rr = Gx(x) + sr - rb
+        rp = G(x) + sl - h_all
         re = Ex(x)
-        ru = (x - hi)[hasu] + su
-        rl = (lo - x)[hasl] + sl
-        gap = float(sr @ zr + su @ zu + sl @ zl)
-        pres = max(float(np.abs(rr).max(initial=0.0)), float(np.abs(re).max(initial=0.0)),
-                   float(np.abs(ru).max(initial=0.0)), float(np.abs(rl).max(initial=0.0)))
-        if (pres <= tol * scale_p and float(np.abs(rd).max()) <= tol * scale_d
+        gap = float(sl @ z)
+        if (max(float(np.abs(rp).max(initial=0.0)), float(np.abs(re).max(initial=0.0)))
+                <= tol * scale_p and float(np.abs(rd).max()) <= tol * scale_d
                 and gap <= tol * (1.0 + abs(float(c @ x)))):
             status = 0
             break
         if it == maxiter:
             break
         mu = gap / m_all
-        Dr = zr / sr
-        du, dl = zu / su, zl / sl
-        diag = np.full(nx, REG)
-        diag[hasu] += du
-        diag[hasl] += dl
+        Dz = z / sl
+        diag = np.full(nx, REG) + np.bincount(bnd, Dz[R:], minlength=nx)
         diag[fixed] = 1.0
-        w = Dr[:, None] * ram
+        w = Dz[:R, None] * ram
         ab = static + np.bincount(flat_rows, (w[:, :, None] * ram[:, None, :]).reshape(-1),
                                   minlength=nrow * nb)
         ab[diag_x] += diag[:nk]
         U = np.stack([np.bincount(bpos.reshape(-1), (w * rgm[:, p:p + 1]).reshape(-1),
                                   minlength=nb) for p in range(P)], axis=1)
-        corner = (rgm * Dr[:, None]).T @ rgm + np.diag(diag[nk:])
+        corner = (rgm * Dz[:R, None]).T @ rgm + np.diag(diag[nk:])
         lu, piv, info = lapack.dgbtrf(ab.reshape(nrow, nb), KL, KU)
         if info != 0:
             status = 2
             break
         BU = lapack.dgbtrs(lu, KL, KU, U, piv)[0]
-        schur = corner - U.T @ BU
-
-        sys_ = _Newton(lu, piv, BU, U, schur, Dr, du, dl, rd, rr, re, ru, rl, zr, zu, zl, sr,
-                       su, sl, GTz, Gx, hasu, hasl, fixed, xband, yband, nb, nk)
-        _, _, azr, azu, azl, asr, asu, asl = sys_.step(sr * zr, su * zu, sl * zl)
-        ap = min(1.0, _to_bound(sr, asr), _to_bound(su, asu), _to_bound(sl, asl))
-        ad = min(1.0, _to_bound(zr, azr), _to_bound(zu, azu), _to_bound(zl, azl))
-        mu_aff = float((sr + ap * asr) @ (zr + ad * azr) + (su + ap * asu) @ (zu + ad * azu)
-                       + (sl + ap * asl) @ (zl + ad * azl)) / m_all
-        target = (mu_aff / mu) ** 3 * mu
-        dx, dy, dzr, dzu, dzl, dsr, dsu, dsl = sys_.step(
-            sr * zr + asr * azr - target, su * zu + asu * azu - target,
-            sl * zl + asl * azl - target)
-        ap = min(1.0, ETA * min(_to_bound(sr, dsr), _to_bound(su, dsu), _to_bound(sl, dsl)))
-        ad = min(1.0, ETA * min(_to_bound(zr, dzr), _to_bound(zu, dzu), _to_bound(zl, dzl)))
+        newton = _Newton(lu, piv, BU, U, corner - U.T @ BU, Dz, rd, rp, re, z, sl, G, GT,
+                         fixed, xband, yband, nb, nk)
+        _, _, adz, ads = newton.step(sl * z)
+        ap = min(1.0, _to_bound(sl, ads))
+        ad = min(1.0, _to_bound(z, adz))
+        mu_aff = float((sl + ap * ads) @ (z + ad * adz)) / m_all
+        dx, dy, dz, ds = newton.step(sl * z + ads * adz - (mu_aff / mu) ** 3 * mu)
+        ap = min(1.0, ETA * _to_bound(sl, ds))
+        ad = min(1.0, ETA * _to_bound(z, dz))
         x += ap * dx
-        sr += ap * dsr
-        su += ap * dsu
-        sl += ap * dsl
+        sl += ap * ds
         y += ad * dy
-        zr += ad * dzr
-        zu += ad * dzu
-        zl += ad * dzl
+        z += ad * dz
     return LPResult(x, float(c @ x), status, it)
 
 
 @dataclass(frozen=True)
 class _Newton:
     """One iteration's Newton system, factorised: the band's LU, the border's solves and
-    Schur complement, the barrier terms and residuals at the iterate."""
+    Schur complement, the barrier terms ``z / s`` and the residuals at the iterate."""
 
     lu: Array
     piv: Array
     BU: Array
     U: Array
     schur: Array
-    Dr: Array
-    du: Array
-    dl: Array
+    Dz: Array
     rd: Array
-    rr: Array
+    rp: Array
     re: Array
-    ru: Array
-    rl: Array
-    zr: Array
-    zu: Array
-    zl: Array
-    sr: Array
-    su: Array
-    sl: Array
-    GTz: Callable[[Array], Array]
-    Gx: Callable[[Array], Array]
-    hasu: Array
-    hasl: Array
+    z: Array
+    s: Array
+    G: Callable[[Array], Array]
+    GT: Callable[[Array], Array]
     fixed: Array
     xband: Array
     yband: Array
     nb: int
     nk: int
 
-    def step(self, cr: Array, cu: Array, cl: Array) -> tuple[Array, ...]:
-        """The step ``(dx, dy, dzr, dzu, dzl, dsr, dsu, dsl)`` for the complementarity
-        targets ``s z + ds z + s dz = -c`` of the rows, upper and lower bounds."""
-        zr, zu, zl, sr, su, sl = self.zr, self.zu, self.zl, self.sr, self.su, self.sl
-        hasu, hasl, fixed, nk = self.hasu, self.hasl, self.fixed, self.nk
-        tr, tu, tl = self.rr - cr / zr, self.ru - cu / zu, self.rl - cl / zl
-        rhs = -self.rd - self.GTz(self.Dr * tr)
-        rhs[hasu] -= self.du * tu
-        rhs[hasl] += self.dl * tl
-        rhs[fixed] = 0.0
+    def step(self, cc: Array) -> tuple[Array, Array, Array, Array]:
+        """The step ``(dx, dy, dz, ds)`` for the complementarity targets
+        ``s z + ds z + s dz = -cc`` of every inequality."""
+        nk = self.nk
+        t = self.rp - cc / self.z
+        rhs = -self.rd - self.GT(self.Dz * t)
         full = np.zeros(self.nb)
         full[self.xband] = rhs[:nk]
         full[self.yband] = -self.re
@@ -284,12 +273,9 @@ class _Newton:
         dp = np.linalg.solve(self.schur, rhs[nk:] - self.U.T @ sb)
         db = sb - self.BU @ dp
         dx = np.concatenate([db[self.xband], dp])
-        dx[fixed] = 0.0
-        dzr = self.Dr * (self.Gx(dx) + tr)
-        dzu = self.du * (dx[hasu] + tu)
-        dzl = self.dl * (tl - dx[hasl])
-        return (dx, db[self.yband], dzr, dzu, dzl, (-cr - sr * dzr) / zr,
-                (-cu - su * dzu) / zu, (-cl - sl * dzl) / zl)
+        dx[self.fixed] = 0.0
+        dz = self.Dz * (self.G(dx) + t)
+        return dx, db[self.yband], dz, (-cc - self.s * dz) / self.z
 
 
 def _to_bound(v: Array, dv: Array) -> float:

@@ -18,7 +18,7 @@ from ..constraints import (
     point_rows,
     speed_cap,
 )
-from .mesh import Mesh, Motion
+from .mesh import Mesh, Motion, knot_T
 from .table import DA, DB, DG, Q1, Q2, Q3, A, B, Table, interp
 
 
@@ -26,11 +26,18 @@ from .table import DA, DB, DG, Q1, Q2, Q3, A, B, Table, interp
 class Rows:
     """The rows ``F <= 0`` (R,) at a motion, each at a point of an interval ``k`` (R,), and
     their gradients in the LP's variables of that interval: ``C`` (R, 5) in ``sigma_k, w_k,
-    alpha_k, alpha_k+1, T`` (the jerk of the interval is ``(alpha_k+1 - alpha_k) / h``)."""
+    alpha_k, alpha_k+1, T`` (the jerk of the interval is ``(alpha_k+1 - alpha_k) / h``).
+
+    Each row is its limit's polynomial form (``pu alpha + px w^2 - ph T^2``, ``q' J + ...
+    - j_max T^3``) over a normalisation ``norm`` (R,) taken at the motion (its limit's scale:
+    ``|ph| T^2``, ``j_max T^3``): the gradients keep the normalisation fixed, so the linear
+    model is the polynomial form's, whose dependence on ``T`` is concave (a tangent above
+    it: the model never underestimates a row when ``T`` shrinks)."""
 
     F: Array
     k: Array
     C: Array
+    norm: Array
     kinds: tuple[tuple[str, int], ...] = ()  # (what, how many) per block (development)
 
     def kind_of(self, i: int) -> str:
@@ -48,18 +55,23 @@ class Rows:
         p = {"second-order": 2.0, "cap": 1.0, "w>=0": 0.0}
         return np.concatenate([np.full(n, p.get(name, 3.0)) for name, n in self.kinds])
 
-    def linear(self, d_sigma: Array, d_w: Array, d_alpha: Array, d_T: float) -> Array:
-        """The rows' linear model after a change of the knots' states and of ``T``."""
+    def linear(self, d_sigma: Array, d_w: Array, d_alpha: Array, d_alpha_end: Array,
+               d_T: Array) -> Array:
+        """The rows' linear model after a change of the knots' states (M + 1,), of the
+        intervals' end accelerations in their own normalisation and of their durations
+        (M,)."""
         k, C = self.k, self.C
         return np.asarray(self.F + C[:, 0] * d_sigma[k] + C[:, 1] * d_w[k]
-                          + C[:, 2] * d_alpha[k] + C[:, 3] * d_alpha[k + 1] + C[:, 4] * d_T)
+                          + C[:, 2] * d_alpha[k] + C[:, 3] * d_alpha_end[k]
+                          + C[:, 4] * d_T[k])
 
 
 def local(h: Array, k: Array, theta: Array, gs: Array, gw: Array, ga: Array, gj: Array,
            gT: Array) -> Array:
-    """A row's gradient ``C`` (n, 5) from its derivatives in the point's ``sigma, w,
-    alpha``, the interval's jerk ``J`` and ``T`` (each (n,)), the point ``theta`` into the
-    interval ``k``."""
+    """A row's gradient ``C`` (n, 5) in its interval's ``sigma_k, w_k, alpha_k``, end
+    acceleration and duration ``T_k`` (all in the interval's normalisation) from its
+    derivatives in the point's ``sigma, w, alpha``, the interval's jerk ``J`` and ``T_k``
+    (each (n,)), the point ``theta`` into the interval ``k``."""
     cJ = gs * theta**3 / 6 + gw * theta**2 / 2 + ga * theta + gj
     ca = gs * theta**2 / 2 + gw * theta + ga
     hk = h[k]
@@ -88,13 +100,13 @@ class Model:
         """The tangent points of the speed-dependent bounds on the grid: the motion's squared
         speeds (floored at 1e-4 of the largest: a tangent above the speed is still an upper
         bound, and near rest the viscous torque it bounds is small)."""
-        x = np.maximum(mo.w, 0.0) ** 2 / (mo.T * mo.T)
+        x = (np.maximum(mo.w, 0.0) / knot_T(mo.Tk)) ** 2
         x0 = np.interp(self.table.s, mo.sigma, x)
         return np.asarray(np.maximum(x0, 1e-4 * float(x0.max()) + 1e-300))
 
     def rows(self, mo: Motion) -> Rows:
-        """All rows at the motion, normalised by their limits (at its ``T``)."""
-        mesh, tab, S, T = self.mesh, self.table, self.length, mo.T
+        """All rows at the motion, normalised by their limits (at its durations)."""
+        mesh, tab, S = self.mesh, self.table, self.length
         h = mesh.h
         x0 = self.tangent(mo)
         pr = point_rows(self.second, Tangent(tab.moving, np.concatenate([x0[:1], x0,
@@ -110,7 +122,7 @@ class Model:
         pu, px, ph = vals[:, :m], vals[:, m:2 * m], vals[:, 2 * m:]
         dpu, dpx, dph = slopes[:, :m], slopes[:, m:2 * m], slopes[:, 2 * m:]
         keep = (interp(tab.s, finite.astype(float), sig)[0] > 1 - 1e-12).reshape(-1)
-        a_, w_ = al[:, None], w[:, None]
+        a_, w_, T = al[:, None], w[:, None], mo.Tk[k][:, None]
         c = np.maximum(np.abs(ph), 1e-9 * float(np.abs(ph).max()) + 1e-300) * T * T
         F = (pu * a_ + px * w_ * w_ - ph * T * T) / c
         kk, tt = np.repeat(k, m), np.repeat(th, m)
@@ -120,19 +132,24 @@ class Model:
             return np.asarray(v.reshape(-1))
 
         Cs = [local(h, kk, tt, flat((dpu * a_ + dpx * w_ * w_ - dph * T * T) / c),
-                     flat(2 * px * w_ / c), flat(pu / c), zero, flat(-2 * ph * T / c))[keep]]
+                    flat(2 * px * w_ / c), flat(pu / c), zero, flat(-2 * ph * T / c))[keep]]
+        norms = [flat(np.broadcast_to(c, F.shape))[keep]]
         Fs, ks, names = [flat(F)[keep]], [kk[keep]], ["second-order"]
         n2 = len(k)
         if self.root_cap is not None:  # w <= sqrt(cap) T
             rv, rs = interp(tab.s, self.root_cap[:, None], sig)
             rv, rs = rv[:, 0], rs[:, 0]
+            T = mo.Tk[k]
             c2 = np.maximum(rv, 1e-300) * T
-            Fs.append((w - rv * T) / c2)
+            Fc = (w - rv * T) / c2
+            Fs.append(Fc)
             Cs.append(local(h, k, th, -rs * T / c2, 1.0 / c2, np.zeros(n2), np.zeros(n2),
-                             -rv / c2))
+                            -rv / c2))
+            norms.append(c2)
             ks.append(k)
             names.append("cap")
         Fs.append(-w / S)  # the speed stays >= 0
+        norms.append(np.full(n2, S))
         Cs.append(local(h, k, th, np.zeros(n2), np.full(n2, -1.0 / S), np.zeros(n2),
                          np.zeros(n2), np.zeros(n2)))
         ks.append(k)
@@ -141,26 +158,30 @@ class Model:
         for th3, before in zip(self.t3, (False, False, True), strict=True):
             sig, w, al = mo.at(mesh, kM, th3)
             v, d = tab.at(sig, before)
-            F3, C3, k3 = self._third_at(mo, kM, th3, v, d, w, al)
+            F3, C3, k3, n3 = self._third_at(mo, kM, th3, v, d, w, al)
+            norms.append(n3)
             Fs.append(F3)
             Cs.append(C3)
             ks.append(k3)
             names.append("third")
         return Rows(np.concatenate(Fs), np.concatenate(ks), np.concatenate(Cs),
-                     tuple((n, len(f)) for n, f in zip(names, Fs, strict=True)))
+                    np.concatenate(norms),
+                    tuple((n, len(f)) for n, f in zip(names, Fs, strict=True)))
 
     def _third_at(self, mo: Motion, k: Array, theta: Array, v: Array, d: Array, w: Array,
-                  al: Array) -> tuple[Array, Array, Array]:
+                  al: Array) -> tuple[Array, Array, Array, Array]:
         """The joint jerk and torque-rate rows, on both sides of each limit, at offsets
         ``theta`` into the intervals ``k`` (n,), with the table's columns ``v`` and slopes
-        ``d`` (n, 18) and the states ``w, al`` (n,) there: rows, gradients, intervals."""
-        T = mo.T
+        ``d`` (n, 18) and the states ``w, al`` (n,) there: rows, gradients, intervals,
+        normalisations."""
+        T = mo.Tk[k][:, None]
         h = self.mesh.h
         q1, q2, q3 = v[:, Q1], v[:, Q2], v[:, Q3]
         dq1, dq2, dq3 = d[:, Q1], d[:, Q2], d[:, Q3]
         jj, ww, aa = mo.J[k][:, None], w[:, None], al[:, None]
         Fs: list[Array] = []
         Cs: list[Array] = []
+        Ns: list[Array] = []
         for c in self.third:
             if isinstance(c, JerkLimit):
                 lim = np.asarray(c.max_jerk, float)
@@ -196,10 +217,12 @@ class Model:
             kk, tt = np.repeat(k, 2), np.repeat(theta, 2)
             for sign in (1.0, -1.0):
                 Fs.append(((sign * val - scale) / scale).reshape(-1))
+                Ns.append(np.broadcast_to(scale, val.shape).reshape(-1))
                 g_s, g_w, g_a, g_j = ((sign * x / scale).reshape(-1) for x in (gs, gw, ga, gj))
                 Cs.append(local(h, kk, tt, g_s, g_w, g_a, g_j,
-                                 ((sign * gT - 3 * lim * T * T) / scale).reshape(-1)))
+                                ((sign * gT - 3 * lim * T * T) / scale).reshape(-1)))
         if not Fs:
-            return np.zeros(0), np.zeros((0, 5)), np.zeros(0, int)
+            return np.zeros(0), np.zeros((0, 5)), np.zeros(0, int), np.zeros(0)
         n = len(Fs)
-        return np.concatenate(Fs), np.concatenate(Cs), np.tile(np.repeat(k, 2), n)
+        return (np.concatenate(Fs), np.concatenate(Cs), np.tile(np.repeat(k, 2), n),
+                np.concatenate(Ns))

@@ -25,7 +25,7 @@ import numpy as np
 
 from ..._arrays import Array
 from .banded import LPResult, StagedLP, solve_staged
-from .mesh import Mesh, Motion, motion
+from .mesh import Mesh, Motion, knot_T, motion, projected
 from .rows import Model, Rows
 
 log = logging.getLogger(__name__)
@@ -36,6 +36,11 @@ START_DELTA = 0.3
 RESTART_DELTA = 0.1
 #: The trust region's share for ``T``: it moves by at most this times ``delta`` (relative).
 T_SHARE = 0.5
+#: The trust region's share for the durations of neighbouring stretches relative to each
+#: other (their ratio moves by at most this times ``delta``).
+RHO_SHARE = 0.01
+#: The trust region's floor for the speeds, a fraction of the largest.
+W_FLOOR = 0.2
 #: Weight of the l-infinity penalty on the rows (normalised) against ``T / T_start``: above
 #: the sum of the rows' multipliers (at most about 1: relaxing every limit by a fraction
 #: ``e`` shortens the motion by at most ``e T``), so that the penalty is exact.
@@ -60,36 +65,46 @@ def merit(T: float, T_ref: float, F: Array, ahead: float) -> float:
 
 @dataclass(frozen=True)
 class Run:
-    """What an SLP run found and what it cost: the normalised jerks, the duration, the
-    programmes solved, whether they settled, and the largest row at the motion."""
+    """What an SLP run found and what it cost: the normalised jerks and the intervals'
+    durations, the programmes solved, whether they settled, and the largest row at the
+    motion."""
 
     J: Array
-    T: float
+    Tk: Array
     programmes: int
     converged: bool
     worst: float
 
 
 class Programme:
-    """The linear programme's fixed parts on a mesh (see the module doc): the equalities, the
-    bounds that do not move, the cost."""
+    """The linear programme on a mesh (see the module doc): its variables are each knot's
+    ``sigma, w, alpha, T`` (``T`` the duration of the knot's stretch) and the slack; its
+    equalities each interval's exact integration and, inside a stretch, the duration's
+    continuity (at a pinned knot the end states change normalisation, ``w_end = rho w``,
+    ``alpha_end = rho^2 alpha`` with ``rho = T_k / T_k+1``: linearised)."""
 
     def __init__(self, mesh: Mesh, length: float) -> None:
         M, h = mesh.M, mesh.h
         self.mesh, self.M, self.length = mesh, M, length
         K = M + 1
         z, one = np.zeros(M), np.ones(M)
-        # w_k+1 - w_k = h (alpha_k + alpha_k+1) / 2 and, over h, the arc length's
-        self.E = np.stack([np.stack([z, -one, -h / 2, z, one, -h / 2], axis=1),
-                           np.stack([-1 / h, -one, -h / 3, 1 / h, z, -h / 6], axis=1)], axis=1)
-        lo = np.zeros((K, 3))
-        hi = np.stack([np.full(K, length), np.full(K, np.inf), np.zeros(K)], axis=1)
+        # w_k+1 - w_k = h (alpha_k + alpha_k+1) / 2, the arc length's over h, T_k = T_k+1,
+        # on (sigma, w, alpha, T) of knots k and k + 1
+        E = np.stack([np.stack([z, -one, -h / 2, z, z, one, -h / 2, z], axis=1),
+                      np.stack([-1 / h, -one, -h / 3, z, 1 / h, z, -h / 6, z], axis=1),
+                      np.stack([z, z, z, one, z, z, z, -one], axis=1)], axis=1)
+        self.into_pin = mesh.pinned[1:]  # the intervals that end at a pinned knot
+        E[self.into_pin, 2, :] = 0.0
+        self.E = E
+        lo = np.stack([np.zeros(K), np.zeros(K), np.zeros(K), np.zeros(K)], axis=1)
+        hi = np.stack([np.full(K, length), np.full(K, np.inf), np.zeros(K), np.zeros(K)],
+                      axis=1)
         lo[-1, 0], hi[0, 0] = length, 0.0
         hi[0, 1] = hi[-1, 1] = 0.0
         lo[mesh.pins, 0] = hi[mesh.pins, 0] = mesh.pin_s
         self.lo, self.hi = lo, hi
-        self.c = np.zeros(3 * K + 2)
-        self.c[3:3 * M:3] = -PROGRESS / ((M - 1) * length)  # the reward for being ahead
+        self.c = np.zeros(4 * K + 1)
+        self.c[4:4 * M:4] = -PROGRESS / ((M - 1) * length)  # the reward for being ahead
         self.c[-1] = PENALTY
         # how far the arc lengths and speeds can move per unit change of the accelerations:
         # their integrals from the nearer end
@@ -100,52 +115,124 @@ class Programme:
         """The mean of the inner knots' arc lengths over the path's length."""
         return float(mo.sigma[1:self.M].sum()) / ((self.M - 1) * self.length)
 
-    def reach(self, rows: Rows, delta: float, scale: float, T: float) -> Array:
+    def reach(self, rows: Rows, mo: Motion, delta: float, scale: float) -> Array:
         """The largest change of each row's linear model within the trust region."""
         C, k = np.abs(rows.C), rows.k
-        d = delta * scale
+        d, dT = delta * scale, T_SHARE * delta
         return np.asarray(d * (C[:, 0] * self.reach_sw[k, 0] + C[:, 1] * self.reach_sw[k, 1]
-                               + C[:, 2] + C[:, 3]) + C[:, 4] * T * T_SHARE * delta)
+                               + C[:, 2] + C[:, 3])
+                          + dT * (C[:, 4] * mo.Tk[k] + 4 * C[:, 3] * np.abs(mo.alpha_end[k])))
+
+    def _end_terms(self, mo: Motion) -> tuple[Array, Array, Array, Array, Array, Array]:
+        """The linearised end states of every interval in its own normalisation:
+        ``w_end = rw w_k+1 + tw``, ``alpha_end = ra alpha_k+1 + ta`` with ``tw, ta`` linear in
+        ``T_k / T0_k - T_k+1 / T0_k+1`` (coefficients ``cw, ca``); (M,) each."""
+        Tn = knot_T(mo.Tk)
+        rho = Tn[:-1] / Tn[1:]
+        pin = self.into_pin
+        rho = np.where(pin, rho, 1.0)
+        cw = np.where(pin, rho * mo.w[1:], 0.0)
+        ca = np.where(pin, 2 * rho * rho * mo.alpha[1:], 0.0)
+        return rho, rho * rho, cw, ca, Tn[:-1], Tn[1:]
+
+    def _local(self, C: Array, k: Array, mo: Motion) -> Array:
+        """The rows' coefficients (n, 6) on ``sigma_k, w_k, alpha_k, T_k, alpha_k+1,
+        T_k+1`` from their gradients ``C`` (n, 5) in the interval's own states."""
+        _, r2, _, ca, T0, T1 = self._end_terms(mo)
+        c3 = C[:, 3]
+        return np.stack([C[:, 0], C[:, 1], C[:, 2], C[:, 4] + c3 * ca[k] / T0[k],
+                         c3 * r2[k], -c3 * ca[k] / T1[k]], axis=1)
+
+    def x0(self, mo: Motion) -> Array:
+        """The motion as the programme's variables."""
+        return np.concatenate([np.stack([mo.sigma, mo.w, mo.alpha, knot_T(mo.Tk)],
+                                        axis=1).reshape(-1), [0.0]])
 
     def solve(self, rows: Rows, use: Array, mo: Motion, T_ref: float, delta: float,
               scale: float) -> LPResult:
         """The programme on the rows ``use`` (a mask) about the motion ``mo``, within the
-        trust region: the accelerations within ``delta * scale`` of the motion's, ``T``
-        within ``T_SHARE * delta`` (relative) of it."""
+        trust region: the accelerations within ``delta * scale`` of the motion's, the
+        durations within ``T_SHARE * delta`` (relative) of theirs."""
+        M, mesh = self.M, self.mesh
         sel = np.flatnonzero(use)
-        k, C = rows.k[sel], rows.C[sel]
-        x0 = np.concatenate([np.stack([mo.sigma, mo.w, mo.alpha], axis=1).reshape(-1),
-                             [mo.T, 0.0]])
-        ra = C[:, :4]
-        local = np.stack([mo.sigma[k], mo.w[k], mo.alpha[k], mo.alpha[k + 1]], axis=1)
-        rb = np.einsum("ij,ij->i", ra, local) + C[:, 4] * mo.T - rows.F[sel]
-        rg = np.stack([C[:, 4], -np.ones(len(sel))], axis=1)
+        k = rows.k[sel]
+        ra = self._local(rows.C[sel], k, mo)
+        x0 = self.x0(mo)
+        xk = x0[:-1].reshape(-1, 4)
+        local = np.concatenate([xk[k], xk[k + 1, 2:]], axis=1)
+        rb = np.einsum("ij,ij->i", ra, local) - rows.F[sel]
+        # the integration into a pinned knot, linearised in the durations
+        rho, r2, cw, ca, T0, T1 = self._end_terms(mo)
+        E = self.E.copy()
+        pin = self.into_pin
+        h = mesh.h[pin]
+        E[pin, 0, 5] = rho[pin]
+        E[pin, 0, 6] = -h / 2 * r2[pin]
+        E[pin, 1, 6] = -h / 6 * r2[pin]
+        dTe = np.stack([cw[pin] - h / 2 * ca[pin], -h / 6 * ca[pin]], axis=1)  # per unit
+        E[pin, :2, 3] = dTe / T0[pin, None]
+        E[pin, :2, 7] = -dTe / T1[pin, None]
         lo, hi = self.lo.copy(), self.hi.copy()
-        inner = slice(1, self.M)
+        inner = slice(1, M)
         lo[inner, 2] = mo.alpha[inner] - delta * scale
         hi[inner, 2] = mo.alpha[inner] + delta * scale
-        dT = T_SHARE * delta
+        # the speeds within delta of theirs (relative, with a floor): the third-order rows
+        # grow as their cube, so a slow stretch (a blend) moves in proportion
+        wr = delta * (np.abs(mo.w[inner]) + W_FLOOR * float(np.abs(mo.w).max()))
+        lo[inner, 1] = np.maximum(mo.w[inner] - wr, 0.0)
+        hi[inner, 1] = mo.w[inner] + wr
+        Tn = knot_T(mo.Tk)
+        lo[:, 3] = Tn * (1 - T_SHARE * delta)
+        hi[:, 3] = Tn * (1 + T_SHARE * delta)
         c = self.c.copy()
-        c[-2] = 1.0 / T_ref
-        lp = StagedLP(c, k, ra, rg, rb, self.E,
-                      np.concatenate([lo.reshape(-1), [mo.T * (1 - dT), 0.0]]),
-                      np.concatenate([hi.reshape(-1), [mo.T * (1 + dT), np.inf]]))
+        c[3:4 * M:4] = mesh.h / T_ref
+        # the stretches' durations relative to each other change less than the whole: the
+        # jerk of the short interval into a pinned knot changes with the square of their
+        # ratio over the interval's length
+        kp = np.flatnonzero(pin)
+        tr = np.zeros((len(kp), 6))
+        tr[:, 3], tr[:, 5] = 1.0 / T0[kp], -1.0 / T1[kp]
+        k = np.concatenate([k, kp, kp])
+        ra = np.concatenate([ra, tr, -tr])
+        rg = np.concatenate([-np.ones(len(sel)), np.zeros(2 * len(kp))])[:, None]
+        rb = np.concatenate([rb, np.full(2 * len(kp), RHO_SHARE * delta)])
+        lp = StagedLP(c, k, ra, rg, rb, E, np.zeros((M, 3)),
+                      np.concatenate([lo.reshape(-1), [0.0]]),
+                      np.concatenate([hi.reshape(-1), [np.inf]]))
         return solve_staged(lp, x0)
 
-    def states(self, x: Array) -> tuple[Array, Array, Array, float, float]:
-        """``sigma, w, alpha`` (M + 1,), ``T`` and the slack of a programme's solution."""
-        s = x[:-2].reshape(-1, 3)
-        return s[:, 0], s[:, 1], s[:, 2], float(x[-2]), float(x[-1])
+    def model(self, rows: Rows, x: Array, mo: Motion) -> Array:
+        """Every row's linear model at the programme's variables ``x``."""
+        ra = self._local(rows.C, rows.k, mo)
+        d = (x[:-1] - self.x0(mo)[:-1]).reshape(-1, 4)
+        k = rows.k
+        return np.asarray(rows.F + np.einsum("ij,ij->i", ra,
+                                             np.concatenate([d[k], d[k + 1, 2:]], axis=1)))
+
+    def motion(self, x: Array, length: float) -> Motion:
+        """The motion of a programme's solution: its accelerations and durations, the jerks
+        between them projected to meet the ends and the pinned knots exactly (the
+        linearised normalisation at the pinned knots leaves them a little off)."""
+        mesh = self.mesh
+        s = x[:-1].reshape(-1, 4)
+        Tn = np.maximum(s[:, 3], 1e-300)
+        Tk = Tn[:-1]
+        a = s[:, 2] / (Tn * Tn)
+        a[-1] = 0.0
+        j = np.diff(a) / (mesh.h * Tk)
+        j = projected(mesh, j, Tk, length)
+        return motion(mesh, j * Tk**3, Tk, length)
 
 
-def time_scaled(model: Model, J: Array, T: float) -> float:
-    """The duration that brings the normalised motion ``J`` just within its rows (a start
-    that is slower than the limits allow is sped up, one beyond them slowed down): each
-    row's use scales about as ``T^-p`` (:meth:`Rows.powers`); exact where it does, so a few
-    rounds, then doubling while a row is still beyond its limit (gravity or friction rows
-    that scale more slowly)."""
+def time_scaled(model: Model, J: Array, Tk: Array) -> Array:
+    """The durations that bring the normalised motion ``J`` just within its rows (a start
+    that is slower than the limits allow is sped up, one beyond them slowed down), all
+    scaled alike: each row's use scales about as ``T^-p`` (:meth:`Rows.powers`); exact
+    where it does, so a few rounds, then stretching while a row is still beyond its limit
+    (gravity or friction rows that scale more slowly)."""
+    Tk = np.asarray(Tk, float)
     for _ in range(40):
-        rows = model.rows(motion(model.mesh, J, T, model.length))
+        rows = model.rows(motion(model.mesh, J, Tk, model.length))
         i = int(np.argmax(rows.F))
         worst = float(rows.F[i])
         p = rows.powers()
@@ -158,34 +245,32 @@ def time_scaled(model: Model, J: Array, T: float) -> float:
             if p[i] == 0:
                 break  # a row the duration does not change
             factor = max(factor, 1.5)
-        T *= factor * (1 + 1e-4)
-    return T
+        Tk = Tk * (factor * (1 + 1e-4))
+    return Tk
 
 
-def slp(model: Model, J: Array, T: float, budget: int, delta: float) -> Run:
-    """Sequential linear programming with a trust region from the motion ``(J, T)``, which
+def slp(model: Model, J: Array, Tk: Array, budget: int, delta: float) -> Run:
+    """Sequential linear programming with a trust region from the motion ``(J, Tk)``, which
     meets the end conditions (see the module doc)."""
     mesh, S = model.mesh, model.length
     lp = Programme(mesh, S)
-    mo = motion(mesh, J, T, S)
-    T_ref = T
+    mo = motion(mesh, J, Tk, S)
+    T_ref = mo.T
     rows = model.rows(mo)
-    phi = merit(T, T_ref, rows.F, lp.ahead(mo))
+    phi = merit(mo.T, T_ref, rows.F, lp.ahead(mo))
     n = 0
     converged = False
     scale = max(float(np.abs(mo.alpha).max()), 1e-300)
     debug = log.isEnabledFor(logging.DEBUG)
     while n < budget:
-        use = rows.F + lp.reach(rows, delta, scale, mo.T) > -1e-9
+        use = rows.F + lp.reach(rows, mo, delta, scale) > -1e-9
         res = None
         for _ in range(5):  # a row left out and crossed (rounding only) joins
             res = lp.solve(rows, use, mo, T_ref, delta, scale)
             n += 1
             if res.status != 0:
                 break
-            sig, w, al, Tn, eps = lp.states(res.x)
-            lin = rows.linear(sig - mo.sigma, w - mo.w, al - mo.alpha, Tn - mo.T)
-            crossed = ~use & (lin > eps + 1e-9)
+            crossed = ~use & (lp.model(rows, res.x, mo) > res.x[-1] + 1e-9)
             if not crossed.any():
                 break
             log.debug("      %d rows left out crossed", int(crossed.sum()))
@@ -197,29 +282,56 @@ def slp(model: Model, J: Array, T: float, budget: int, delta: float) -> Run:
             if delta < 1e-8:
                 break
             continue
-        sig, w, an, Tn, eps = lp.states(res.x)
-        Jn = np.diff(an) / mesh.h
+        eps = float(res.x[-1])
         pred = phi - res.fun
-        mn = motion(mesh, Jn, Tn, S)
+        mn = lp.motion(res.x, S)
         new = model.rows(mn)
-        phin = merit(Tn, T_ref, new.F, lp.ahead(mn))
+        phin = merit(mn.T, T_ref, new.F, lp.ahead(mn))
         actual = phi - phin
         ratio = actual / pred if pred > 0 else (1.0 if actual >= 0 else -1.0)
-        step = max(float(np.abs(an - mo.alpha).max()) / scale, abs(Tn - T) / (T_SHARE * T))
+        step = max(float(np.abs(mn.alpha - mo.alpha).max()) / scale,
+                   float(np.abs(mn.Tk / mo.Tk - 1.0).max()) / T_SHARE)
         if debug:
+            s4 = res.x[:-1].reshape(-1, 4)
+            lin = lp.model(rows, res.x, mo)
+            bad = int(np.argmax(new.F - lin))
+            log.debug("      projection moved alpha %.2e w %.2e (of %.2e, %.2e); worst model "
+                      "error %.2e at row %d (%s, interval %d of %d, pinned end %s)",
+                      float(np.abs(s4[:, 2] - mn.alpha).max()),
+                      float(np.abs(s4[:, 1] - mn.w).max()), scale, float(mo.w.max()),
+                      float((new.F - lin)[bad]), bad, new.kind_of(bad), int(new.k[bad]), mesh.M,
+                      bool(mesh.pinned[int(new.k[bad]) + 1]))
             i = int(np.argmax(new.F))
             log.debug("    T %.7f eps %.1e max row %.2e (%s) rows %d/%d pred %.1e ratio %.2f "
-                      "delta %.2g iterations %d", Tn, eps, new.F.max(), new.kind_of(i),
+                      "delta %.2g iterations %d", mn.T, eps, new.F.max(), new.kind_of(i),
                       int(use.sum()), len(use), pred, ratio, delta, res.nit)
+        if ratio <= 0.1:  # back along the step: the rows are evaluated, no programme
+            x0 = lp.x0(mo)
+            lin1 = lp.model(rows, res.x, mo)
+            ahead0 = lp.ahead(mo)
+            for part in (0.5, 0.25):
+                mp = lp.motion(x0 + part * (res.x - x0), S)
+                rp = model.rows(mp)
+                php = merit(mp.T, T_ref, rp.F, lp.ahead(mp))
+                model_p = (mo.T + part * (mn.T - mo.T)) / T_ref + PENALTY * max(
+                    0.0, float((rows.F + part * (lin1 - rows.F))[use].max())) - PROGRESS * (
+                    ahead0 + part * (lp.ahead(mn) - ahead0))
+                pp = phi - model_p
+                rp_ratio = (phi - php) / pp if pp > 0 else -1.0
+                log.debug("      back to %.2f of the step: ratio %.2f", part, rp_ratio)
+                if rp_ratio > 0.1:
+                    mn, new, phin, pred, ratio = mp, rp, php, pp, rp_ratio
+                    step *= part
+                    break
         if ratio > 0.1:
-            T_prev, delta_prev = T, delta
-            mo, T, rows, phi = mn, Tn, new, phin
-            if ratio > 0.75 and step > 0.5 * delta:
+            T_prev, delta_prev = mo.T, delta
+            mo, rows, phi = mn, new, phin
+            if ratio > 0.5 and step > 0.5 * delta:
                 delta = min(2 * delta, 2.0)
-            elif ratio < 0.25:
-                delta = 0.5 * delta
+            elif ratio < 0.25 or step < 0.5 * delta_prev:
+                delta = max(0.5 * delta, step)
             if float(rows.F.max()) <= FEAS_TOL and (
-                    pred <= STEP_TOL or (abs(Tn - T_prev) <= STEP_TOL * T
+                    pred <= STEP_TOL or (abs(mo.T - T_prev) <= STEP_TOL * mo.T
                                          and step < 0.5 * delta_prev)):
                 converged = True  # feasible, and T no longer moves within the region
                 break
@@ -227,4 +339,4 @@ def slp(model: Model, J: Array, T: float, budget: int, delta: float) -> Run:
             delta = 0.3 * min(delta, step)
         if delta < 1e-9:
             break
-    return Run(mo.J, mo.T, n, converged, float(rows.F.max()))
+    return Run(mo.J, mo.Tk, n, converged, float(rows.F.max()))

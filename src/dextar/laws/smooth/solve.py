@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Sequence
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -20,10 +20,20 @@ from ..constraints import Constraint, PathDynamics, motor_constraints
 from ..time_optimal import TimeOptimalLaw, solve_time_optimal_law
 from .check import RATE_KINDS, check
 from .law import JerkLimitedLaw
-from .mesh import Mesh, make_mesh
+from .mesh import Mesh, integrate, make_mesh
 from .rows import Model
 from .slp import FEAS_TOL, RESTART_DELTA, START_DELTA, Run, slp, time_scaled
-from .start import filtered, fractions, ramp, start_jerks
+from .start import (
+    CapConstraint,
+    Start,
+    filtered,
+    fractions,
+    pinned,
+    ramp,
+    start_jerks,
+    third_order_cap,
+    without_idle,
+)
 from .table import CachedDynamics, Table, make_table
 
 log = logging.getLogger(__name__)
@@ -42,6 +52,11 @@ MAX_PROGRAMMES = 24
 MAX_REFINE = 3
 MAX_TIGHTEN = 2
 MAX_STRETCH = 6
+#: Rounds of re-timing (a motion with idle time solved again without it).
+MAX_RETIME = 2
+#: Rounds of the start's cap (see :func:`_start`), and the excess over it accepted.
+START_ROUNDS = 4
+START_SLACK = 0.1
 #: Tolerance of the third-order ratios (finite differences) on the check samples.
 RATE_TOL = 1e-2
 #: How the use of each kind of limit falls when a motion is stretched in time (about
@@ -112,41 +127,58 @@ def solve_jerk_limited_law(dynamics: PathDynamics, *, motors: MotorLimits | None
     table = make_table(dynamics, pts)
     base = _second_order(dynamics, table, second, units)
     T2 = float(base.duration)
-    rho = min(ramp(base, table, third), 4.0 * T2)
-    start = filtered(base, rho, length)
-    f, pin_f, pin_s = fractions(start, table, cons, int(segments))
-    mesh = make_mesh(f, pin_f, pin_s)
-    log.debug("joints %s pinned %s at knots %s", table.joints, pin_s, mesh.pins)
-    J, T = start_jerks(start, mesh, length), start.T
+    # the start: the second-order law, slower where the path's own third-order terms
+    # (a blend's curvature changing fast) would use much of their limits at its speeds
+    start = _start(dynamics, table, second, third, base, units)
+    mesh = pinned(fractions(start, table, cons, int(segments)), start, table.joints)
+    log.debug("%d knots; the path's joints at %s, pinned at knots %s", mesh.M + 1,
+              table.joints, mesh.pins)
+    J, Tk = start_jerks(start, mesh, length), np.full(mesh.M, start.T)
     scales = dict.fromkeys((c.kind for c in cons), 1.0)
-    programmes = refined = tightened = stretched = 0
+    programmes = refined = tightened = stretched = retimed = 0
     delta = START_DELTA
+    fresh = True  # a new start: its duration brought within the rows first
+    best: _Round | None = None
     while True:
         model = Model(mesh, table, [c.scaled(scales) for c in second],
                       [c.scaled(scales) for c in third], length)
-        if programmes == 0:
-            T = time_scaled(model, J, T)
-        run = slp(model, J, T, MAX_PROGRAMMES, delta)
+        if fresh:
+            Tk = time_scaled(model, J, Tk)
+            fresh = False
+        run = slp(model, J, Tk, MAX_PROGRAMMES, delta)
         if run.worst > FEAS_TOL:  # the programmes left a limit exceeded: slower instead
-            run = replace(run, T=time_scaled(model, run.J, run.T))
+            run = replace(run, Tk=time_scaled(model, run.J, run.Tk))
         delta = RESTART_DELTA
         programmes += run.programmes
-        J, T = run.J, run.T
+        J, Tk = run.J, run.Tk
         law = _law(run, mesh, length, base)
         ratio, excess = check(dynamics, cons, law, tol, rate_tol)
         bad = excess > 0
         log.debug("check %s bad %d intervals %d T %.9g converged %s",
-                  {k: round(v, 5) for k, v in ratio.items()}, int(bad.sum()), mesh.M, T,
+                  {k: round(v, 5) for k, v in ratio.items()}, int(bad.sum()), mesh.M,
+                  law.duration,
                   run.converged)
         if not bad.any():
-            break
+            if best is None or law.duration < best.law.duration:
+                best = _Round(law, ratio, bad, mesh, run, refined, stretched)
+            again = without_idle(law) if retimed < MAX_RETIME else None
+            if again is None:
+                break
+            # the motion stops somewhere (it reached a pinned knot early) or waits at the
+            # end: again from it with that time cut out and the knots placed anew
+            retimed += 1
+            mesh = pinned(fractions(again, table, cons, int(segments)), again, table.joints)
+            J, Tk = start_jerks(again, mesh, length), np.full(mesh.M, again.T)
+            log.debug("re-timed: %d knots, %.9g s", mesh.M + 1, again.T)
+            fresh, delta, refined = True, START_DELTA, 0
+            continue
         if refined < MAX_REFINE:
             # split the intervals where a limit is exceeded, into as many pieces as bring
             # an excess that falls with the square of the interval to a quarter of its
             # tolerance (the same motion: each piece keeps its interval's jerk)
             refined += 1
             pieces = np.where(bad, np.clip(np.ceil(np.sqrt(4 * excess)), 2, 8), 1).astype(int)
-            mesh, J = _split(mesh, J, pieces, pin_f, pin_s)
+            mesh, J, Tk = _split(mesh, J, Tk, pieces)
             continue
         if tightened < MAX_TIGHTEN:
             tightened += 1
@@ -161,12 +193,15 @@ def solve_jerk_limited_law(dynamics: PathDynamics, *, motors: MotorLimits | None
             stretched += 1
             factor = max((r / (1 + 0.5 * (rate_tol if k in RATE_KINDS else tol)))
                          ** (1 / _POWERS.get(k, 1.0)) for k, r in ratio.items())
-            T *= max(factor, 1.0 + tol)
-            law = _law(replace(run, T=T), mesh, length, base)
+            Tk = Tk * max(factor, 1.0 + tol)
+            law = _law(replace(run, Tk=Tk), mesh, length, base)
             ratio, excess = check(dynamics, cons, law, tol, rate_tol)
             bad = excess > 0
         break
-    return _verdict(law, ratio, bad, scales, mesh, refined, stretched, programmes, run, T2)
+    last = _Round(law, ratio, bad, mesh, run, refined, stretched)
+    if best is not None and (bad.any() or best.law.duration <= law.duration):
+        last = best
+    return _verdict(last, scales, programmes, T2)
 
 
 def _second_order(dynamics: PathDynamics, table: Table, second: Sequence[Constraint],
@@ -189,36 +224,79 @@ def _second_order(dynamics: PathDynamics, table: Table, second: Sequence[Constra
     return solve_time_optimal_law(cached, constraints=second, grid=pts, tol=0.05, units=units)
 
 
-def _split(mesh: Mesh, J: Array, pieces: Array, pin_f: Array, pin_s: Array
-           ) -> tuple[Mesh, Array]:
+def _start(dynamics: PathDynamics, table: Table, second: Sequence[Constraint],
+           third: Sequence[Constraint], base: TimeOptimalLaw, units: Units | None) -> Start:
+    """The start motion: the second-order law filtered (:func:`.start.filtered`); where the
+    path's own third-order terms cap the speed (:func:`.start.third_order_cap`), the
+    second-order law within that cap, and where its filtered version still passes faster
+    (the filter averages the speed over its width, and a steep deceleration into a blend is
+    shorter), the cap lowered there by the excess, a few rounds."""
+    cap = third_order_cap(table, third)
+    ok = np.sqrt(cap)
+    law = base
+    start = None
+    for _ in range(START_ROUNDS):
+        if law is base and not np.any(base.knots_v ** 2 > np.interp(base.knots_s, table.s,
+                                                                    cap)):
+            break  # the cap does not bind: the second-order law as it is
+        law = _second_order(dynamics, table, [*second, CapConstraint(table.s, cap)], units)
+        rho = min(ramp(law, table, third), 4.0 * float(law.duration))
+        start = filtered(law, rho, float(table.s[-1]))
+        over = np.interp(table.s, start.s, start.v) / ok
+        if over.max() <= 1.0 + START_SLACK:
+            return start
+        cap = np.where(over > 1.0, cap / np.maximum(over, 1.0) ** 2, cap)
+    if start is None:
+        rho = min(ramp(law, table, third), 4.0 * float(law.duration))
+        start = filtered(law, rho, float(table.s[-1]))
+    return start
+
+
+def _split(mesh: Mesh, J: Array, Tk: Array, pieces: Array) -> tuple[Mesh, Array, Array]:
     """The mesh with interval ``k`` split into ``pieces[k]`` equal ones, and the same motion
-    (each piece keeps its interval's jerk)."""
+    (each piece keeps its interval's jerk and duration)."""
     h = mesh.h
     many = pieces > 1
     n = pieces[many]
     idx = np.repeat(np.flatnonzero(many), n - 1)
     j = np.concatenate([np.arange(1, m) for m in n]) if n.size else np.zeros(0)
     inner = mesh.f[idx] + h[idx] * j / np.repeat(n, n - 1)
-    return (make_mesh(np.sort(np.concatenate([mesh.f, inner])), pin_f, pin_s),
-            np.repeat(J, pieces))
+    f = np.sort(np.concatenate([mesh.f, inner]))
+    return (make_mesh(f, mesh.f[mesh.pins], mesh.pin_s), np.repeat(J, pieces),
+            np.repeat(Tk, pieces))
 
 
 def _law(run: Run, mesh: Mesh, length: float, base: TimeOptimalLaw) -> JerkLimitedLaw:
     """The law of a run's normalised jerks and duration."""
-    T = run.T
-    a, v, s = mesh.states(run.J)
-    v, a = v / T, a / (T * T)
+    dt = mesh.h * run.Tk
+    jerk = run.J / run.Tk**3
+    a, v, s = integrate(dt, jerk)
+    t = np.concatenate([[0.0], np.cumsum(dt)])
     s[0], v[0], a[0] = 0.0, 0.0, 0.0
     s[-1], v[-1], a[-1] = length, 0.0, 0.0
-    return JerkLimitedLaw(length, float(T), mesh.f * T, s, v, a, run.J / T**3,
+    return JerkLimitedLaw(length, float(t[-1]), t, s, v, a, jerk,
                           base.torque_limit, base.speed_limit, {}, float(base.duration), 0,
                           "", 0)
 
 
-def _verdict(law: JerkLimitedLaw, ratio: dict[str, float], bad: Array,
-             scales: dict[str, float], mesh: Mesh, refined: int, stretched: int,
-             programmes: int, run: Run, T2: float) -> JerkLimitedLaw:
+@dataclass(frozen=True)
+class _Round:
+    """A law the solve found, with its check and how it came."""
+
+    law: JerkLimitedLaw
+    ratio: dict[str, float]
+    bad: Array
+    mesh: Mesh
+    run: Run
+    refined: int
+    stretched: int
+
+
+def _verdict(r: _Round, scales: dict[str, float], programmes: int, T2: float
+             ) -> JerkLimitedLaw:
     """The law with its ratios, status and message."""
+    law, ratio, bad, mesh, run = r.law, r.ratio, r.bad, r.mesh, r.run
+    refined, stretched = r.refined, r.stretched
     ok = not bad.any()
     T = law.duration
     words = ", ".join(f"{k} ratio {r:.5f}" for k, r in ratio.items())

@@ -11,16 +11,23 @@ filters for jerk-limited profiles)."""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from ..._arrays import Array
-from ..constraints import Constraint, JerkLimit, TorqueRateLimit
-from .mesh import Mesh, ends
-from .table import Q1, Q2, Q3, A, B, Table
+from ..base import Law
+from ..constraints import (
+    Constraint,
+    JerkLimit,
+    JointSamples,
+    PathCoefficients,
+    TorqueRateLimit,
+)
+from .mesh import Mesh, make_mesh, projected
+from .table import DB, DG, Q1, Q2, Q3, A, B, Table
 
 
 def jumps(base: Any) -> tuple[Array, Array]:
@@ -44,6 +51,55 @@ def ramp(base: Any, table: Table, third: Sequence[Constraint]) -> float:
             rho = max(rho, float((np.abs(jump)[:, None] * a
                                   / np.asarray(c.max_torque_rate)).max()))
     return rho
+
+
+#: The share of a third-order limit the start's speed cap leaves to the path's terms alone
+#: (the joint jerk ``q''' sdot^3``, the torque rate ``b' sdot^3`` and ``g' sdot``): the rest
+#: is for the motion's acceleration and jerk.
+CAP_SHARE = 0.5
+
+
+def third_order_cap(table: Table, third: Sequence[Constraint]) -> Array:
+    """The squared path speed (N + 1,) at which the path's own terms of a third-order limit
+    (those without the motion's acceleration or jerk: ``q''' sdot^3`` of the joint jerk;
+    ``b' sdot^3`` and ``g' sdot`` of the torque rate) use :data:`CAP_SHARE` of it, at the
+    table's points (``inf`` where none)."""
+    v = np.concatenate([np.abs(table.lo[:1]), np.maximum(np.abs(table.lo[1:]),
+                                                         np.abs(table.hi[:-1])),
+                        np.abs(table.hi[-1:])])
+    cap = np.full(len(v), np.inf)
+    with np.errstate(divide="ignore"):
+        for c in third:
+            if isinstance(c, JerkLimit):
+                lim = CAP_SHARE * np.asarray(c.max_jerk, float)
+                cap = np.minimum(cap, ((lim / v[:, Q3]) ** (2 / 3)).min(axis=1))
+            elif isinstance(c, TorqueRateLimit):
+                lim = CAP_SHARE * np.asarray(c.max_torque_rate, float)
+                cap = np.minimum(cap, ((lim / v[:, DB]) ** (2 / 3)).min(axis=1))
+                cap = np.minimum(cap, ((lim / v[:, DG]) ** 2).min(axis=1))
+    return cap
+
+
+@dataclass(frozen=True, eq=False)
+class CapConstraint(Constraint):
+    """A cap on the squared path speed, given on a grid of arc lengths (the start's
+    third-order cap for the second-order law; never measured: its ratio is 0)."""
+
+    s: Array
+    cap: Array
+    kind: str = "start cap"
+
+    def speed_cap(self, co: PathCoefficients) -> Array:
+        """The cap at the points ``co.s`` (linear between the grid's)."""
+        return np.asarray(np.interp(co.s, self.s, self.cap))
+
+    def sample_ratios(self, js: JointSamples) -> Array:
+        """Nothing is measured: zeros."""
+        return np.zeros(len(js.tau))
+
+    def scaled(self, scales: Mapping[str, float]) -> CapConstraint:
+        """Unchanged."""
+        return self
 
 
 @dataclass(frozen=True)
@@ -79,12 +135,11 @@ def filtered(base: Any, rho: float, length: float, n: int = 4001) -> Start:
 
 
 def fractions(start: Start, table: Table, cons: Sequence[Constraint], segments: int,
-               tol: float = 2e-3) -> tuple[Array, Array, Array]:
+               tol: float = 2e-3) -> Array:
     """The knots' fractions of the duration (M + 1,): at least ``segments`` per duration,
     and where the rows change fast along the start motion as many as keep the rows between
     the points they are imposed at (knots and middles) within about ``tol`` of their values
-    there; a knot at each of the path's joints the start motion passes (moved there: the
-    fractions of those knots and their arc lengths are the second and third results).
+    there.
 
     The monitor is the second time derivative ``c`` of the motion's joint accelerations,
     torques (without friction) and joint jerks from the path's curvature (``q'' v^2``,
@@ -120,29 +175,68 @@ def fractions(start: Start, table: Table, cons: Sequence[Constraint], segments: 
     M = max(segments, int(np.ceil(cdf[-1])))
     f = np.interp(np.linspace(0.0, cdf[-1], M + 1), cdf, t / start.T)
     f[0], f[-1] = 0.0, 1.0
-    # the joints: the nearest inner knot of each moves to where the start passes it
-    joints = table.joints[(table.joints > 0) & (table.joints < s[-1])]
+    return np.asarray(f)
+
+
+def pinned(f: Array, start: Start, joints: Array) -> Mesh:
+    """The mesh of the knots ``f`` with, for each of the path's ``joints`` (arc lengths) the
+    start motion passes, the nearest inner knot moved to where it passes it and pinned there
+    (the path's curvature's derivative jumps at a joint: the jerk may jump at a knot)."""
+    t, s = start.t, start.s
+    f = np.array(f, float)
+    M = len(f) - 1
     pin_f: list[float] = []
     pin_s: list[float] = []
-    for sj in joints:
+    for sj in joints[(joints > 0) & (joints < s[-1])]:
         fj = float(np.interp(sj, s, t)) / start.T
         k = int(np.argmin(np.abs(f - fj)))
-        if 0 < k < M and not any(abs(f[k] - x) < 1e-12 for x in pin_f):
-            lo, hi = f[k - 1], f[k + 1]
-            if lo < fj < hi:
-                f[k] = fj
-                pin_f.append(fj)
-                pin_s.append(float(sj))
-    return np.asarray(f), np.asarray(pin_f, float), np.asarray(pin_s, float)
+        if 0 < k < M and not any(abs(f[k] - x) < 1e-12 for x in pin_f) and \
+                f[k - 1] < fj < f[k + 1]:
+            f[k] = fj
+            pin_f.append(fj)
+            pin_s.append(float(sj))
+    return make_mesh(f, np.asarray(pin_f, float), np.asarray(pin_s, float))
 
 
 def start_jerks(start: Start, mesh: Mesh, length: float) -> Array:
     """The normalised jerks (M,) whose knot accelerations are the start motion's, changed
-    the least to meet the end conditions and the pinned knots exactly."""
+    the least to meet the end conditions and the pinned knots exactly (every interval's
+    duration normalised by the start's)."""
     T, f = start.T, mesh.f
-    ak = np.interp(f * T, start.t, start.a) * T * T
+    ak = np.interp(f * T, start.t, start.a)
     ak[0] = ak[-1] = 0.0
-    J = np.diff(ak) / np.diff(f)
-    E, e = ends(mesh, length)
-    miss = E @ J - e
-    return np.asarray(J - E.T @ np.linalg.lstsq(E @ E.T, miss, rcond=None)[0])
+    Tk = np.full(mesh.M, T)
+    j = projected(mesh, np.diff(ak) / (mesh.h * T), Tk, length)
+    return np.asarray(j * T**3)
+
+
+#: A motion is idle where its speed and acceleration stay below these fractions of their
+#: largest (it barely moves: a stop before a pinned knot the motion reached early, a wait at
+#: the end) for at least :data:`IDLE_SPAN` of the duration; the re-timing removes that time.
+IDLE_SPEED = 0.02
+IDLE_ACCEL = 0.05
+IDLE_SPAN = 0.03
+
+
+def without_idle(law: Law, n: int = 4001) -> Start | None:
+    """The law sampled on ``n`` times with its idle spans cut out (the motion before and
+    after each span joined: the states there differ by the little it moves while idle), as
+    a start motion; None when it has no idle span."""
+    T = float(law.duration)
+    t = np.linspace(0.0, T, n)
+    s, v, a = law.evaluate(t)[:3]
+    still = (np.abs(v) <= IDLE_SPEED * np.abs(v).max()) & \
+        (np.abs(a) <= IDLE_ACCEL * np.abs(a).max())
+    # runs of still samples, long enough
+    edges = np.diff(np.concatenate([[0], still.astype(int), [0]]))
+    first, last = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1
+    long = (t[last] - t[first]) >= IDLE_SPAN * T
+    if not long.any():
+        return None
+    cut = np.zeros(n - 1, bool)  # the sample pairs whose time is removed
+    for i0, i1 in zip(first[long], last[long], strict=True):
+        cut[i0:i1] = True
+    dt = np.where(cut, 0.0, np.diff(t))
+    keep = np.concatenate([[True], ~cut])
+    tn = np.concatenate([[0.0], np.cumsum(dt)])[keep]
+    return Start(tn, s[keep], v[keep], a[keep])

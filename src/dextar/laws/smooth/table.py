@@ -55,42 +55,87 @@ class Table:
                                 co.coulomb_speed)
 
 
+#: The table's grid is refined until every column's linear interpolation is within this
+#: fraction of the column's largest value at the segments' middles (the rows' coefficients,
+#: and so the limits' use, to about this much), in at most :data:`TABLE_ROUNDS` rounds.
+TABLE_TOL = 2e-4
+TABLE_ROUNDS = 4
+#: The step of the derivatives along the path (a fraction of the path's length): a central
+#: difference of the dynamics' own coefficients, or one-sided at a joint (truncation about
+#: the step times the next derivative, far below the interpolation's).
+DERIVATIVE_STEP = 1e-7
+#: A grid point is a joint (pieces of a path meet there, the curvature's derivative jumps)
+#: where a column's one-sided derivatives differ by more than this fraction of its largest.
+JOINT_JUMP = 1e-3
+
+
 def make_table(dynamics: PathDynamics, s: Array) -> Table:
-    """The table of the dynamics' coefficients at the arc lengths ``s`` (N + 1,)."""
-    co = dynamics.coefficients(s)
-    values = np.concatenate([co.dq_ds, co.ddq_ds, co.ddq_ds, co.a, co.b, co.g, co.a, co.b,
-                             co.g], axis=1)
-    lo, hi = values[:-1].copy(), values[1:].copy()
-    d = np.r_[4:6, 12:18]  # the columns that are derivatives of others
-    dlo, dhi, joints = derivative(co.s, values[:, d])
-    lo[:, d], hi[:, d] = dlo, dhi
-    return Table(co, lo, hi, co.s[joints])
+    """The table of the dynamics' coefficients from the grid ``s`` (N + 1,) of arc lengths,
+    refined where a column's linear interpolation misses its value at a segment's middle by
+    more than :data:`TABLE_TOL` of its largest (a blend's dynamics change over a fraction of
+    a millimetre). The derivatives along the path (of ``q''``, ``a``, ``b``, ``g``) are
+    differences of the dynamics' coefficients a short step apart, one-sided at the joints
+    (both sides kept: the segment before a joint ends with its left derivative, the one
+    after starts with its right one)."""
+    s = np.asarray(s, float)
+    length = float(s[-1])
+    for _ in range(TABLE_ROUNDS):
+        co, lo, hi, joint = _columns(dynamics, s, length)
+        mid = 0.5 * (s[1:] + s[:-1])
+        m = _columns(dynamics, mid, length, central_only=True)[1]
+        scale = np.abs(np.concatenate([lo, hi])).max(axis=0) + 1e-300
+        err = (np.abs(m - 0.5 * (lo + hi)) / scale).max(axis=1)
+        bad = err > TABLE_TOL
+        if not bad.any():
+            break
+        pieces = np.where(bad, np.clip(np.ceil(np.sqrt(err / TABLE_TOL)), 2, 8), 1)
+        s = _split(s, pieces.astype(int))
+    else:
+        co, lo, hi, joint = _columns(dynamics, s, length)
+    return Table(co, lo, hi, co.s[joint])
 
 
-def derivative(s: Array, v: Array) -> tuple[Array, Array, Array]:
-    """The derivative along the path of ``v`` (N + 1, p) at both ends of every segment (two
-    arrays (N, p)): central differences at the grid's points, one-sided where the derivative
-    jumps (where pieces of a path join, their curvature's derivative jumps: a jump of the
-    segments' slopes far above their neighbours'), and those points (indices)."""
-    ds = np.diff(s)[:, None]
-    slope = np.diff(v, axis=0) / ds  # (N, p), each segment's
-    n = len(slope)
-    central = np.asarray(np.gradient(v, s, axis=0))
-    left, right = central[:-1].copy(), central[1:].copy()  # at each segment's two ends
-    if n < 5:
-        return left, right, np.zeros(0, int)
-    jump = np.abs(np.diff(slope, axis=0))  # (N - 1, p) at the inner points 1..N-1
-    scale = np.abs(slope).max(axis=0) + 1e-300
-    zero = np.zeros_like(jump[:1])
-    near = np.maximum(np.concatenate([zero, jump[:-1]]), np.concatenate([jump[1:], zero]))
-    joint = (jump > 4 * near) & (jump > 1e-3 * scale)
-    k, c = np.nonzero(joint)
-    pk = k + 1  # the grid point
-    ok = (pk >= 2) & (pk <= n - 2)  # one-sided slopes need two segments on each side
-    pk, c = pk[ok], c[ok]
-    left[pk, c] = 1.5 * slope[pk, c] - 0.5 * slope[pk + 1, c]
-    right[pk - 1, c] = 1.5 * slope[pk - 1, c] - 0.5 * slope[pk - 2, c]
-    return left, right, np.unique(pk)
+def _split(s: Array, pieces: Array) -> Array:
+    """The grid with segment ``k`` split into ``pieces[k]`` equal ones."""
+    many = pieces > 1
+    n = pieces[many]
+    k = np.repeat(np.flatnonzero(many), n - 1)
+    j = np.concatenate([np.arange(1, v) for v in n])
+    return np.sort(np.concatenate([s, s[k] + (s[k + 1] - s[k]) * j / np.repeat(n, n - 1)]))
+
+
+def _columns(dynamics: PathDynamics, s: Array, length: float, central_only: bool = False
+             ) -> tuple[PathCoefficients, Array, Array, Array]:
+    """The coefficients at ``s`` (N + 1,), and the table's columns (see :class:`Table`) at
+    the starts and the ends of the segments (two arrays (N, 18)) and the joints (indices);
+    with ``central_only``, the columns at the points themselves (N + 1, 18), twice."""
+    step = DERIVATIVE_STEP * length
+    left, right = np.maximum(s - step, 0.0), np.minimum(s + step, length)
+    co, cl, cr = (dynamics.coefficients(x) for x in (s, left, right))
+
+    def base(c: PathCoefficients) -> Array:  # the columns with derivatives
+        return np.concatenate([c.ddq_ds, c.a, c.b, c.g], axis=1)
+
+    f0, fl, fr = base(co), base(cl), base(cr)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        dl = np.where((s > left)[:, None], (f0 - fl) / (s - left)[:, None], np.nan)
+        dr = np.where((right > s)[:, None], (fr - f0) / (right - s)[:, None], np.nan)
+    dl = np.where(np.isnan(dl), dr, dl)  # (at the path's ends, the one side there is)
+    dr = np.where(np.isnan(dr), dl, dr)
+    central = 0.5 * (dl + dr)
+
+    def table(d: Array) -> Array:
+        return np.concatenate([co.dq_ds, co.ddq_ds, d[:, :2], co.a, co.b, co.g, d[:, 2:]],
+                              axis=1)
+
+    if central_only:
+        return co, table(central), table(central), np.zeros(0, int)
+    scale = np.abs(central).max(axis=0) + 1e-300
+    joint = (np.abs(dr - dl) > JOINT_JUMP * scale).any(axis=1)
+    joint[[0, -1]] = False
+    after = np.where(joint[:, None], dr, central)
+    before = np.where(joint[:, None], dl, central)
+    return co, table(after)[:-1], table(before)[1:], np.flatnonzero(joint)
 
 
 def interp(grid: Array, values: Array, s: Array) -> tuple[Array, Array]:
