@@ -123,29 +123,29 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9,
     hasl = np.isfinite(lo) & free
     k = np.arange(M)
     # the variables of each row and equality (x numbering), and their band positions
-    xi = (D * rk)[:, None] + ROW_X[None, :]
-    xi_flat = xi.reshape(-1)
+    xr = D * rk  # each row's first variable
     exi = (D * k)[:, None] + np.arange(2 * D)[None, :]
     exi_flat = np.repeat(exi[:, None, :], Q, axis=1).reshape(-1)
-    bpos = (BLOCK * rk)[:, None] + ROW_POS[None, :]
+    base = BLOCK * rk  # each row's first band position
     xband = ((BLOCK * np.arange(K))[:, None] + np.arange(D)[None, :]).reshape(-1)
     yband = ((BLOCK * k)[:, None] + D + np.arange(Q)[None, :]).reshape(-1)
     # the matrix's columns of fixed variables are empty (their steps are zero)
-    ram = ra * free[xi]
-    rgm = rg * free[None, nk:]
     Em = E * free[exi][:, None, :]
-    # band storage for dgbtrf: A[i, j] at ab[KL + KU + i - j, j]
+    # the fixed variables' rows of the matrix are those of the identity (their steps are
+    # zero, so what their columns hold does not matter): the band's entries to clear
+    fpos = xband[np.flatnonzero(fixed[:nk])]
+    cols = fpos[:, None] + np.arange(-KU, KL + 1)[None, :]
+    ok = (cols >= 0) & (cols < nb)
+    # band storage for dgbtrf: A[i, j] at ab[KL + KU + i - j, j], ab in Fortran order (so
+    # that LAPACK takes it as it is): flat index j * nrow + KL + KU + i - j
     nrow = 2 * KL + KU + 1
-    ii, jj = np.repeat(bpos, NR, axis=1), np.tile(bpos, (1, NR))
-    flat_rows = ((KL + KU + ii - jj) * nb + jj).reshape(-1)
-    ei = np.repeat(yband.reshape(M, Q)[:, :, None], 2 * D, axis=2)
-    ej = np.repeat(((BLOCK * k)[:, None] + EQ_POS[None, :])[:, None, :], Q, axis=1)
-    static = np.bincount(np.concatenate([((KL + KU + ei - ej) * nb + ej).reshape(-1),
-                                         ((KL + KU + ej - ei) * nb + ei).reshape(-1)]),
-                         np.concatenate([Em.reshape(-1), Em.reshape(-1)]),
-                         minlength=nrow * nb)
-    static[(KL + KU) * nb + yband] -= REG
-    diag_x = (KL + KU) * nb + xband
+    clear = (cols * nrow + KL + KU + fpos[:, None] - cols)[ok]
+    # the rows' terms of the matrix, by pairs of their variables (a <= b): each pair's sum
+    # over the rows of an interval lands on one diagonal of the band
+    pairs = [(a, b) for a in range(NR) for b in range(a, NR)
+             if ra[:, a].any() and ra[:, b].any()]
+    diag_x = xband * nrow + KL + KU
+    diag_y = yband * nrow + KL + KU
 
     iu, il = np.flatnonzero(hasu), np.flatnonzero(hasl)
     nu, nl = len(iu), len(il)
@@ -157,14 +157,17 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9,
 
     def G(x: Array) -> Array:
         """Every inequality's ``g . x``."""
-        return np.concatenate([np.einsum("ij,ij->i", ra, x[xi]) + rg @ x[nk:],
-                               sgn * x[bnd]])
+        out = rg @ x[nk:]
+        for a in range(NR):
+            out += ra[:, a] * x[xr + ROW_X[a]]
+        return np.concatenate([out, sgn * x[bnd]])
 
     def GT(z: Array) -> Array:
         """``sum z g`` over the inequalities (fixed variables' entries zero)."""
-        out = np.empty(nx)
+        out = np.zeros(nx)
         zr = z[:R]
-        out[:nk] = np.bincount(xi_flat, (ra * zr[:, None]).reshape(-1), minlength=nk)
+        for a in range(NR):
+            out[ROW_X[a]:nk] += np.bincount(xr, ra[:, a] * zr, minlength=nk)[:nk - ROW_X[a]]
         out[nk:] = rg.T @ zr
         out += np.bincount(bnd, sgn * z[R:], minlength=nx)
         out[fixed] = 0.0
@@ -208,14 +211,33 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9,
         Dz = z / sl
         diag = np.full(nx, REG) + np.bincount(bnd, Dz[R:], minlength=nx)
         diag[fixed] = 1.0
-        w = Dz[:R, None] * ram
-        ab = static + np.bincount(flat_rows, (w[:, :, None] * ram[:, None, :]).reshape(-1),
-                                  minlength=nrow * nb)
+        Dr = Dz[:R]
+        ab = np.zeros(nrow * nb)
+        abT = ab.reshape(nb, nrow)  # abT[j, KL + KU + i - j] = A[i, j]
+        for q in range(Q):  # the equalities and their transposes, interval by interval
+            i = D + q
+            for a in range(2 * D):
+                j = EQ_POS[a]
+                abT[j:nb - BLOCK + j + 1:BLOCK, KL + KU + i - j] += Em[:, q, a]
+                abT[i:nb - BLOCK + i + 1:BLOCK, KL + KU + j - i] += Em[:, q, a]
+        ab[diag_y] -= REG
+        for a, b in pairs:
+            add = np.bincount(base, Dr * ra[:, a] * ra[:, b], minlength=nb)
+            i, j = ROW_POS[a], ROW_POS[b]
+            abT[j:, KL + KU + i - j] += add[:nb - j]
+            if a != b:
+                abT[i:, KL + KU + j - i] += add[:nb - i]
+        ab[clear] = 0.0
         ab[diag_x] += diag[:nk]
-        U = np.stack([np.bincount(bpos.reshape(-1), (w * rgm[:, p:p + 1]).reshape(-1),
-                                  minlength=nb) for p in range(P)], axis=1)
-        corner = (rgm * Dz[:R, None]).T @ rgm + np.diag(diag[nk:])
-        lu, piv, info = lapack.dgbtrf(ab.reshape(nrow, nb), KL, KU)
+        U = np.zeros((nb, P))
+        for p in range(P):
+            drg = Dr * rg[:, p]
+            for a in range(NR):
+                U[ROW_POS[a]:, p] += np.bincount(base, drg * ra[:, a],
+                                                 minlength=nb)[:nb - ROW_POS[a]]
+        U[fpos] = 0.0
+        corner = (rg * Dr[:, None]).T @ rg + np.diag(diag[nk:])
+        lu, piv, info = lapack.dgbtrf(abT.T, KL, KU, overwrite_ab=1)
         if info != 0:
             status = 2
             break

@@ -21,6 +21,10 @@ from ..constraints import (
 from .mesh import Mesh, Motion, knot_T
 from .table import DA, DB, DG, Q1, Q2, Q3, A, B, Table, interp
 
+#: Intervals whose rows are built at once (the temporaries of a block are a few hundred
+#: bytes a row).
+CHUNK = 2048
+
 
 @dataclass(frozen=True)
 class Rows:
@@ -37,7 +41,8 @@ class Rows:
     F: Array
     k: Array
     C: Array
-    norm: Array
+    norm: Array  # float32
+    sizes: Array  # (R, 5) float32: |d/d sigma|, |d/d w|, |d/d alpha|, |d/d J|, |d/d T|
     kinds: tuple[tuple[str, int], ...] = ()  # (what, how many) per block (development)
 
     def kind_of(self, i: int) -> str:
@@ -71,11 +76,13 @@ def local(h: Array, k: Array, theta: Array, gs: Array, gw: Array, ga: Array, gj:
     """A row's gradient ``C`` (n, 5) in its interval's ``sigma_k, w_k, alpha_k``, end
     acceleration and duration ``T_k`` (all in the interval's normalisation) from its
     derivatives in the point's ``sigma, w, alpha``, the interval's jerk ``J`` and ``T_k``
-    (each (n,)), the point ``theta`` into the interval ``k``."""
+    (each (n,)), the point ``theta`` into the interval ``k``; then those derivatives'
+    sizes (n, 5), for the bound of the row's change in a trust region."""
     cJ = gs * theta**3 / 6 + gw * theta**2 / 2 + ga * theta + gj
     ca = gs * theta**2 / 2 + gw * theta + ga
     hk = h[k]
-    return np.stack([gs, gs * theta + gw, ca - cJ / hk, cJ / hk, gT], axis=1)
+    return np.stack([gs, gs * theta + gw, ca - cJ / hk, cJ / hk, gT, np.abs(gs), np.abs(gw),
+                     np.abs(ga), np.abs(gj), np.abs(gT)], axis=1)
 
 
 class Model:
@@ -90,9 +97,8 @@ class Model:
         # the points of the second-order rows: the inner knots and every interval's middle
         self.k2 = np.concatenate([k[1:], k])
         self.t2 = np.concatenate([np.zeros(M - 1), h / 2])
-        # the third-order rows: every interval at its start, middle and end
-        self.t3 = (np.zeros(M), h / 2, h)
         cap = speed_cap(second, table.co)
+        self._grad = True
         self.root_cap = (None if not np.isfinite(cap).any()
                          else np.sqrt(np.where(np.isfinite(cap), cap, 1e300)))
 
@@ -104,18 +110,46 @@ class Model:
         x0 = np.interp(self.table.s, mo.sigma, x)
         return np.asarray(np.maximum(x0, 1e-4 * float(x0.max()) + 1e-300))
 
-    def rows(self, mo: Motion) -> Rows:
-        """All rows at the motion, normalised by their limits (at its durations)."""
-        mesh, tab, S = self.mesh, self.table, self.length
-        h = mesh.h
+    def rows(self, mo: Motion, gradients: bool = True) -> Rows:
+        """All rows at the motion, normalised by their limits (at its durations), built
+        :data:`CHUNK` intervals at a time (their temporaries bounded); without
+        ``gradients``, their values only (``C`` and ``sizes`` empty)."""
+        self._grad = gradients
         x0 = self.tangent(mo)
+        tab = self.table
         pr = point_rows(self.second, Tangent(tab.moving, np.concatenate([x0[:1], x0,
                                                                            x0[-1:]])))
         pr = PointRows(pr.pu[1:-1], pr.px[1:-1], pr.ph[1:-1])
-        m = pr.pu.shape[1]
-        k, th = self.k2, self.t2
-        sig, w, al = mo.at(mesh, k, th)
         finite = np.isfinite(pr.ph)
+        phmax = float(np.abs(np.where(finite, pr.ph, 0.0)).max(initial=0.0))
+        parts = [self._block(mo, pr, finite, phmax, k0, min(k0 + CHUNK, self.mesh.M))
+                 for k0 in range(0, self.mesh.M, CHUNK)]
+        if len(parts) == 1:
+            return parts[0]
+        return Rows(np.concatenate([r.F for r in parts]), np.concatenate([r.k for r in parts]),
+                    np.concatenate([r.C for r in parts]),
+                    np.concatenate([r.norm for r in parts]),
+                    np.concatenate([r.sizes for r in parts]),
+                    tuple(kind for r in parts for kind in r.kinds))
+
+    def _loc(self, h: Array, k: Array, theta: Array, gs: Array, gw: Array, ga: Array,
+             gj: Array, gT: Array, keep: Array | None = None) -> Array:
+        """:func:`local` of the rows (those ``keep`` selects), or nothing when the rows are
+        built without their gradients."""
+        if not self._grad:
+            return np.zeros((0, 10))
+        out = local(h, k, theta, gs, gw, ga, gj, gT)
+        return out if keep is None else out[keep]
+
+    def _block(self, mo: Motion, pr: PointRows, finite: Array, phmax: float, k0: int,
+               k1: int) -> Rows:
+        """The rows of the intervals ``k0`` to ``k1`` (excluded)."""
+        mesh, tab, S = self.mesh, self.table, self.length
+        h = mesh.h
+        m = pr.pu.shape[1]
+        in2 = (self.k2 >= k0) & (self.k2 < k1)
+        k, th = self.k2[in2], self.t2[in2]
+        sig, w, al = mo.at(mesh, k, th)
         vals, slopes = interp(tab.s, np.concatenate([pr.pu, pr.px, np.where(finite, pr.ph,
                                                                              0.0)], axis=1),
                                sig)
@@ -123,7 +157,7 @@ class Model:
         dpu, dpx, dph = slopes[:, :m], slopes[:, m:2 * m], slopes[:, 2 * m:]
         keep = (interp(tab.s, finite.astype(float), sig)[0] > 1 - 1e-12).reshape(-1)
         a_, w_, T = al[:, None], w[:, None], mo.Tk[k][:, None]
-        c = np.maximum(np.abs(ph), 1e-9 * float(np.abs(ph).max()) + 1e-300) * T * T
+        c = np.maximum(np.abs(ph), 1e-9 * phmax + 1e-300) * T * T
         F = (pu * a_ + px * w_ * w_ - ph * T * T) / c
         kk, tt = np.repeat(k, m), np.repeat(th, m)
         zero = np.zeros(len(kk))
@@ -131,8 +165,9 @@ class Model:
         def flat(v: Array) -> Array:
             return np.asarray(v.reshape(-1))
 
-        Cs = [local(h, kk, tt, flat((dpu * a_ + dpx * w_ * w_ - dph * T * T) / c),
-                    flat(2 * px * w_ / c), flat(pu / c), zero, flat(-2 * ph * T / c))[keep]]
+        Cs = [self._loc(h, kk, tt, flat((dpu * a_ + dpx * w_ * w_ - dph * T * T) / c),
+                        flat(2 * px * w_ / c), flat(pu / c), zero, flat(-2 * ph * T / c),
+                        keep)]
         norms = [flat(np.broadcast_to(c, F.shape))[keep]]
         Fs, ks, names = [flat(F)[keep]], [kk[keep]], ["second-order"]
         n2 = len(k)
@@ -143,19 +178,20 @@ class Model:
             c2 = np.maximum(rv, 1e-300) * T
             Fc = (w - rv * T) / c2
             Fs.append(Fc)
-            Cs.append(local(h, k, th, -rs * T / c2, 1.0 / c2, np.zeros(n2), np.zeros(n2),
-                            -rv / c2))
+            Cs.append(self._loc(h, k, th, -rs * T / c2, 1.0 / c2, np.zeros(n2),
+                                np.zeros(n2), -rv / c2))
             norms.append(c2)
             ks.append(k)
             names.append("cap")
         Fs.append(-w / S)  # the speed stays >= 0
         norms.append(np.full(n2, S))
-        Cs.append(local(h, k, th, np.zeros(n2), np.full(n2, -1.0 / S), np.zeros(n2),
-                         np.zeros(n2), np.zeros(n2)))
+        Cs.append(self._loc(h, k, th, np.zeros(n2), np.full(n2, -1.0 / S), np.zeros(n2),
+                            np.zeros(n2), np.zeros(n2)))
         ks.append(k)
         names.append("w>=0")
-        kM = np.arange(mesh.M)
-        for th3, before in zip(self.t3, (False, False, True), strict=True):
+        kM = np.arange(k0, k1)
+        for th3, before in zip((np.zeros(k1 - k0), h[kM] / 2, h[kM]), (False, False, True),
+                               strict=True):
             sig, w, al = mo.at(mesh, kM, th3)
             v, d = tab.at(sig, before)
             F3, C3, k3, n3 = self._third_at(mo, kM, th3, v, d, w, al)
@@ -164,8 +200,11 @@ class Model:
             Cs.append(C3)
             ks.append(k3)
             names.append("third")
-        return Rows(np.concatenate(Fs), np.concatenate(ks), np.concatenate(Cs),
-                    np.concatenate(norms),
+        C = np.concatenate([c[:, :5] for c in Cs])
+        sizes = np.concatenate([c[:, 5:].astype(np.float32) for c in Cs])
+        del Cs
+        return Rows(np.concatenate(Fs), np.concatenate(ks).astype(np.int32), C,
+                    np.concatenate(norms).astype(np.float32), sizes,
                     tuple((n, len(f)) for n, f in zip(names, Fs, strict=True)))
 
     def _third_at(self, mo: Motion, k: Array, theta: Array, v: Array, d: Array, w: Array,
@@ -219,10 +258,10 @@ class Model:
                 Fs.append(((sign * val - scale) / scale).reshape(-1))
                 Ns.append(np.broadcast_to(scale, val.shape).reshape(-1))
                 g_s, g_w, g_a, g_j = ((sign * x / scale).reshape(-1) for x in (gs, gw, ga, gj))
-                Cs.append(local(h, kk, tt, g_s, g_w, g_a, g_j,
-                                ((sign * gT - 3 * lim * T * T) / scale).reshape(-1)))
+                Cs.append(self._loc(h, kk, tt, g_s, g_w, g_a, g_j,
+                                    ((sign * gT - 3 * lim * T * T) / scale).reshape(-1)))
         if not Fs:
-            return np.zeros(0), np.zeros((0, 5)), np.zeros(0, int), np.zeros(0)
+            return np.zeros(0), np.zeros((0, 10)), np.zeros(0, int), np.zeros(0)
         n = len(Fs)
         return (np.concatenate(Fs), np.concatenate(Cs), np.tile(np.repeat(k, 2), n),
                 np.concatenate(Ns))

@@ -107,21 +107,26 @@ class Programme:
         self.c[4:4 * M:4] = -PROGRESS / ((M - 1) * length)  # the reward for being ahead
         self.c[-1] = PENALTY
         # how far the arc lengths and speeds can move per unit change of the accelerations:
-        # their integrals from the nearer end
-        g = np.minimum(mesh.f, 1.0 - mesh.f)[:-1]
+        # their integrals from the nearer end (at any point of the interval)
+        g = np.minimum(mesh.f[:-1], 1.0 - mesh.f[1:]) + h
         self.reach_sw = np.stack([g * g / 2, g], axis=1)
 
     def ahead(self, mo: Motion) -> float:
         """The mean of the inner knots' arc lengths over the path's length."""
         return float(mo.sigma[1:self.M].sum()) / ((self.M - 1) * self.length)
 
-    def reach(self, rows: Rows, mo: Motion, delta: float, scale: float) -> Array:
-        """The largest change of each row's linear model within the trust region."""
-        C, k = np.abs(rows.C), rows.k
+    def reach(self, rows: Rows, mo: Motion, delta: float, scale: float, jscale: float
+              ) -> Array:
+        """The largest change of each row's linear model within the trust region: the
+        accelerations within ``delta * scale`` (so the speeds and arc lengths within their
+        integrals), the jerks within ``delta * jscale``, the durations within
+        ``T_SHARE * delta`` (relative; at a pinned knot the end acceleration with them)."""
+        G, k = rows.sizes, rows.k
         d, dT = delta * scale, T_SHARE * delta
-        return np.asarray(d * (C[:, 0] * self.reach_sw[k, 0] + C[:, 1] * self.reach_sw[k, 1]
-                               + C[:, 2] + C[:, 3])
-                          + dT * (C[:, 4] * mo.Tk[k] + 4 * C[:, 3] * np.abs(mo.alpha_end[k])))
+        return np.asarray(d * (G[:, 0] * self.reach_sw[k, 0] + G[:, 1] * self.reach_sw[k, 1]
+                               + G[:, 2]) + delta * jscale * G[:, 3]
+                          + dT * (G[:, 4] * mo.Tk[k] + 4 * np.abs(rows.C[:, 3] * mo.alpha_end[k])
+                                  * self.into_pin[k]))
 
     def _end_terms(self, mo: Motion) -> tuple[Array, Array, Array, Array, Array, Array]:
         """The linearised end states of every interval in its own normalisation:
@@ -135,13 +140,18 @@ class Programme:
         ca = np.where(pin, 2 * rho * rho * mo.alpha[1:], 0.0)
         return rho, rho * rho, cw, ca, Tn[:-1], Tn[1:]
 
-    def _local(self, C: Array, k: Array, mo: Motion) -> Array:
+    def _local(self, C: Array, k: Array, mo: Motion, out: Array | None = None) -> Array:
         """The rows' coefficients (n, 6) on ``sigma_k, w_k, alpha_k, T_k, alpha_k+1,
-        T_k+1`` from their gradients ``C`` (n, 5) in the interval's own states."""
+        T_k+1`` from their gradients ``C`` (n, 5) in the interval's own states (into
+        ``out`` when given)."""
         _, r2, _, ca, T0, T1 = self._end_terms(mo)
+        out = np.empty((len(k), 6)) if out is None else out
         c3 = C[:, 3]
-        return np.stack([C[:, 0], C[:, 1], C[:, 2], C[:, 4] + c3 * ca[k] / T0[k],
-                         c3 * r2[k], -c3 * ca[k] / T1[k]], axis=1)
+        out[:, :3] = C[:, :3]
+        out[:, 3] = C[:, 4] + c3 * (ca / T0)[k]
+        out[:, 4] = c3 * r2[k]
+        out[:, 5] = -c3 * (ca / T1)[k]
+        return out
 
     def x0(self, mo: Motion) -> Array:
         """The motion as the programme's variables."""
@@ -149,22 +159,46 @@ class Programme:
                                         axis=1).reshape(-1), [0.0]])
 
     def solve(self, rows: Rows, use: Array, mo: Motion, T_ref: float, delta: float,
-              scale: float) -> LPResult:
+              scale: float, jscale: float) -> LPResult:
         """The programme on the rows ``use`` (a mask) about the motion ``mo``, within the
         trust region: the accelerations within ``delta * scale`` of the motion's, the
         durations within ``T_SHARE * delta`` (relative) of theirs."""
         M, mesh = self.M, self.mesh
         sel = np.flatnonzero(use)
-        k = rows.k[sel]
-        ra = self._local(rows.C[sel], k, mo)
+        R = len(sel)
+        pin = self.into_pin
+        kp, kj = np.flatnonzero(pin), np.flatnonzero(~pin)
+        n = R + 2 * len(kp) + 2 * len(kj)
+        k = np.empty(n, np.int64)
+        ra = np.zeros((n, 6))
+        rb = np.empty(n)
+        rg = np.zeros((n, 1))
+        k[:R] = rows.k[sel]
+        self._local(rows.C[sel], k[:R], mo, ra[:R])
         x0 = self.x0(mo)
-        xk = x0[:-1].reshape(-1, 4)
-        local = np.concatenate([xk[k], xk[k + 1, 2:]], axis=1)
-        rb = np.einsum("ij,ij->i", ra, local) - rows.F[sel]
+        rb[:R] = -rows.F[sel]
+        for j, off in enumerate((0, 1, 2, 3, 6, 7)):
+            rb[:R] += ra[:R, j] * x0[4 * k[:R] + off]
+        rg[:R] = -1.0
+        # the stretches' durations relative to each other change less than the whole: the
+        # jerk of the short interval into a pinned knot changes with the square of their
+        # ratio over the interval's length
+        _, _, _, _, T0, T1 = self._end_terms(mo)
+        i = R + np.arange(len(kp))
+        k[i], k[i + len(kp)] = kp, kp
+        ra[i, 3], ra[i, 5] = 1.0 / T0[kp], -1.0 / T1[kp]
+        ra[i + len(kp)] = -ra[i]
+        rb[i], rb[i + len(kp)] = RHO_SHARE * delta, RHO_SHARE * delta
+        # the jerks within delta * jscale of theirs (inside a stretch)
+        i = R + 2 * len(kp) + np.arange(len(kj))
+        k[i], k[i + len(kj)] = kj, kj
+        ra[i, 2], ra[i, 4] = -1.0 / mesh.h[kj], 1.0 / mesh.h[kj]
+        ra[i + len(kj)] = -ra[i]
+        jb = delta * jscale
+        rb[i], rb[i + len(kj)] = mo.J[kj] + jb, jb - mo.J[kj]
         # the integration into a pinned knot, linearised in the durations
         rho, r2, cw, ca, T0, T1 = self._end_terms(mo)
         E = self.E.copy()
-        pin = self.into_pin
         h = mesh.h[pin]
         E[pin, 0, 5] = rho[pin]
         E[pin, 0, 6] = -h / 2 * r2[pin]
@@ -186,16 +220,6 @@ class Programme:
         hi[:, 3] = Tn * (1 + T_SHARE * delta)
         c = self.c.copy()
         c[3:4 * M:4] = mesh.h / T_ref
-        # the stretches' durations relative to each other change less than the whole: the
-        # jerk of the short interval into a pinned knot changes with the square of their
-        # ratio over the interval's length
-        kp = np.flatnonzero(pin)
-        tr = np.zeros((len(kp), 6))
-        tr[:, 3], tr[:, 5] = 1.0 / T0[kp], -1.0 / T1[kp]
-        k = np.concatenate([k, kp, kp])
-        ra = np.concatenate([ra, tr, -tr])
-        rg = np.concatenate([-np.ones(len(sel)), np.zeros(2 * len(kp))])[:, None]
-        rb = np.concatenate([rb, np.full(2 * len(kp), RHO_SHARE * delta)])
         lp = StagedLP(c, k, ra, rg, rb, E, np.zeros((M, 3)),
                       np.concatenate([lo.reshape(-1), [0.0]]),
                       np.concatenate([hi.reshape(-1), [np.inf]]))
@@ -203,11 +227,13 @@ class Programme:
 
     def model(self, rows: Rows, x: Array, mo: Motion) -> Array:
         """Every row's linear model at the programme's variables ``x``."""
-        ra = self._local(rows.C, rows.k, mo)
+        _, r2, _, ca, T0, T1 = self._end_terms(mo)
         d = (x[:-1] - self.x0(mo)[:-1]).reshape(-1, 4)
-        k = rows.k
-        return np.asarray(rows.F + np.einsum("ij,ij->i", ra,
-                                             np.concatenate([d[k], d[k + 1, 2:]], axis=1)))
+        k, C = rows.k, rows.C
+        c3 = C[:, 3]
+        return np.asarray(rows.F + C[:, 0] * d[k, 0] + C[:, 1] * d[k, 1] + C[:, 2] * d[k, 2]
+                          + (C[:, 4] + c3 * (ca / T0)[k]) * d[k, 3]
+                          + c3 * (r2[k] * d[k + 1, 2] - (ca / T1)[k] * d[k + 1, 3]))
 
     def motion(self, x: Array, length: float) -> Motion:
         """The motion of a programme's solution: its accelerations and durations, the jerks
@@ -232,7 +258,7 @@ def time_scaled(model: Model, J: Array, Tk: Array) -> Array:
     (gravity or friction rows that scale more slowly)."""
     Tk = np.asarray(Tk, float)
     for _ in range(40):
-        rows = model.rows(motion(model.mesh, J, Tk, model.length))
+        rows = model.rows(motion(model.mesh, J, Tk, model.length), gradients=False)
         i = int(np.argmax(rows.F))
         worst = float(rows.F[i])
         p = rows.powers()
@@ -261,12 +287,13 @@ def slp(model: Model, J: Array, Tk: Array, budget: int, delta: float) -> Run:
     n = 0
     converged = False
     scale = max(float(np.abs(mo.alpha).max()), 1e-300)
+    jscale = max(float(np.abs(mo.J).max()), 1e-300)
     debug = log.isEnabledFor(logging.DEBUG)
     while n < budget:
-        use = rows.F + lp.reach(rows, mo, delta, scale) > -1e-9
+        use = rows.F + lp.reach(rows, mo, delta, scale, jscale) > -1e-9
         res = None
         for _ in range(5):  # a row left out and crossed (rounding only) joins
-            res = lp.solve(rows, use, mo, T_ref, delta, scale)
+            res = lp.solve(rows, use, mo, T_ref, delta, scale, jscale)
             n += 1
             if res.status != 0:
                 break
@@ -285,22 +312,13 @@ def slp(model: Model, J: Array, Tk: Array, budget: int, delta: float) -> Run:
         eps = float(res.x[-1])
         pred = phi - res.fun
         mn = lp.motion(res.x, S)
-        new = model.rows(mn)
+        new = model.rows(mn, gradients=False)  # (with them once the step is taken)
         phin = merit(mn.T, T_ref, new.F, lp.ahead(mn))
         actual = phi - phin
         ratio = actual / pred if pred > 0 else (1.0 if actual >= 0 else -1.0)
         step = max(float(np.abs(mn.alpha - mo.alpha).max()) / scale,
                    float(np.abs(mn.Tk / mo.Tk - 1.0).max()) / T_SHARE)
         if debug:
-            s4 = res.x[:-1].reshape(-1, 4)
-            lin = lp.model(rows, res.x, mo)
-            bad = int(np.argmax(new.F - lin))
-            log.debug("      projection moved alpha %.2e w %.2e (of %.2e, %.2e); worst model "
-                      "error %.2e at row %d (%s, interval %d of %d, pinned end %s)",
-                      float(np.abs(s4[:, 2] - mn.alpha).max()),
-                      float(np.abs(s4[:, 1] - mn.w).max()), scale, float(mo.w.max()),
-                      float((new.F - lin)[bad]), bad, new.kind_of(bad), int(new.k[bad]), mesh.M,
-                      bool(mesh.pinned[int(new.k[bad]) + 1]))
             i = int(np.argmax(new.F))
             log.debug("    T %.7f eps %.1e max row %.2e (%s) rows %d/%d pred %.1e ratio %.2f "
                       "delta %.2g iterations %d", mn.T, eps, new.F.max(), new.kind_of(i),
@@ -311,7 +329,7 @@ def slp(model: Model, J: Array, Tk: Array, budget: int, delta: float) -> Run:
             ahead0 = lp.ahead(mo)
             for part in (0.5, 0.25):
                 mp = lp.motion(x0 + part * (res.x - x0), S)
-                rp = model.rows(mp)
+                rp = model.rows(mp, gradients=False)
                 php = merit(mp.T, T_ref, rp.F, lp.ahead(mp))
                 model_p = (mo.T + part * (mn.T - mo.T)) / T_ref + PENALTY * max(
                     0.0, float((rows.F + part * (lin1 - rows.F))[use].max())) - PROGRESS * (
@@ -325,7 +343,8 @@ def slp(model: Model, J: Array, Tk: Array, budget: int, delta: float) -> Run:
                     break
         if ratio > 0.1:
             T_prev, delta_prev = mo.T, delta
-            mo, rows, phi = mn, new, phin
+            del rows
+            mo, rows, phi = mn, model.rows(mn), phin
             if ratio > 0.5 and step > 0.5 * delta:
                 delta = min(2 * delta, 2.0)
             elif ratio < 0.25 or step < 0.5 * delta_prev:

@@ -1,0 +1,111 @@
+"""The jerk-limited law on blended programs (issue 29): the example's eight moves and a
+longer chain plan within the limits, checked on the written setpoints by finite differences;
+a slower motion is found where holding still fits the torque limits, and where it does not
+the error quotes the user's limit."""
+
+import json
+
+import numpy as np
+import pytest
+
+from dextar.cli import main
+
+from ..program.test_drive_limits import check_limits, columns
+from ..program.test_program import EXAMPLES
+
+JMAX, PEAK = 3000.0, 1.5
+#: The example's program with its moves replaced (a longer chain: eight blended lines).
+ZIGZAG = "".join(f'[[move]]\ntype = "line"\nto = [{x:.1f}, {y:.1f}]\nblend = 8.0\n'
+                 for x, y in [(-60, 160), (-20, 200), (20, 160), (60, 200), (20, 240),
+                              (-20, 200), (-60, 240)]) + \
+    '[[move]]\ntype = "line"\nto = [-60.0, 200.0]\n'
+
+
+def plan(tmp_path, text, name="p"):
+    cfg = tmp_path / f"{name}.toml"
+    cfg.write_text(text)
+    out = tmp_path / name
+    code = main(["program", "--no-figures", str(cfg), "--out", str(out), "--quiet"])
+    return code, out
+
+
+@pytest.fixture(scope="module")
+def example(tmp_path_factory):
+    d = tmp_path_factory.mktemp("jpp")
+    code, out = plan(d, (EXAMPLES / "jerk_pick_place.toml").read_text())
+    assert code == 0
+    return out
+
+
+def test_the_example_plans_within_its_limits_on_every_setpoint(example):
+    """Eight moves (lines blended within 8 mm, dwells, an arc through a via point) with
+    ``max_jerk = 3000``: the joint jerk by finite differences of the written accelerations
+    within 1 + 1e-2 of the limit and at it somewhere, the torques within 1 + 1e-3 of the
+    peak, every motion from rest to rest with zero acceleration."""
+    sp = columns(example / "setpoints.csv")
+    s = json.loads((example / "summary.json").read_text())
+    check_limits(sp, np.inf, JMAX, PEAK, np.inf, s["moves"])
+    assert s["status"] == "fits"
+    laws = [m for m in s["moves"] if m["law"] == "time-optimal"]
+    assert len(laws) == 6 and all(m["law_status"] == 0 for m in laws)
+    assert all("jerk-limited" in m["law_message"] for m in laws)
+
+
+def test_a_longer_chain_plans_within_its_limits(tmp_path):
+    """Eight lines blended into one motion (seven blends)."""
+    text = (EXAMPLES / "jerk_pick_place.toml").read_text()
+    head = text[:text.index("[[move]]")].replace("start = [-60.0, 200.0]",
+                                                 "start = [-60.0, 200.0]")
+    code, out = plan(tmp_path, head + ZIGZAG, "zigzag")
+    assert code in (0, 1)  # (1: the RMS rating, not the law)
+    s = json.loads((out / "summary.json").read_text())
+    assert all(m["law_status"] == 0 for m in s["moves"] if m["law"])
+    check_limits(columns(out / "setpoints.csv"), np.inf, JMAX, PEAK, np.inf, s["moves"])
+
+
+def holding_program(peak):
+    """The example's first move with the motors' peak torque set to ``peak``."""
+    text = (EXAMPLES / "jerk_pick_place.toml").read_text()
+    head = text[:text.index("[[move]]")]
+    head = head.replace("peak_torque = 1.5 ", f"peak_torque = {peak} ").replace(
+        "rms_torque = 0.6 ", f"rms_torque = {peak} ")
+    return head + '[[move]]\ntype = "line"\nto = [-60.0, 160.0]\nblend = 8.0\n' \
+        '[[move]]\ntype = "line"\nto = [60.0, 160.0]\n'
+
+
+@pytest.fixture(scope="module")
+def holding():
+    """The largest torque holding the robot still needs along the example's first moves
+    (gravity alone: no friction in the example), N m."""
+    from dextar.config import load_scenario
+    from dextar.dynamics import gravity_torques
+    from dextar.kinematics import inverse_kinematics
+
+    sc = load_scenario(str(EXAMPLES / "jerk_pick_place.toml"))
+    pts = np.concatenate([np.stack([np.full(50, -0.06), np.linspace(0.2, 0.16, 50)], -1),
+                          np.stack([np.linspace(-0.06, 0.06, 50), np.full(50, 0.16)], -1)])
+    q = inverse_kinematics(sc.si_model.robot, pts, "+-")
+    return float(np.abs(gravity_torques(sc.si_model, q)).max())
+
+
+def test_a_slower_motion_where_holding_still_barely_fits(tmp_path, capsys, holding):
+    """Peak torque 15 % above what holding still needs (a blended chain): a motion is
+    planned within it (the search once ended in a false "no motion" from its coarse start
+    grid, quoting a limit it had tightened itself)."""
+    peak = round(1.15 * holding, 4)
+    code, out = plan(tmp_path, holding_program(peak), "slow")
+    assert code == 0, capsys.readouterr().err
+    sp = columns(out / "setpoints.csv")
+    s = json.loads((out / "summary.json").read_text())
+    check_limits(sp, np.inf, JMAX, peak, np.inf, s["moves"])
+
+
+def test_no_motion_where_holding_still_does_not_fit_names_the_users_limit(tmp_path, capsys,
+                                                                          holding):
+    """Peak torque 5 % below what holding still needs: exit 2, the error naming the motor,
+    the torque needed and the user's own limit in N m."""
+    peak = round(0.95 * holding, 4)
+    code, _ = plan(tmp_path, holding_program(peak), "hold")
+    err = capsys.readouterr().err
+    assert code == 2
+    assert "no motion within the limits" in err and f"{peak:.4g} N m" in err
