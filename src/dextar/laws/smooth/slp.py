@@ -53,7 +53,7 @@ PROGRESS = 1e-4
 #: was below ``STEP_TOL``, or which moved ``T`` by less than ``STEP_TOL`` (relative) from
 #: inside the trust region. Near the solution the SLP converges fast (the programmes'
 #: solutions are near vertices), so the next step would be far smaller still.
-STEP_TOL = 2e-5
+STEP_TOL = 1e-4
 FEAS_TOL = 1e-4
 
 
@@ -345,7 +345,7 @@ def slp(model: Model, J: Array, Tk: Array, budget: int, delta: float) -> Run:
             T_prev, delta_prev = mo.T, delta
             del rows
             mo, rows, phi = mn, model.rows(mn), phin
-            if ratio > 0.5 and step > 0.5 * delta:
+            if ratio > 0.75 and step > 0.5 * delta:
                 delta = min(2 * delta, 2.0)
             elif ratio < 0.25 or step < 0.5 * delta_prev:
                 delta = max(0.5 * delta, step)

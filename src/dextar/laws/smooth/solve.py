@@ -45,8 +45,11 @@ SEGMENTS = 32
 #: start motion, which the programmes improve; the whole grid where the coarse one finds no
 #: motion, e.g. a blend narrower than its segments).
 START_GRID = 40
-#: Greatest number of linear programmes of one SLP run.
+#: Greatest number of linear programmes of one SLP run, and of a run that can be followed by
+#: a re-timing (a motion far from the answer, on knots placed for its start, moves slowly:
+#: placed anew for the motion reached, the programmes go faster).
 MAX_PROGRAMMES = 24
+FIRST_PROGRAMMES = 8
 #: Rounds of refinement after the output check, then of tightening, then of stretching the
 #: motion in time (a slower motion, never a false "no motion").
 MAX_REFINE = 3
@@ -145,7 +148,8 @@ def solve_jerk_limited_law(dynamics: PathDynamics, *, motors: MotorLimits | None
         if fresh:
             Tk = time_scaled(model, J, Tk)
             fresh = False
-        run = slp(model, J, Tk, MAX_PROGRAMMES, delta)
+        run = slp(model, J, Tk, MAX_PROGRAMMES if retimed == MAX_RETIME else FIRST_PROGRAMMES,
+                  delta)
         if run.worst > FEAS_TOL:  # the programmes left a limit exceeded: slower instead
             run = replace(run, Tk=time_scaled(model, run.J, run.Tk))
         delta = RESTART_DELTA
@@ -161,11 +165,13 @@ def solve_jerk_limited_law(dynamics: PathDynamics, *, motors: MotorLimits | None
         if not bad.any():
             if best is None or law.duration < best.law.duration:
                 best = _Round(law, ratio, bad, mesh, run, refined, stretched)
-            again = without_idle(law) if retimed < MAX_RETIME else None
+            again = (without_idle(law, always=not run.converged) if retimed < MAX_RETIME
+                     else None)
             if again is None:
                 break
             # the motion stops somewhere (it reached a pinned knot early) or waits at the
-            # end: again from it with that time cut out and the knots placed anew
+            # end, or the programmes had not settled: again from it, with that time cut out
+            # and the knots placed anew (denser where its rows change fast)
             retimed += 1
             mesh = pinned(fractions(again, table, cons, int(segments)), again, table.joints)
             J, Tk = start_jerks(again, mesh, length), np.full(mesh.M, again.T)

@@ -218,10 +218,11 @@ IDLE_ACCEL = 0.05
 IDLE_SPAN = 0.03
 
 
-def without_idle(law: Law, n: int = 4001) -> Start | None:
+def without_idle(law: Law, n: int = 4001, always: bool = False) -> Start | None:
     """The law sampled on ``n`` times with its idle spans cut out (the motion before and
     after each span joined: the states there differ by the little it moves while idle), as
-    a start motion; None when it has no idle span."""
+    a start motion; None when it has no idle span (unless ``always``: then the law
+    sampled)."""
     T = float(law.duration)
     t = np.linspace(0.0, T, n)
     s, v, a = law.evaluate(t)[:3]
@@ -232,7 +233,7 @@ def without_idle(law: Law, n: int = 4001) -> Start | None:
     first, last = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1
     long = (t[last] - t[first]) >= IDLE_SPAN * T
     if not long.any():
-        return None
+        return Start(t, s, v, a) if always else None
     cut = np.zeros(n - 1, bool)  # the sample pairs whose time is removed
     for i0, i1 in zip(first[long], last[long], strict=True):
         cut[i0:i1] = True
