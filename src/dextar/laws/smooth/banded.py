@@ -8,7 +8,7 @@ penalty); every inequality row couples the states of one interval (knots ``k`` a
 ``k + 1``) with the border, every equality (``Q = 3`` per interval: the exact integration,
 the duration's continuity) the states of one interval. In the Newton system of the
 interior-point method, with the variables of each knot followed by the multipliers of its
-interval's equalities, the matrix is a band of half-width ``2 D + Q - 1 = 10`` bordered by
+interval's equalities, the matrix is a band of half-width 8 bordered by
 ``P`` dense columns: one LU factorisation of the band (LAPACK ``dgbtrf``) and a ``P x P``
 Schur complement solve it in ``O(M)``.
 
@@ -42,16 +42,20 @@ from ..._arrays import Array
 D, Q, P = 4, 3, 1
 #: Band positions per knot (its states, then its interval's equalities).
 BLOCK = D + Q
+#: Each state's band position in its knot's block (``alpha, T`` first: a row couples the
+#: interval's states with the next knot's ``alpha, T``, so the band is narrowest so).
+PERM = np.array([2, 3, 0, 1])
 #: A row's variables relative to its interval's first knot: sigma_k, w_k, alpha_k, T_k,
 #: alpha_k+1 and T_k+1 (the rows of the transcription do not involve sigma_k+1 or w_k+1),
 #: as indices of x and as band positions.
 ROW_X = np.array([0, 1, 2, 3, D + 2, D + 3])
-ROW_POS = np.array([0, 1, 2, 3, BLOCK + 2, BLOCK + 3])
+ROW_POS = np.concatenate([PERM, BLOCK + PERM[2:]])
 NR = len(ROW_POS)
 #: An equality's band positions: the states of both knots of its interval.
-EQ_POS = np.concatenate([np.arange(D), BLOCK + np.arange(D)])
-#: The band's half-widths (below and above the diagonal).
-KL = KU = 2 * D + Q - 1
+EQ_POS = np.concatenate([PERM, BLOCK + PERM])
+#: The band's half-widths (below and above the diagonal): 8.
+KL = KU = max(int(ROW_POS.max() - ROW_POS.min()),
+              int(np.abs(EQ_POS[:, None] - (D + np.arange(Q))[None, :]).max()))
 #: Regularisation of the Newton matrix (primal +, dual -): far below the barrier terms.
 REG = 1e-11
 #: Fraction of the step to the boundary.
@@ -132,7 +136,7 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
     exi = (D * k)[:, None] + np.arange(2 * D)[None, :]
     exi_flat = np.repeat(exi[:, None, :], Q, axis=1).reshape(-1)
     base = BLOCK * rk  # each row's first band position
-    xband = ((BLOCK * np.arange(K))[:, None] + np.arange(D)[None, :]).reshape(-1)
+    xband = ((BLOCK * np.arange(K))[:, None] + PERM[None, :]).reshape(-1)
     yband = ((BLOCK * k)[:, None] + D + np.arange(Q)[None, :]).reshape(-1)
     # the matrix's columns of fixed variables are empty (their steps are zero)
     Em = E * free[exi][:, None, :]
@@ -303,7 +307,8 @@ class _Newton:
         full[self.xband] = rhs[:nk]
         full[self.yband] = -self.re
         sb = lapack.dgbtrs(self.lu, KL, KU, full[:, None], self.piv)[0][:, 0]
-        dp = np.linalg.solve(self.schur, rhs[nk:] - self.U.T @ sb)
+        r = rhs[nk:] - self.U.T @ sb
+        dp = r / self.schur[0, 0] if P == 1 else np.linalg.solve(self.schur, r)
         db = sb - self.BU @ dp
         dx = np.concatenate([db[self.xband], dp])
         dx[self.fixed] = 0.0
@@ -313,5 +318,5 @@ class _Newton:
 
 def _to_bound(v: Array, dv: Array) -> float:
     """The largest step ``a`` with ``v + a dv >= 0`` (``inf`` when none is limited)."""
-    neg = dv < 0
-    return float((-v[neg] / dv[neg]).min(initial=np.inf))
+    with np.errstate(divide="ignore"):
+        return float(np.min(np.where(dv < 0, -v / dv, np.inf), initial=np.inf))

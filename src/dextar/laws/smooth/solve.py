@@ -50,6 +50,8 @@ START_GRID = 40
 #: placed anew for the motion reached, the programmes go faster).
 MAX_PROGRAMMES = 24
 FIRST_PROGRAMMES = 8
+#: The knots' density: the rows between them within about this of their values there.
+KNOT_TOL = 5e-3
 #: Rounds of refinement after the output check, then of tightening, then of stretching the
 #: motion in time (a slower motion, never a false "no motion").
 MAX_REFINE = 3
@@ -133,7 +135,7 @@ def solve_jerk_limited_law(dynamics: PathDynamics, *, motors: MotorLimits | None
     # the start: the second-order law, slower where the path's own third-order terms
     # (a blend's curvature changing fast) would use much of their limits at its speeds
     start = _start(dynamics, table, second, third, base, units)
-    mesh = pinned(fractions(start, table, cons, int(segments)), start, table.joints)
+    mesh = pinned(fractions(start, table, cons, int(segments), KNOT_TOL), start, table.joints)
     log.debug("%d knots; the path's joints at %s, pinned at knots %s", mesh.M + 1,
               table.joints, mesh.pins)
     J, Tk = start_jerks(start, mesh, length), np.full(mesh.M, start.T)
@@ -173,7 +175,8 @@ def solve_jerk_limited_law(dynamics: PathDynamics, *, motors: MotorLimits | None
             # end, or the programmes had not settled: again from it, with that time cut out
             # and the knots placed anew (denser where its rows change fast)
             retimed += 1
-            mesh = pinned(fractions(again, table, cons, int(segments)), again, table.joints)
+            mesh = pinned(fractions(again, table, cons, int(segments), KNOT_TOL), again,
+                          table.joints)
             J, Tk = start_jerks(again, mesh, length), np.full(mesh.M, again.T)
             log.debug("re-timed: %d knots, %.9g s", mesh.M + 1, again.T)
             fresh, delta, refined = True, START_DELTA, 0
