@@ -41,7 +41,7 @@ class Rows:
     F: Array
     k: Array
     C: Array
-    norm: Array  # float32
+    norm: Array
     sizes: Array  # (R, 5) float32: |d/d sigma|, |d/d w|, |d/d alpha|, |d/d J|, |d/d T|
     kinds: tuple[tuple[str, int], ...] = ()  # (what, how many) per block (development)
 
@@ -204,7 +204,7 @@ class Model:
         sizes = np.concatenate([c[:, 5:].astype(np.float32) for c in Cs])
         del Cs
         return Rows(np.concatenate(Fs), np.concatenate(ks).astype(np.int32), C,
-                    np.concatenate(norms).astype(np.float32), sizes,
+                    np.concatenate(norms), sizes,
                     tuple((n, len(f)) for n, f in zip(names, Fs, strict=True)))
 
     def _third_at(self, mo: Motion, k: Array, theta: Array, v: Array, d: Array, w: Array,
