@@ -227,3 +227,43 @@ def test_limits_tightened_for_the_grid_never_make_a_false_no_motion(chain, monke
     law = time_optimal.solve_time_optimal_law(dyn, torque_limit=(1.5, 1.5), grid=12,
                                               tol=1e-6)
     assert law.status == 1 and "limits exceeded" in law.message
+
+
+class _Parabola:
+    """A torque ratio ``peak - c (t - t0)^2`` on motor A, at least 0.5 (a sharp bend, as the
+    envelope's near the speed limit), counting the calls."""
+
+    def __init__(self, peak, t0, c):
+        self.peak, self.t0, self.c, self.calls = peak, t0, c, 0
+
+    def samples(self, law, times):
+        from dextar.laws.constraints import JointSamples
+
+        self.calls += 1
+        r = np.maximum(self.peak - self.c * (times - self.t0) ** 2, 0.5)
+        tau = np.stack([r, np.zeros_like(times)], -1)
+        return JointSamples(tau, np.zeros_like(tau), np.zeros_like(tau), times)
+
+
+@pytest.mark.parametrize("peak, found", [(1.004, True), (0.9995, False)])
+def test_the_check_finds_a_peak_between_its_samples(peak, found):
+    """A ratio peaking halfway between two check samples, 0.999 at both: 1.004 at its peak
+    is found (the interval sampled more finely, its ratio to 1e-4, the interval marked for
+    refinement), 0.9995 is not an excess (and no finer sampling: one call). The samples alone
+    read 0.999 in both cases."""
+    from types import SimpleNamespace
+
+    from dextar.laws.constraints import TorqueLimit
+    from dextar.laws.smooth import check
+
+    knots = np.linspace(0.0, 1.0, 5)
+    h = 0.25 / (check.CHECK_PER_INTERVAL - 1)  # the samples' spacing
+    t0 = 0.5 + 3.5 * h  # halfway between two samples of the third interval
+    dyn = _Parabola(peak, t0, (peak - 0.999) / (h / 2) ** 2)
+    ratio, excess = check.check(dyn, [TorqueLimit((1.0, 1.0))], SimpleNamespace(knots_t=knots),
+                                1e-3, 1e-2)
+    if found:
+        assert ratio["torque"] == pytest.approx(peak, abs=1e-4)
+        assert np.flatnonzero(excess).tolist() == [2] and dyn.calls == 2
+    else:
+        assert ratio["torque"] <= 0.9995 and not excess.any() and dyn.calls == 1
