@@ -33,7 +33,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import sparse
 from scipy.linalg import lapack
 
 from ..._arrays import Array
@@ -135,8 +134,12 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
     # the variables of each row and equality (x numbering), and their band positions
     xr = D * rk  # each row's first variable
     exi = (D * k)[:, None] + np.arange(2 * D)[None, :]
+    exi_flat = np.repeat(exi[:, None, :], Q, axis=1).reshape(-1)
+    base = BLOCK * rk  # each row's first band position
     xband = ((BLOCK * np.arange(K))[:, None] + PERM[None, :]).reshape(-1)
     yband = ((BLOCK * k)[:, None] + D + np.arange(Q)[None, :]).reshape(-1)
+    # the matrix's columns of fixed variables are empty (their steps are zero)
+    Em = E * free[exi][:, None, :]
     # the fixed variables' rows of the matrix are those of the identity (their steps are
     # zero, so what their columns hold does not matter): the band's entries to clear
     fpos = xband[np.flatnonzero(fixed[:nk])]
@@ -146,72 +149,46 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
     # that LAPACK takes it as it is): flat index j * nrow + KL + KU + i - j
     nrow = 2 * KL + KU + 1
     clear = (cols * nrow + KL + KU + fpos[:, None] - cols)[ok]
-    diag_x = xband * nrow + KL + KU
-    diag_y = yband * nrow + KL + KU
-    # the equalities' part of the matrix, the same at every iteration (the columns of fixed
-    # variables empty: their steps are zero)
-    Em = E * free[exi][:, None, :]
-    ab_eq = np.zeros(nrow * nb)
-    abT = ab_eq.reshape(nb, nrow)  # abT[j, KL + KU + i - j] = A[i, j]
-    for q in range(Q):  # the equalities and their transposes, interval by interval
-        i = D + q
-        for a in range(2 * D):
-            j = EQ_POS[a]
-            abT[j:nb - BLOCK + j + 1:BLOCK, KL + KU + i - j] += Em[:, q, a]
-            abT[i:nb - BLOCK + i + 1:BLOCK, KL + KU + j - i] += Em[:, q, a]
-    ab_eq[diag_y] -= REG
     # the rows' terms of the matrix, by pairs of their variables (a <= b): each pair's sum
-    # over the rows of an interval lands on one diagonal of the band (one bincount for all
-    # pairs: interval by pair)
+    # over the rows of an interval lands on one diagonal of the band
     pairs = [(a, b) for a in range(NR) for b in range(a, NR)
              if ra[:, a].any() and ra[:, b].any()]
-    npairs = len(pairs)
-    pa, pb = (np.array([p[i] for p in pairs], int) for i in (0, 1))
-    products = ra[:, pa] * ra[:, pb]  # (R, pairs)
-    at_pair = (rk[:, None] * npairs + np.arange(npairs)[None, :]).reshape(-1)
-    # where each interval's sum of a pair lands in the band, and its mirror (an interval's
-    # last knot is the next one's first: a position may take two sums)
-    dst, src = [], []
-    for p, (a, b) in enumerate(pairs):
-        for i, j in ((ROW_POS[a], ROW_POS[b]), (ROW_POS[b], ROW_POS[a]))[:1 + (a != b)]:
-            dst.append((BLOCK * k + j) * nrow + KL + KU + i - j)
-            src.append(k * npairs + p)
-    to_band, from_sums = np.concatenate(dst), np.concatenate(src)
+    diag_x = xband * nrow + KL + KU
+    diag_y = yband * nrow + KL + KU
 
     iu, il = np.flatnonzero(hasu), np.flatnonzero(hasl)
     nu, nl = len(iu), len(il)
     m_all = R + nu + nl
-    # every inequality as g . x <= h: the rows, then x <= hi, then -x <= -lo (sparse)
+    # every inequality as g . x <= h: the rows, then x <= hi, then -x <= -lo
     h_all = np.concatenate([rb, hi[iu], -lo[il]])
     bnd = np.concatenate([iu, il])
     sgn = np.concatenate([np.ones(nu), -np.ones(nl)])
-    A = sparse.csr_matrix(
-        (np.concatenate([ra.reshape(-1), rg.reshape(-1), sgn]),
-         (np.concatenate([np.repeat(np.arange(R), NR), np.repeat(np.arange(R), P),
-                          R + np.arange(nu + nl)]),
-          np.concatenate([(xr[:, None] + ROW_X[None, :]).reshape(-1),
-                          np.tile(nk + np.arange(P), R), bnd]))), shape=(m_all, nx))
-    AT = A.T.tocsr()
-    Es = sparse.csr_matrix((E.reshape(-1), (np.repeat(np.arange(Q * M), 2 * D),
-                                            np.repeat(exi, Q, axis=0).reshape(-1))),
-                           shape=(Q * M, nx))
-    EsT = Es.T.tocsr()
 
     def G(x: Array) -> Array:
         """Every inequality's ``g . x``."""
-        return np.asarray(A @ x)
+        out = rg @ x[nk:]
+        for a in range(NR):
+            out += ra[:, a] * x[xr + ROW_X[a]]
+        return np.concatenate([out, sgn * x[bnd]])
 
     def GT(z: Array) -> Array:
         """``sum z g`` over the inequalities (fixed variables' entries zero)."""
-        out = np.asarray(AT @ z)
+        out = np.zeros(nx)
+        zr = z[:R]
+        for a in range(NR):
+            out[ROW_X[a]:nk] += np.bincount(xr, ra[:, a] * zr, minlength=nk)[:nk - ROW_X[a]]
+        out[nk:] = rg.T @ zr
+        out += np.bincount(bnd, sgn * z[R:], minlength=nx)
         out[fixed] = 0.0
         return out
 
     def Ex(x: Array) -> Array:
-        return np.asarray(Es @ x - e)
+        return np.asarray(np.einsum("kqj,kj->kq", E, x[exi]).reshape(-1) - e)
 
     def ETy(y: Array) -> Array:
-        out = np.asarray(EsT @ y)
+        out = np.zeros(nx)
+        out[:nk] = np.bincount(exi_flat, (E * y.reshape(M, Q)[:, :, None]).reshape(-1),
+                               minlength=nk)
         out[fixed] = 0.0
         return out
 
@@ -248,19 +225,32 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
         diag = np.full(nx, REG) + np.bincount(bnd, Dz[R:], minlength=nx)
         diag[fixed] = 1.0
         Dr = Dz[:R]
-        ab = ab_eq.copy()
-        sums = np.bincount(at_pair, (products * Dr[:, None]).reshape(-1),
-                           minlength=M * npairs)
-        ab += np.bincount(to_band, sums[from_sums], minlength=nrow * nb)
+        ab = np.zeros(nrow * nb)
+        abT = ab.reshape(nb, nrow)  # abT[j, KL + KU + i - j] = A[i, j]
+        for q in range(Q):  # the equalities and their transposes, interval by interval
+            i = D + q
+            for a in range(2 * D):
+                j = EQ_POS[a]
+                abT[j:nb - BLOCK + j + 1:BLOCK, KL + KU + i - j] += Em[:, q, a]
+                abT[i:nb - BLOCK + i + 1:BLOCK, KL + KU + j - i] += Em[:, q, a]
+        ab[diag_y] -= REG
+        for a, b in pairs:
+            add = np.bincount(base, Dr * ra[:, a] * ra[:, b], minlength=nb)
+            i, j = ROW_POS[a], ROW_POS[b]
+            abT[j:, KL + KU + i - j] += add[:nb - j]
+            if a != b:
+                abT[i:, KL + KU + j - i] += add[:nb - i]
         ab[clear] = 0.0
         ab[diag_x] += diag[:nk]
-        # the border's columns: the rows' terms with the border variables
         U = np.zeros((nb, P))
         for p in range(P):
-            U[xband, p] = GT(np.concatenate([Dr * rg[:, p], np.zeros(nu + nl)]))[:nk]
+            drg = Dr * rg[:, p]
+            for a in range(NR):
+                U[ROW_POS[a]:, p] += np.bincount(base, drg * ra[:, a],
+                                                 minlength=nb)[:nb - ROW_POS[a]]
         U[fpos] = 0.0
         corner = (rg * Dr[:, None]).T @ rg + np.diag(diag[nk:])
-        lu, piv, info = lapack.dgbtrf(ab.reshape(nb, nrow).T, KL, KU, overwrite_ab=1)
+        lu, piv, info = lapack.dgbtrf(abT.T, KL, KU, overwrite_ab=1)
         if info != 0:
             status = 2
             break
@@ -328,5 +318,5 @@ class _Newton:
 
 def _to_bound(v: Array, dv: Array) -> float:
     """The largest step ``a`` with ``v + a dv >= 0`` (``inf`` when none is limited)."""
-    neg = dv < 0
-    return float(np.min(-v[neg] / dv[neg], initial=np.inf))
+    with np.errstate(divide="ignore"):
+        return float(np.min(np.where(dv < 0, -v / dv, np.inf), initial=np.inf))
