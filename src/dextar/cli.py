@@ -8,22 +8,28 @@ from __future__ import annotations
 
 import argparse
 import atexit
-import importlib
 import json
 import os
 import signal
 import sys
 import threading
 import warnings
-from collections.abc import Sequence
-from types import ModuleType
-from typing import Any, NoReturn
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Any, NoReturn
 
-from . import __version__
+from . import __version__, config
+from ._lazy import lazy_module
 from .commands import COMMANDS
 from .commands.base import Result
 from .errors import DextarError
 from .geometry import MODE_ALIASES
+
+if TYPE_CHECKING:  # the registries, imported when a help that lists them is shown
+    from . import laws, paths, program
+else:
+    laws = lazy_module("dextar.laws")
+    paths = lazy_module("dextar.paths")
+    program = lazy_module("dextar.program")
 
 #: A working mode's alias (``--mode --`` is read as the alias ``mm``).
 _ALIAS_OF = {v: k for k, v in MODE_ALIASES.items()}
@@ -49,40 +55,30 @@ class _Parser(argparse.ArgumentParser):
 
 def registries_help() -> str:
     """The registered config tables, move types, path types and laws."""
-    from .config import TABLES
-    from .laws import LAW_TYPES
-    from .paths import PATH_TYPES
-    from .program import MOVE_TYPES
-
-    def listing(reg: dict[str, Any]) -> str:
+    def listing(reg: Mapping[str, Any]) -> str:
         return "\n".join(f"  {k:<14} {v.help}" for k, v in reg.items())
 
-    return (f"config tables: {', '.join(f'[{t}]' for t in TABLES)}\n"
-            f"[path].type:\n{listing(PATH_TYPES)}\n[law].type:\n{listing(LAW_TYPES)}\n"
-            f"[[move]] type:\n{listing(MOVE_TYPES)}")
-
-
-def _command(name: str) -> ModuleType:
-    return importlib.import_module(f".commands.{name}", __package__)
+    return (f"config tables: {', '.join(f'[{t}]' for t in config.TABLES)}\n"
+            f"[path].type:\n{listing(paths.PATH_TYPES)}\n[law].type:\n"
+            f"{listing(laws.LAW_TYPES)}\n[[move]] type:\n{listing(program.MOVE_TYPES)}")
 
 
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:
-    """The argument parser of every command (with ``only``, a command's name: every command
-    is listed, and only that one's arguments are added: what parsing its command line
-    needs, at a tenth of the cost)."""
+    """The argument parser of every registered command (with ``only``, a command's name:
+    every command is listed, and only that one's arguments are added: what parsing its
+    command line needs, at a tenth of the cost)."""
     p = _Parser(prog="dextar", description="Five-bar (DexTAR) robot toolkit. Lengths in mm, "
                 "angles in degrees on the command line.")
     p.add_argument("--version", action="version", version=f"dextar {__version__}")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
     p.set_defaults(parsers={})
-    for name in COMMANDS:
-        mod = _command(name)
-        sp = sub.add_parser(mod.NAME, help=mod.HELP, description=mod.HELP)
-        sp.registries = getattr(mod, "REGISTRIES_HELP", False)
-        if only is None or only == mod.NAME:
-            mod.add_arguments(sp)
-        p.get_default("parsers")[mod.NAME] = sp
-        sp.set_defaults(run=mod.run)
+    for name, cmd in COMMANDS.items():
+        sp = sub.add_parser(name, help=cmd.help, description=cmd.help)
+        sp.registries = cmd.registries_help
+        if only is None or only == name:
+            cmd.add_arguments(sp)
+        p.get_default("parsers")[name] = sp
+        sp.set_defaults(command_entry=cmd)
     return p
 
 
@@ -94,9 +90,10 @@ def _emit(args: argparse.Namespace, res: Result) -> int:
         sys.stdout.flush()
     for w in res.warnings:
         sys.stderr.write(w + "\n")
-    if not getattr(args, "quiet", False) or args.json:
+    as_json = getattr(args, "json", False)
+    if not getattr(args, "quiet", False) or as_json:
         stream = sys.stderr if getattr(args, "out", None) == "-" else sys.stdout
-        print(json.dumps(res.payload) if args.json else res.text, file=stream)
+        print(json.dumps(res.payload) if as_json else res.text, file=stream)
     return int(res.code)
 
 
@@ -104,7 +101,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line ``argv``; returns the exit status (0, 1 or 2; 130 on interrupt)."""
     # negative numbers are values, not options: "dextar ik -10 120"
     argv = list(sys.argv[1:] if argv is None else argv)
-    parser = build_parser(argv[0] if argv and argv[0] in COMMANDS else None)
+    parser = build_parser(argv[0] if argv and argv[0] in COMMANDS else "")
     try:
         args, extra = parser.parse_known_args(_protect_negatives(argv))
         if extra:  # the command's own parser says it, pointing to the command's help
@@ -115,7 +112,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         with warnings.catch_warnings():  # numerical warnings of a failing solve: the error
             warnings.simplefilter("ignore", RuntimeWarning)  # that follows says it in words
-            return _emit(args, args.run(args))
+            return _emit(args, args.command_entry.run(args))
     except KeyboardInterrupt:
         return _interrupted(args.command)
     except Exception as exc:

@@ -37,6 +37,12 @@ KINDS = ("number", "integer", "text", "point", "points", "pair", "choice")
 
 _REQUIRED = object()
 
+#: The largest length a config may give (mm, any key or coordinate in mm: 1000 km) and the
+#: smallest positive one (1 nm): beyond them the squares and fourth powers of the dynamics
+#: leave double precision (lengths of 1e300 mm overflowed, 1e-200 mm divided by zero).
+MAX_MM = 1e9
+MIN_MM = 1e-6
+
 
 @dataclass(frozen=True)
 class Param:
@@ -90,20 +96,41 @@ def _where(table: str, key: str) -> str:
     return f"config key {table}.{key}" if table.startswith("[") else f"config key [{table}].{key}"
 
 
+def number_words(x: float) -> str:
+    """A number as a message shows it: NaN called NaN, an infinity ``inf`` or ``-inf``, any
+    other in six significant digits."""
+    if math.isnan(x):
+        return "NaN"
+    return f"{x:.6g}"
+
+
 def _check_number(table: str, key: str, p: Param, v: object) -> float:
     where = _where(table, key)
     if not _is_number(v):
         raise ConfigError(f"{where} must be a number, got {type(v).__name__} {v!r}")
     x = float(cast(float, v))  # a number, checked above
     if not math.isfinite(x):
-        raise ConfigError(f"{where} must be finite, got {v!r}")
+        raise ConfigError(f"{where} must be finite, got "
+                          f"{'NaN' if math.isnan(x) else repr(v)}")
     if p.positive and not x > 0:
         raise ConfigError(f"{where} must be positive, got {v!r}")
     if p.minimum is not None and x < p.minimum:
         raise ConfigError(f"{where} must be at least {p.minimum:g}, got {v!r}")
     if p.maximum is not None and x > p.maximum:
         raise ConfigError(f"{where} must be at most {p.maximum:g}, got {v!r}")
+    if p.unit == "mm":
+        _check_length(where, x, p.positive)
     return x
+
+
+def _check_length(where: str, x: float, positive: bool) -> None:
+    """A length in mm within :data:`MAX_MM` (and, when positive, at least :data:`MIN_MM`)."""
+    if abs(x) > MAX_MM:
+        raise ConfigError(f"{where} = {x:g} mm is beyond {MAX_MM:g} mm (1000 km): lengths are "
+                          "in mm")
+    if positive and x < MIN_MM:
+        raise ConfigError(f"{where} = {x:g} mm is below {MIN_MM:g} mm (1 nm): lengths are in "
+                          "mm")
 
 
 def read_value(table: str, key: str, p: Param, v: object) -> Any:
@@ -131,21 +158,26 @@ def read_value(table: str, key: str, p: Param, v: object) -> Any:
         raise ConfigError(f"{where} must be a number or a pair of numbers [motor A, motor D], "
                           f"got {type(v).__name__} {v!r}")
     if p.kind == "point":
-        return _point(where, v)
+        return _point(where, v, p.unit)
     if p.kind == "points":
         if not isinstance(v, list):
             raise ConfigError(f"{where} must be a list of points [[x, y], ...], got "
                               f"{type(v).__name__} {v!r}")
-        return tuple(_point(f"{where}[{i}]", w) for i, w in enumerate(v))
+        return tuple(_point(f"{where}[{i}]", w, p.unit) for i, w in enumerate(v))
     raise ValueError(f"unknown parameter kind {p.kind!r}")
 
 
-def _point(where: str, v: object) -> tuple[float, float]:
+def _point(where: str, v: object, unit: str = "") -> tuple[float, float]:
     if not (isinstance(v, list) and len(v) == 2 and all(_is_number(x) for x in v)):
         raise ConfigError(f"{where} must be a point [x, y], got {type(v).__name__} {v!r}")
     x, y = (float(c) for c in v)
     if not (math.isfinite(x) and math.isfinite(y)):
-        raise ConfigError(f"{where} must be finite, got {v!r}")
+        bad = " and ".join(f"{c} is {'NaN' if math.isnan(w) else 'infinite'}"
+                           for c, w in (("x", x), ("y", y)) if not math.isfinite(w))
+        raise ConfigError(f"{where} must be finite, got {v!r} ({bad})")
+    if unit == "mm":
+        for w in (x, y):
+            _check_length(where, w, False)
     return (x, y)
 
 

@@ -10,7 +10,7 @@ import pytest
 from dextar import DEXTAR_MM
 from dextar.calibration import KinematicModel
 from dextar.config import load_kinematics, scenario_from_dict
-from dextar.config.tables import InstrumentTable, RobotTable
+from dextar.config.kinematic import InstrumentTable, RobotTable
 from dextar.errors import ConfigError
 
 

@@ -9,6 +9,7 @@ import re
 import tempfile
 from pathlib import Path
 
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -19,9 +20,25 @@ from .harness import (
     run_config_case,
     run_identify_case,
     run_program_case,
+    run_run_case,
     toml_text,
 )
-from .strategies import COMMANDS, configs, kinematics_argv, motion_files, programs
+from .strategies import (
+    COMMANDS,
+    configs,
+    dry_friction_runs,
+    falling_simulations,
+    kinematics_argv,
+    long_animated_runs,
+    metre_configs,
+    motion_files,
+    programs,
+    time_scaled_motion_files,
+)
+
+pytestmark = pytest.mark.slow
+
+PICK_PLACE = str(Path(__file__).resolve().parents[2] / "examples" / "pick_place.toml")
 
 SETTINGS = settings(max_examples=100, deadline=None, derandomize=True,
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
@@ -107,3 +124,51 @@ def test_a_parameter_held_at_its_bound_gives_a_summary_not_an_error():
                 assert p["rel_std"] is None and p["poorly_determined"], p
             else:
                 assert isinstance(p["rel_std"], float), p
+
+
+SHAPES = settings(max_examples=8, deadline=None, derandomize=True,
+                  suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+
+
+@SHAPES
+@given(doc=metre_configs(), command=st.sampled_from(["plan", "simulate"]))
+def test_metre_sized_lengths_never_crash(doc, command):
+    outcome, detail = run_config_case(doc, command)
+    assert outcome not in DEFECTS, f"{outcome}: {detail}\nconfig:\n{toml_text(doc)}"
+
+
+@SHAPES
+@given(doc=falling_simulations())
+def test_falling_simulations_never_crash(doc):
+    """A robot that falls is a result: exit 1 with its files, within the time bound."""
+    outcome, detail = run_config_case(doc, "simulate")
+    assert outcome not in DEFECTS, f"{outcome}: {detail}\nconfig:\n{toml_text(doc)}"
+
+
+@settings(max_examples=3, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@given(doc=dry_friction_runs())
+def test_long_runs_with_dry_friction_never_crash(doc):
+    outcome, detail = run_run_case(doc)
+    assert outcome not in DEFECTS, f"{outcome}: {detail}\nconfig:\n{toml_text(doc)}"
+
+
+@settings(max_examples=2, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@given(doc=long_animated_runs())
+def test_long_runs_with_the_animation_never_hang(doc):
+    outcome, detail = run_run_case(doc)
+    assert outcome not in DEFECTS, f"{outcome}: {detail}\nconfig:\n{toml_text(doc)}"
+
+
+@SHAPES
+@given(case=time_scaled_motion_files(), config=st.sampled_from([None, PICK_PLACE]))
+def test_time_columns_in_other_units_never_crash(case, config):
+    """A time column in milliseconds or microseconds is refused naming that unit (issue 28,
+    time scales); seconds, or a motion 1000 times faster, end in a result or a refusal."""
+    text, options, factor = case
+    outcome, detail = run_identify_case(text, options, config)
+    assert outcome not in DEFECTS, f"{outcome}: {detail}\nfactor {factor}\n{text[:300]}"
+    unit = {1e3: "milliseconds", 1e6: "microseconds"}.get(factor)
+    if unit is not None:
+        assert outcome == "refused" and f"Is the time in {unit}?" in detail, detail

@@ -12,10 +12,12 @@ from .. import __version__
 from .._arrays import Array
 from ..dynamics import Inertia
 from ..dynamics.paper import paper_model_limits
+from ..errors import DextarError
 from ..geometry import DEXTAR_MM
 from ..laws import LAW_TYPES, Law, law_type
 from ..trajectory import Trajectory
 from .core import (
+    POWER_BALANCE_TOL,
     Analysis,
     PaperComparison,
     RunInputs,
@@ -26,13 +28,33 @@ from .core import (
 
 
 def validation(an: Analysis) -> dict[str, Any]:
-    """The physics checks of a run: power balance and forward re-simulation."""
+    """The physics checks of a run, each reported with its figure, its threshold and whether
+    it passed (a check that fails, or cannot run, is a result: ``passed`` false and the
+    reason in ``failed``): the power balance (:data:`~.core.POWER_BALANCE_TOL`) and the
+    forward re-simulation in windows anchored to the plan (:data:`~.core.REPLAY_TOL`)."""
     out: dict[str, Any] = {"forward_resimulation": forward_error(an)}
-    out["power_balance_relative"] = power_balance_residual(an)
+    failed = []
+    if not out["forward_resimulation"]["passed"]:
+        failed.append(f"forward re-simulation: {out['forward_resimulation']['message']}")
+    try:
+        pb: float | None = power_balance_residual(an)
+    except DextarError as exc:
+        pb = None
+        failed.append(f"power balance: it could not be computed: {exc}")
+    else:
+        assert pb is not None
+        if not pb <= POWER_BALANCE_TOL:
+            failed.append(f"power balance: max |tau.qdot - dT/dt| / max |tau.qdot| = {pb:.3g} "
+                          f"above {POWER_BALANCE_TOL:g}: the torques do not match the "
+                          "kinetic energy's rate")
+    out["power_balance_relative"] = pb if pb is None or math.isfinite(pb) else None
+    out["power_balance_threshold"] = POWER_BALANCE_TOL
     out["power_balance_note"] = (
         "max |tau.qdot - dT/dt| / max |tau.qdot| (dimensionless) on interior times clear of "
         "the law's breakpoints, dT/dt by 8th-order differences of the exact kinetic energy, "
         "gravity and friction off; it checks the torques against the energy")
+    out["passed"] = not failed
+    out["failed"] = failed
     return out
 
 

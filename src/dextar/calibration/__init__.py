@@ -37,7 +37,17 @@ Units: SI (m, rad) in Python; files speak mm and degrees.
 from .accuracy import AccuracyMap, accuracy_map, position_covariance
 from .data import PoseData, poses_from_arrays, read_poses_csv
 from .errors import CouplingError, OutlierError
-from .fit import CalibrationResult, Errors, Parameter, calibrate, encoder_std, register
+from .fit import (
+    CalibrationResult,
+    Diagnosis,
+    Errors,
+    Parameter,
+    calibrate,
+    calibrate_or_diagnose,
+    check_scale,
+    encoder_std,
+    register,
+)
 from .model import FRAME, NAMES, ROBOT, KinematicModel
 from .observability import Identifiability, Observability, identifiability, observability
 from .poses import PoseSelection, select_poses
@@ -50,6 +60,7 @@ __all__ = [
     "AccuracyMap",
     "CalibrationResult",
     "CouplingError",
+    "Diagnosis",
     "Errors",
     "Identifiability",
     "KinematicModel",
@@ -60,6 +71,8 @@ __all__ = [
     "PoseSelection",
     "accuracy_map",
     "calibrate",
+    "calibrate_or_diagnose",
+    "check_scale",
     "encoder_std",
     "identifiability",
     "measure",

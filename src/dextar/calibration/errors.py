@@ -3,7 +3,7 @@ it names (rows, parameters) for the caller, with a one-line message."""
 
 from __future__ import annotations
 
-from ..errors import ParameterError
+from ..errors import ParameterError, ReachError
 
 
 class OutlierError(ParameterError):
@@ -22,3 +22,12 @@ class CouplingError(ParameterError):
     def __init__(self, message: str, names: tuple[str, ...]) -> None:
         super().__init__(message)
         self.names = names
+
+
+class OutOfReachError(ReachError):
+    """A measured point out of reach of the nominal and the fitted robot; ``rows`` holds its
+    row number."""
+
+    def __init__(self, message: str, rows: tuple[int, ...]) -> None:
+        super().__init__(message)
+        self.rows = rows

@@ -31,7 +31,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .._arrays import Array, as_points
-from ..errors import ParameterError
+from ..errors import AssemblyError, ParameterError
 from ..geometry import FiveBar
 from ..kinematics import inverse_kinematics
 
@@ -254,8 +254,6 @@ class Closure:
     def raise_if_open(self, rows: Array | None = None) -> None:
         """Raise :class:`AssemblyError` for the first row whose rods cannot meet; ``rows``
         (n,) names the rows (default: their indices)."""
-        from ..errors import AssemblyError
-
         if not self.open.any():
             return
         i = int(np.flatnonzero(self.open)[0])

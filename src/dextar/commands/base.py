@@ -1,20 +1,25 @@
 """What every command shares: its result, the ``--out`` file rules, the options of a command
 that writes a directory, and the words of a law and of the run's units.
 
-A command module (one per command, listed in :data:`dextar.commands.COMMANDS`) holds ``NAME``,
-``HELP``, ``add_arguments(parser)`` and ``run(args) -> Result``; ``run`` only chains config ->
-domain -> output and says what to print. Modules import what their ``run`` needs when it runs,
-so that the command line starts at once.
+A command module (one per command, registered in :data:`dextar.commands.COMMANDS`) holds
+``HELP``, ``add_arguments(parser)`` and ``run(args) -> Result``; ``run`` reads the config,
+calls its job (:mod:`dextar.jobs`: one library call, one typed result), writes its files and
+says what to print. The jobs and the writers are module attributes imported when the command
+runs (:mod:`dextar._lazy`), so that ``--help`` and parsing stay light.
 """
 
 from __future__ import annotations
 
 import argparse
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
-from ..errors import ConfigError
+from .. import config
+from ..errors import ConfigError, DextarError
+from ..output.files import write_text
 
 if TYPE_CHECKING:
     from ..config import Scenario
@@ -56,8 +61,6 @@ def out_file(out: str, *suffixes: str) -> Path | None:
 def write_or_hand_back(out: Path | None, text: str) -> tuple[str, str | None]:
     """Write ``text`` atomically to ``out``; for None (stdout) hand it back as data. Returns
     where it went (for the words) and the data."""
-    from ..output.files import write_text
-
     if out is None:
         return "stdout", text
     write_text(out, text)
@@ -147,3 +150,39 @@ def law_warnings(command: str, law: Law) -> list[str]:
     if law.success:
         return []
     return [f"dextar {command}: warning: {law.name} law status {law.status}: {law.message}"]
+
+
+
+def load(args: argparse.Namespace, units: str | None = None) -> Scenario:
+    """The scenario of ``args.config`` (with ``args.model``'s robot, inertia, friction and
+    gravity when given), computed in ``units`` (``--units``; None: as configured)."""
+    sc = config.load_scenario(args.config, model=getattr(args, "model", None))
+    return sc.in_units(units)
+
+
+class Noted(Protocol):
+    """A config read by a command (:class:`~dextar.config.Scenario`,
+    :class:`~dextar.config.KinematicConfig`): its notes, what the user may not have meant
+    (:func:`dextar.config.kinematic.config_notes`)."""
+
+    @property
+    def notes(self) -> tuple[str, ...]:
+        """What the user may not have meant, in words."""
+
+
+@contextmanager
+def noted(cfg: Noted) -> Iterator[None]:
+    """An error raised inside the block carries the config's notes (a robot in metres, an
+    empty file), where they are the likely cause."""
+    try:
+        yield
+    except DextarError as exc:
+        if cfg.notes and exc.args:
+            exc.args = (f"{exc.args[0]} (note: {'; '.join(cfg.notes)})", *exc.args[1:])
+        raise
+
+
+def note_lines(command: str, cfg: Noted) -> list[str]:
+    """The config's notes as stderr lines, first among a command's warnings: every command
+    that reads a config says them."""
+    return [f"dextar {command}: note: {n}" for n in cfg.notes]

@@ -12,14 +12,16 @@ from __future__ import annotations
 import argparse
 from typing import TYPE_CHECKING
 
-from .base import Result, into_directory, shown
+from .. import jobs
+from .._lazy import lazy_module
+from ..config.kinematic import load_kinematic_config
+from ..output.files import OutputDir
+from .base import Result, into_directory, note_lines, noted, shown
 
-if TYPE_CHECKING:
-    from ..calibration import CalibrationResult, KinematicModel, PoseData
-
-NAME = "calibrate"
-HELP = ("calibrate the kinematics from measured poses and write a config with the identified "
-        "lengths, encoder offsets and instrument frame (exit 1 when the fit does not fit)")
+if TYPE_CHECKING:  # the writers, imported when the command runs (start-up: dextar._lazy)
+    from ..output import calibration as written
+else:
+    written = lazy_module("dextar.output.calibration")
 
 
 def add_arguments(sp: argparse.ArgumentParser) -> None:
@@ -44,59 +46,23 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
-    """Read, calibrate, write, word."""
-    from ..calibration import read_poses_csv
-    from ..calibration.fit import encoder_std
-    from ..config import load_scenario
-    from ..output.calibration import (
-        CALIBRATION_FILES,
-        CalibrationRun,
-        calibration_files,
-        write_calibration,
-    )
-    from ..output.files import OutputDir
-
-    od = OutputDir(args.out, force=args.force, produces=CALIBRATION_FILES)  # checked now
-    sc = load_scenario(args.config)
-    rt, inst = sc.robot_table, sc.instrument_table
-    nominal = sc.kinematic_model
-    data = read_poses_csv(args.data, working_mode=rt.working_mode)
-    held = (read_poses_csv(args.validate, working_mode=rt.working_mode)
-            if args.validate else None)
-    point_std = None if inst.sigma_mm is None else 1e-3 * inst.sigma_mm
-    reading_std = None if rt.encoder_counts is None else encoder_std(rt.encoder_counts)
-    res, outliers, problem = _fit_or_diagnose(args, data, nominal, point_std=point_std,
-                                              reading_std=reading_std, validation=held)
-    extra = {k: v for k, v in sc.doc.items() if k not in ("robot", "instrument")}
-    files = calibration_files(res, data=args.data, config=args.config or "",
-                              working_mode=rt.working_mode, assembly_mode=rt.assembly_mode,
-                              encoder_counts=rt.encoder_counts, extra=extra,
-                              validation=held, figures=figures, outliers=outliers,
-                              outlier_message=problem, sigma_mm=inst.sigma_mm)
-    said = CalibrationRun(res, shown(args.out), write_calibration(od, files),
-                          outliers=outliers, problem=problem, robust=args.robust,
-                          sigma_mm=inst.sigma_mm, working_mode=rt.working_mode,
-                          default_robot=rt.geometry_mm if args.config is None else None)
-    return Result(said.payload(files), said.text(), said.warnings(), code=said.code)
-
-
-def _fit_or_diagnose(args: argparse.Namespace, data: PoseData, nominal: KinematicModel, *,
-                     point_std: float | None, reading_std: float | None,
-                     validation: PoseData | None
-                     ) -> tuple[CalibrationResult, tuple[int, ...], str]:
-    """The calibration the options ask for; when it finds outliers, the fit that keeps
-    them (a diagnosis: their arrows in residuals.png) with their rows and the error's
-    words."""
-    from ..calibration import OutlierError, calibrate
-    from ..calibration.fit import OUTLIER_FACTOR
-
-    def fit(factor: float) -> CalibrationResult:
-        return calibrate(data, nominal, frame=args.frame, robust=args.robust,
-                         outlier_factor=factor, point_std=point_std, reading_std=reading_std,
-                         validation=validation)
-
-    factor = OUTLIER_FACTOR if args.outlier_factor is None else args.outlier_factor
-    try:
-        return fit(factor), (), ""
-    except OutlierError as exc:
-        return fit(1e300), exc.rows, str(exc)
+    """Calibrate (:func:`dextar.jobs.calibrate`: outliers diagnosed), write, word."""
+    od = OutputDir(args.out, force=args.force, produces=written.CALIBRATION_FILES)  # checked
+    kc = load_kinematic_config(args.config)
+    rt, inst = kc.robot, kc.instrument
+    with noted(kc):
+        job = jobs.calibrate(args.data, kc, validate=args.validate, frame=args.frame,
+                             robust=args.robust, outlier_factor=args.outlier_factor)
+    d = job.diagnosis
+    files = written.calibration_files(
+        d.result, data=args.data, config=args.config or "", working_mode=rt.working_mode,
+        assembly_mode=rt.assembly_mode, encoder_counts=rt.encoder_counts,
+        extra=kc.other_tables(), validation=job.held, figures=figures, outliers=d.outliers,
+        outlier_message=d.message, sigma_mm=inst.sigma_mm, region_mm=inst.region_mm)
+    said = written.CalibrationRun(d.result, shown(args.out),
+                                  written.write_calibration(od, files), outliers=d.outliers,
+                                  problem=d.message, robust=args.robust,
+                                  sigma_mm=inst.sigma_mm, working_mode=rt.working_mode,
+                                  default_robot=rt.geometry_mm if args.config is None else None)
+    return Result(said.payload(files), said.text(),
+                  note_lines("calibrate", kc) + said.warnings(), code=said.code)

@@ -4,12 +4,19 @@ row, the Pareto front, the chosen robot as a config, the figures and the report.
 from __future__ import annotations
 
 import argparse
-from typing import Any
+import sys
+from collections.abc import Callable
+from typing import TYPE_CHECKING
 
-from .base import Result, config_argument, into_directory, shown
+from .. import jobs
+from .._lazy import lazy_module
+from ..output.files import OutputDir
+from .base import Result, config_argument, into_directory, load, note_lines, noted, shown
 
-NAME = "design"
-HELP = "sweep five-bar geometries for a task on Dask: designs, Pareto front, the chosen robot"
+if TYPE_CHECKING:  # the writers, imported when the command runs (start-up: dextar._lazy)
+    from ..output import design as written
+else:
+    written = lazy_module("dextar.output.design")
 
 
 def add_arguments(sp: argparse.ArgumentParser) -> None:
@@ -29,9 +36,7 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
                     help="complete the sweep in --out (evaluate only what is missing)")
 
 
-def _progress(args: argparse.Namespace) -> Any:
-    import sys
-
+def _progress(args: argparse.Namespace) -> Callable[[int, int], None] | None:
     if not (sys.stderr.isatty() and not args.quiet):
         return None
 
@@ -43,66 +48,33 @@ def _progress(args: argparse.Namespace) -> Any:
 
 
 def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
-    """Sweep, choose, write, word."""
-    import hashlib
-
-    from ..config import load_scenario
-    from ..design.evaluate import evaluate_path, inertia_of
-    from ..design.pareto import choose
-    from ..design.space import LENGTHS
-    from ..design.sweep import Cluster, require_dask, run_sweep
-    from ..geometry import FiveBar
-    from ..output.design import (
-        DESIGN_FILES,
-        DesignsFile,
-        best_workspace_figure,
-        sweep_summary,
-        write_sweep_outputs,
-    )
-    from ..output.files import OutputDir
-
-    require_dask()
-    sc = load_scenario(args.config, model=args.model)
-    task, space = sc.design_task(samples=args.samples, seed=args.seed)
-    designs = space.designs()
-    n = len(designs)
-    signature = hashlib.sha256(repr((sc.text, space, sc.design.grid)).encode()).hexdigest()
-    with OutputDir(args.out, force=args.force, keep=args.resume, produces=DESIGN_FILES,
+    """Sweep and choose (:func:`dextar.jobs.design`), write, word."""
+    sc = load(args)
+    with noted(sc):
+        sweep = jobs.design_sweep(sc, samples=args.samples, seed=args.seed)
+    n = len(sweep.designs)
+    with OutputDir(args.out, force=args.force, keep=args.resume, produces=written.DESIGN_FILES,
                    hint="use --force to overwrite it or --resume to complete its sweep") as od:
-        store = DesignsFile(od, designs, signature, resume=args.resume, label=shown(args.out))
-        with Cluster(workers=args.workers, scheduler=args.scheduler) as cluster, store:
-            stats = run_sweep(cluster, task, designs, store.missing, chunk=sc.design.chunk,
-                              on_chunk=store.append, progress=_progress(args))
-        rows = store.finish()
-        choice = choose(rows, space)
-        best = choice.best_row
-        summary = sweep_summary(args.config, task.kind, space, stats, choice, rows)
-        best_toml = best_fig = None
-        if best is not None:
-            robot_mm = FiveBar(*(best[k] for k in LENGTHS))
-            rods = (f"uniform rods of {space.mass_per_length[0]:g} and "
-                    f"{space.mass_per_length[1]:g} kg/m" if space.mass_per_length else
-                    "each rod of the task's robot keeps its linear density and shape on its "
-                    "new length (mass and centre of mass scale with the length, the inertia "
-                    "about the centre with its cube); the effector, payload and rotors as "
-                    "given")
-            best_toml = sc.model_file(
-                robot_mm, task.working_mode, inertia_of(task, robot_mm.scaled(1e-3)),
-                f"the Pareto design closest to the ideal point of dextar design {args.config} "
-                f"(design {best['design']} of {n}; objectives {', '.join(space.objectives)})\n"
-                f"rods: {rods}")
-            if figures:
-                best_fig = best_workspace_figure(robot_mm, task.working_mode,
-                                                 evaluate_path(task, [best[k]
-                                                                      for k in LENGTHS]))
-        write_sweep_outputs(od, summary, choice, rows, space.varied_axes, best_toml,
-                            best_fig, with_figures=figures)
+        store = written.DesignsFile(od, sweep.designs, sweep.signature, resume=args.resume,
+                                    label=shown(args.out))
+        res = jobs.design(sweep, workers=args.workers, scheduler=args.scheduler, store=store,
+                          progress=_progress(args), label=args.config)
+        summary = written.sweep_summary(args.config, sweep.task.kind, sweep.space, res.stats,
+                                        res.choice, res.rows)
+        best_fig = None
+        if figures and res.best_robot_mm is not None and res.best_path_mm is not None:
+            best_fig = written.best_workspace_figure(res.best_robot_mm, sweep.task.working_mode,
+                                                     res.best_path_mm)
+        written.write_sweep_outputs(od, summary, res.choice, res.rows,
+                                    sweep.space.varied_axes, res.best_toml, best_fig,
+                                    with_figures=figures)
+    stats, best = res.stats, res.best
     text = (f"design sweep: {n} designs ({stats.evaluated} evaluated, {n - stats.evaluated} "
             f"resumed) on {stats.workers} workers in {stats.wall_s:.1f} s "
-            f"({summary['designs_per_second']:.3g} designs/s); {len(choice.feasible)} "
-            f"feasible, {len(choice.pareto_rows)} on the Pareto front"
+            f"({summary['designs_per_second']:.3g} designs/s); {len(res.choice.feasible)} "
+            f"feasible, {len(res.choice.pareto_rows)} on the Pareto front"
             + (f"; chosen design {best['design']}: l1 = {best['l1']:.4g}, l2 = "
                f"{best['l2']:.4g}, L1 = {best['L1']:.4g}, L2 = {best['L2']:.4g}, d = "
                f"{best['d']:.4g} mm -> {shown(args.out, 'best.toml')}" if best
                else "; no feasible design"))
-    return Result(summary, text)
+    return Result(summary, text, note_lines("design", sc))

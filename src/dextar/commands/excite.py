@@ -7,15 +7,15 @@ from __future__ import annotations
 import argparse
 from typing import TYPE_CHECKING
 
-from .base import Result, config_argument, json_flag, out_file, write_or_hand_back
+from .. import jobs
+from .._lazy import lazy_module
+from ..output.tables import csv_text
+from .base import Result, config_argument, json_flag, load, note_lines, out_file, write_or_hand_back
 
-if TYPE_CHECKING:
-    from ..config import Scenario
-    from ..identification.coverage import JointRegion
-
-NAME = "excite"
-HELP = ("an exciting trajectory for identification (a Fourier series per motor, regressor "
-        "condition number minimised) to CSV")
+if TYPE_CHECKING:  # the writers, imported when the command runs (start-up: dextar._lazy)
+    from ..output import identification as written
+else:
+    written = lazy_module("dextar.output.identification")
 
 
 def add_arguments(sp: argparse.ArgumentParser) -> None:
@@ -37,24 +37,18 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> Result:
-    """Design the motion, sample it at the servo rate, write it."""
-    from ..config import load_scenario
-    from ..identification.excite import design_excitation
-    from ..output.identification import excitation_columns, excitation_payload
-    from ..output.tables import csv_text
-
+    """Design the motion (:func:`dextar.jobs.excite`), sample it at the servo rate, write
+    it."""
     target = out_file(args.out, ".csv")
-    sc = load_scenario(args.config, model=args.model)
-    model = sc.si_model
-    region = None if args.task is None else task_region(args.task, sc)
-    res = design_excitation(model, sc.mode, harmonics=args.harmonics, base_hz=args.base_hz,
-                            duration=args.duration, motors=sc.si_motors, seed=args.seed,
-                            region=region)
+    sc = load(args)
+    job = jobs.excite(sc, harmonics=args.harmonics, base_hz=args.base_hz,
+                      duration=args.duration, seed=args.seed, task=args.task)
+    res, region = job.result, job.region
     rate = sc.output.servo_rate_hz
-    cols = excitation_columns(model, res, rate)
+    cols = written.excitation_columns(sc.si_model, res, rate)
     where, data = write_or_hand_back(target, csv_text(cols))
-    payload = excitation_payload(res, args.harmonics, args.base_hz, len(cols["t_s"]), rate,
-                                 where)
+    payload = written.excitation_payload(res, args.harmonics, args.base_hz, len(cols["t_s"]),
+                                         rate, where)
     text = (f"exciting trajectory: condition number {res.condition_number:.4g} (base "
             f"regressor, unit-norm columns); {res.periods} period(s) of "
             f"{res.trajectory.period:g} s, {args.harmonics} harmonics; peak torques "
@@ -62,6 +56,9 @@ def run(args: argparse.Namespace) -> Result:
             f"distances type 1 {res.min_type1_distance:.3g}, type 2 "
             f"{res.min_type2_distance:.3g}; wrote {where} ({payload['samples']} samples at "
             f"{rate:g} Hz)")
+    if res.coverage is not None:
+        text += "; " + written.coverage_text(res, region is not None)
+    # below the advisory floors: written, exit 0, a warning (see identification.excite)
     warnings = [] if res.status == 0 else [f"dextar excite: warning: {res.message}"]
     if region is not None:
         text += (f"; covers {res.region_coverage:.1%} of the task's poses, at "
@@ -72,22 +69,6 @@ def run(args: argparse.Namespace) -> Result:
                             f"{res.region_coverage:.1%} of the task's poses and reaches "
                             f"{res.region_speed_ratio.min():.2f} of its peak speed: an "
                             "identification from it extrapolates on the rest")
+    warnings[:0] = note_lines("excite", sc)  # the config's notes (a robot in metres), first
     return Result(payload, text, warnings, data=data)
 
-
-def task_region(path: str, sc: Scenario) -> JointRegion:
-    """The joint region a task visits, with its speeds: its program planned, or its run
-    sampled (SI), on the config's robot."""
-    from ..config import load_scenario
-    from ..errors import ConfigError
-    from ..identification.coverage import JointRegion
-
-    task = load_scenario(path)
-    if task.robot_mm != sc.robot_mm:
-        raise ConfigError(f"--task {path!r} is for another robot ({task.robot_mm.as_dict()} "
-                          f"mm) than the config's ({sc.robot_mm.as_dict()} mm)")
-    if task.moves:
-        res = task.program_request().plan()
-        return JointRegion.from_samples(res.q, res.dq)
-    tr = task.in_units("si").trajectory()
-    return JointRegion.from_samples(tr.q, tr.dq)

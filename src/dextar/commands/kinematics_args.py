@@ -3,19 +3,16 @@
 from __future__ import annotations
 
 import argparse
-from typing import TYPE_CHECKING
 
-if TYPE_CHECKING:
-    from ..config.tables import InstrumentTable
+from ..config.kinematic import InstrumentTable
+from ..errors import ConfigError, DextarError
+from ..geometry import canonical_working_mode
 
 MODE_HELP = "working mode: ++, +-, -+ or -- (aliases pp, pm, mp, mm)"
 
 
 def _mode(text: str) -> str:
     """A working mode by name or alias, through the one parser the config files use too."""
-    from ..errors import DextarError
-    from ..geometry import canonical_working_mode
-
     try:
         return canonical_working_mode(text)
     except DextarError as exc:
@@ -42,8 +39,6 @@ def frame_argument(sp: argparse.ArgumentParser, what: str) -> None:
 
 def instrument_of(table: InstrumentTable | None, path: str | None) -> InstrumentTable:
     """The ``[instrument]`` table, or a one-line error when the file has none."""
-    from ..errors import ConfigError
-
     if table is None:
         raise ConfigError("--frame instrument needs an [instrument] table in --robot FILE.toml"
                           + ("" if path is None else f" ({path} has none)"))

@@ -6,20 +6,21 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
+from .. import jobs
+from ..output.tables import csv_text, trajectory_columns
 from .base import (
     Result,
     csv_command,
     law_line,
     law_payload,
     law_warnings,
+    load,
+    note_lines,
+    noted,
     out_file,
     units_note,
     write_or_hand_back,
 )
-
-NAME = "plan"
-HELP = "law of motion along the path: samples to CSV, cost"
-REGISTRIES_HELP = True
 
 
 def add_arguments(sp: argparse.ArgumentParser) -> None:
@@ -28,14 +29,12 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> Result:
-    """Plan, write the samples, word the law."""
-    from ..config import load_scenario
-    from ..output.tables import csv_text, trajectory_columns
-
+    """Plan (:func:`dextar.jobs.plan`), write the samples, word the law."""
     path = out_file(args.out, ".csv")
-    sc = load_scenario(args.config, model=args.model).in_units(args.units)
-    law = sc.law()
-    tr = sc.trajectory(law)
+    sc = load(args, args.units)
+    with noted(sc):
+        res = jobs.plan(sc)
+    law, tr = res.law, res.trajectory
     where, data = write_or_hand_back(path, csv_text(trajectory_columns(tr, sc.units)))
     payload: dict[str, Any] = {"out": where, "samples": int(tr.t.size), **law_payload(sc, law),
                                "units": sc.units.describe()}
@@ -49,4 +48,5 @@ def run(args: argparse.Namespace) -> Result:
                      f"{sc.units.names['time']}]")
     lines.append(f"wrote {where}: {tr.t.size} samples, working mode {tr.mode} "
                  f"({units_note(sc)})")
-    return Result(payload, "\n".join(lines), law_warnings("plan", law), data)
+    return Result(payload, "\n".join(lines), note_lines("plan", sc) + law_warnings("plan", law),
+                  data)

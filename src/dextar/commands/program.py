@@ -4,12 +4,16 @@ figures and the report (exit status 1 when a motor limit is exceeded)."""
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
 
-from .base import Result, config_argument, into_directory
+from .. import jobs
+from .._lazy import lazy_module
+from .base import Result, config_argument, into_directory, load, note_lines, noted
 
-NAME = "program"
-HELP = ("plan a robot program under the motors: setpoints and sizing (exit 1 when a motor "
-        "limit is exceeded)")
+if TYPE_CHECKING:  # the writers, imported when the command runs (start-up: dextar._lazy)
+    from ..output import program as written
+else:
+    written = lazy_module("dextar.output.program")
 
 
 def add_arguments(sp: argparse.ArgumentParser) -> None:
@@ -23,25 +27,17 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> Result:
-    """Plan, size, write, word (the figures unless ``--no-figures``)."""
-    from ..config import load_scenario
-    from ..output.program import ProgramSummary, write_program
-    from ..program import sizing
-    from ..program.drive import drive_report, pvt_points
-
-    sc = load_scenario(args.config, model=args.model)
-    drive = sc.drive()
-    res = sc.program_request().plan()
-    pvt = None if drive is None else pvt_points(res, drive)
-    report = None
-    if drive is not None and pvt is not None:
-        report = {**drive_report(res, drive, sc.si_model.inertia.rotor),
-                  "pvt_max_error_counts": pvt.max_error_counts}
-    summary = ProgramSummary(args.config, res.cycle_time_s, sc.output.servo_rate_hz,
-                             tuple(res.timeline()), sizing(res), res.rms_fit, report,
-                             sc.robot_table.encoder_offset_deg)
-    write_program(args.out, res, summary, sc.robot_mm, sc.program_mode, force=args.force,
-                  with_figures=args.figures, drive=drive, pvt=pvt)
-    warnings = [f"dextar program: {v.text()}" for v in summary.sizing.violations]
+    """Plan and size (:func:`dextar.jobs.program`), write, word (the figures unless
+    ``--no-figures``)."""
+    sc = load(args)
+    with noted(sc):
+        job = jobs.program(sc)
+    res, summary = job.result, job.summary
+    written.write_program(args.out, res, summary, sc.robot_mm, sc.program_mode,
+                          force=args.force, with_figures=args.figures, drive=job.drive,
+                          pvt=job.pvt)
+    warnings = note_lines("program", sc)
+    warnings += [f"dextar program: {v.text()}" for v in summary.sizing.violations]
+    warnings += [f"dextar program: warning: {n}" for n in job.warnings]
     return Result(summary.as_json(), "\n".join(summary.lines(args.out, res.t.size)), warnings,
-                  code=0 if summary.sizing.fits else 1)
+                  code=0 if job.fits else 1)

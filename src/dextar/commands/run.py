@@ -5,14 +5,18 @@ report."""
 from __future__ import annotations
 
 import argparse
-import time
-from typing import Any
+import sys
+from typing import TYPE_CHECKING
 
-from .base import Result, config_argument, into_directory, shown
+from .. import jobs
+from .._lazy import lazy_module
+from ..output.files import OutputDir
+from .base import Result, config_argument, into_directory, load, note_lines, noted, shown
 
-NAME = "run"
-HELP = "reproduce the paper end to end and write a report"
-REGISTRIES_HELP = True
+if TYPE_CHECKING:  # the writers, imported when the command runs (start-up: dextar._lazy)
+    from ..output import run as written
+else:
+    written = lazy_module("dextar.output.run")
 
 
 def add_arguments(sp: argparse.ArgumentParser) -> None:
@@ -22,38 +26,28 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> Result:
-    """Compute through the stages, write every file, word the law and the claims."""
-    import sys
-
-    from ..analysis import analyze, run_summary, validation
-    from ..config import load_scenario
-    from ..output.files import OutputDir
-    from ..output.parallel import Forked
-    from ..output.run import RUN_FILES, Progress, staged, write_run
-
-    sc = load_scenario(args.config, model=args.model)
-    prog = Progress(enabled=not args.quiet and sys.stderr.isatty())
-    stage = staged(prog)
-    inputs = sc.inputs()
-    with OutputDir(args.out, force=args.force, produces=RUN_FILES) as od:
-        an = stage(f"{sc.law_table.type} law, trajectory and torques",
-                   lambda: analyze(inputs, sc.law()))
-        uniform = stage("uniform law (Fig. 3)", lambda: inputs.trajectory(sc.law("uniform")))
-
-        def checked() -> tuple[dict[str, Any], float]:
-            t0 = time.perf_counter()
-            return validation(an), time.perf_counter() - t0
-
-        # the physics checks (scipy's import and an integration: half a second) on the other
-        # core while this one loads matplotlib and draws
-        with Forked(checked) as checks:
-            s = run_summary(an, None, inputs.trajectory(uniform.law, samples=201))
-            write_run(od, an, uniform, s, validation=checks.result, figures=sc.output.figures,
-                      animation_frames=sc.output.animation_frames, stage=stage, progress=prog)
+    """Run (:func:`dextar.jobs.run`; its physics checks on the other core while this one
+    draws), write every file, word the law, the claims and the checks."""
+    sc = load(args)
+    prog = written.Progress(enabled=not args.quiet and sys.stderr.isatty())
+    stage = written.staged(prog)
+    with noted(sc), OutputDir(args.out, force=args.force, produces=written.RUN_FILES) as od:
+        res = jobs.run(sc, stage=stage)
+        try:
+            written.write_run(od, res.analysis, res.uniform, res.summary,
+                              validation=res.validation, figures=sc.output.figures,
+                              animation_frames=sc.output.animation_frames, stage=stage,
+                              progress=prog)
+        finally:  # the checks' process ended, whatever happened to the files
+            res.checks.close()
+    s = res.summary
     law = s["law"]
-    warnings = ([] if law["success"] else
-                [f"dextar run: warning: {law['type']} law status {law['status']}: "
-                 f"{law['message']}"])
+    warnings = note_lines("run", sc)
+    if not law["success"]:
+        warnings.append(f"dextar run: warning: {law['type']} law status {law['status']}: "
+                        f"{law['message']}")
+    checks = s["validation"]
+    warnings += [f"dextar run: check failed: {why}" for why in checks["failed"]]
     lines = [f"wrote {len(s['files'])} files to {shown(args.out)} (open "
              f"{shown(args.out, 'report.html')})",
              f"{law['type']} law: motion time {law['duration_s']:.6g} s; status "
@@ -64,4 +58,17 @@ def run(args: argparse.Namespace) -> Result:
                  f"{s['units']['torque_unit']}")
     lines += [f"  {c['verdict']:>11}: {c['claim']} ({c['value']:.3g})"
               for c in s.get("claims", [])]
-    return Result(s, "\n".join(lines), warnings)
+    fw = checks["forward_resimulation"]
+    lines.append(
+        f"checks {'passed' if checks['passed'] else 'FAILED'}: power balance "
+        f"{_figure(checks['power_balance_relative'])} (at most "
+        f"{checks['power_balance_threshold']:g}); forward re-simulation in "
+        f"{fw.get('windows', 0)} windows, largest drift {_figure(fw.get('max_drift_rad'))} "
+        f"rad, {_figure(fw.get('max_drift_ratio'))} of the peak acceleration's (at most "
+        f"{fw['threshold']:g})")
+    return Result(s, "\n".join(lines), warnings, code=0 if checks["passed"] else 1)
+
+
+def _figure(v: float | None) -> str:
+    """A check's figure, or "-" where it could not be computed."""
+    return "-" if v is None else f"{v:.3g}"

@@ -6,20 +6,23 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
+import numpy as np
+
+from .. import jobs
+from ..output.tables import csv_text, torque_columns
 from .base import (
     Result,
     csv_command,
     law_line,
     law_payload,
     law_warnings,
+    load,
+    note_lines,
+    noted,
     out_file,
     units_note,
     write_or_hand_back,
 )
-
-NAME = "torques"
-HELP = "exact and paper-model motor torques to CSV"
-REGISTRIES_HELP = True
 
 
 def add_arguments(sp: argparse.ArgumentParser) -> None:
@@ -28,17 +31,13 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> Result:
-    """Analyse, write the columns, word the peaks and the paper model's error."""
-    import numpy as np
-
-    from ..analysis import analyze
-    from ..config import load_scenario
-    from ..dynamics.paper import paper_model_limits
-    from ..output.tables import csv_text, torque_columns
-
+    """Compute (:func:`dextar.jobs.torques`), write the columns, word the peaks and the
+    paper model's error."""
     path = out_file(args.out, ".csv")
-    sc = load_scenario(args.config, model=args.model).in_units(args.units)
-    an = analyze(sc.inputs(), sc.law())
+    sc = load(args, args.units)
+    with noted(sc):
+        res = jobs.torques(sc)
+    an = res.analysis
     where, data = write_or_hand_back(path, csv_text(torque_columns(an)))
     peak = np.abs(an.tau).max(axis=0)
     payload: dict[str, Any] = {"out": where, "samples": int(an.trajectory.t.size),
@@ -56,6 +55,7 @@ def run(args: argparse.Namespace) -> Result:
                  + (f" (against the exact torques without {' and '.join(left)}, which (42) "
                     "leaves out)" if left else ""))
     else:
-        why = paper_model_limits(sc.robot, sc.inertia)
-        text += f"\nno paper-model columns: the paper's simplified model does not apply ({why})"
-    return Result(payload, text, law_warnings("torques", an.law), data)
+        text += ("\nno paper-model columns: the paper's simplified model does not apply "
+                 f"({res.paper_model_reason})")
+    return Result(payload, text, note_lines("torques", sc) + law_warnings("torques", an.law),
+                  data)

@@ -11,7 +11,7 @@ from ..design.space import LENGTHS, SAMPLINGS, DesignSpace, check_objectives
 from ..errors import ConfigError
 from ..geometry import FiveBar
 from ..params import Param, read_params
-from .tables import Table, register_table
+from .base import Table
 
 #: Objectives when ``[design].objectives`` is not given.
 DEFAULT_OBJECTIVES = ("cycle_time_s", "footprint_mm", "-min_type2_distance")
@@ -93,6 +93,3 @@ class DesignTable(Table):
     def grid(self) -> int:
         """Time-optimal grid of the sweep's plans."""
         return int((self.values or {}).get("grid", 100))
-
-
-register_table(DesignTable)

@@ -7,20 +7,15 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, Any, ClassVar
+from typing import Any, ClassVar
 
 from ..errors import ConfigError, DextarError
 from ..geometry import canonical_working_mode
+from ..laws import LawType, law_type
 from ..params import Param, read_params, read_value, to_run_units
+from ..program import MOVE_TYPES, Move, MoveType, move_type
 from ..units import SI
-from .tables import Table, register_table
-
-if TYPE_CHECKING:
-    from ..laws import LawType
-    from ..program import Move, MoveType
-
-# The registries of laws and move types are imported where a table is read: the table's
-# declaration (its keys, for the command line and the config checks) needs neither.
+from .base import Table
 
 
 @dataclass(frozen=True)
@@ -52,10 +47,8 @@ class ProgramTable(Table):
     @classmethod
     def from_toml(cls, raw: Mapping[str, object]) -> ProgramTable:
         """Read ``[program]``."""
-        from ..laws import law_type
-
         t = cls(**read_params(cls.NAME, raw, cls.PARAMS))
-        law_type(t.law)
+        law_type(t.law, "config key [program].law")
         if t.working_mode is not None:
             try:
                 canonical_working_mode(t.working_mode)
@@ -63,8 +56,6 @@ class ProgramTable(Table):
                 raise ConfigError(f"config key [program].working_mode: {exc}") from None
         return t
 
-
-register_table(ProgramTable)
 
 #: The key of a path move (one that can be blended into the next).
 BLEND_PARAM = Param("number", "", None, "corner blend radius, mm", minimum=0.0)
@@ -91,33 +82,19 @@ def read_moves(raw: object, program: ProgramTable,
 
 
 def _move_kind(label: str, raw: Mapping[str, Any]) -> MoveType:
-    from ..program import MOVE_TYPES, move_type
-
     if "type" not in raw:
         raise ConfigError(f"config key {label}.type is required: one of "
                           f"{', '.join(MOVE_TYPES)}")
-    try:
-        return move_type(raw["type"])
-    except DextarError:
-        raise ConfigError(f"config key {label}.type must be one of {', '.join(MOVE_TYPES)}, "
-                          f"got {raw['type']!r}") from None
+    return move_type(raw["type"], f"config key {label}.type")
 
 
 def _read_move(i: int, raw: Mapping[str, Any], program: ProgramTable) -> Move:
-    from ..laws import law_type
-    from ..program import Move
-
     kind = raw.get("type")
     label = f"[[move]] {i} ({kind})" if isinstance(kind, str) else f"[[move]] {i}"
     mt = _move_kind(label, raw)
     lt = None
     if mt.has_law:
-        law_name = raw.get("law", program.law)
-        try:
-            lt = law_type(law_name)
-        except ConfigError:
-            raise ConfigError(f"config key {label}.law must be one of the laws, got "
-                              f"{law_name!r}") from None
+        lt = law_type(raw.get("law", program.law), f"config key {label}.law")
     law_keys = {k: p for k, p in (lt.params if lt else {}).items() if k != "duration"}
     known = ["type", *mt.params, *(("law", "duration") if lt else ()),
              *(("blend",) if mt.path is not None else ()), *law_keys]

@@ -7,55 +7,56 @@ happens here, once, as the objects are built.
 
 from __future__ import annotations
 
+import math
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from pathlib import Path as FilePath
-from typing import TYPE_CHECKING, Any, TypeVar
+from typing import Any, TypeVar
 
+from ..analysis import RunInputs
+from ..calibration import KinematicModel
+from ..design.evaluate import Task
+from ..design.space import DesignSpace
 from ..dynamics import Inertia, Model
+from ..dynamics.along_path import RobotAlongPath
 from ..errors import ConfigError, DextarError
 from ..geometry import FiveBar
 from ..kinematics.checker import Tolerances
+from ..laws import Law, LawRequest, law_type
 from ..motors import MotorLimits
+from ..output.config_file import model_toml
 from ..params import read_params
 from ..paths import Path
+from ..program import Move, ProgramRequest
+from ..program.drive import DriveUnits
+from ..trajectory import Trajectory, check_path, sample_trajectory
 from ..units import SI, Units
+from .base import TABLES, Table
 from .design import DesignTable
+from .design_task import design_task
+from .kinematic import InstrumentTable, RobotTable, config_notes, kinematic_model
 from .program import ProgramTable, read_moves
 from .tables import (
-    TABLES,
     ControlTable,
     DriveTable,
     FrictionTable,
     GravityTable,
     InertiaTable,
-    InstrumentTable,
     LawTable,
     MotorsTable,
     OutputTable,
     PaperTable,
     PathTable,
-    RobotTable,
-    Table,
     TolerancesTable,
 )
 from .toml import check_tables, read_config
 
-if TYPE_CHECKING:
-    from ..analysis import RunInputs
-    from ..calibration import KinematicModel
-    from ..design.evaluate import Task
-    from ..design.space import DesignSpace
-    from ..laws import Law
-    from ..program import Move, ProgramRequest
-    from ..program.drive import DriveUnits
-    from ..trajectory import Trajectory
-
-# The stages a scenario builds (laws, programs, the analysis) are imported by the methods
-# that build them: reading a config, or only its [robot] table, stays light.
-
 T = TypeVar("T", bound=Table)
+
+#: Where a scenario of no file comes from.
+DEFAULT_SOURCE = "defaults (the paper's example)"
 
 
 @dataclass(frozen=True)
@@ -77,7 +78,7 @@ class Scenario:
     """
 
     tables: Mapping[str, Table]
-    source: str = "defaults (the paper's example)"
+    source: str = DEFAULT_SOURCE
     moves: tuple[Move, ...] = ()
     doc: Mapping[str, Any] = field(default_factory=dict)
     text: bytes = b""
@@ -86,6 +87,17 @@ class Scenario:
         """The parsed table ``[name]`` (a registered table; the typed properties below name
         the built-in ones)."""
         return self.tables[name]
+
+    @property
+    def notes(self) -> tuple[str, ...]:
+        """What the user may not have meant, in words (each command says them on stderr and
+        beside its error; computed by :func:`~dextar.config.kinematic.config_notes`): a
+        config file with no table runs the paper's example; a robot that looks written in
+        metres."""
+        return config_notes(None if self.source == DEFAULT_SOURCE else self.source, self.doc,
+                            self.robot_table.geometry_mm,
+                            "this runs the paper's example (the DexTAR, the 120 mm semicircle, "
+                            "the optimal law)")
 
     def _get(self, cls: type[T]) -> T:
         t = self.tables[cls.NAME]
@@ -141,17 +153,13 @@ class Scenario:
 
     def drive(self) -> DriveUnits | None:
         """The drives in SI (``[drive]``), or None without the table."""
-        import math
-
-        from ..program.drive import DriveUnits
-
         t, off = self.drive_table, self.robot_table.encoder_offset_deg
         if not t.given:
             return None
         try:
             return DriveUnits(t.gear_ratio, (int(t.encoder_counts[0]), int(t.encoder_counts[1])),
                               t.rated_torque_Nm, (math.radians(off[0]), math.radians(off[1])),
-                              t.pvt_period_ms * 1e-3)
+                              t.pvt_period_ms * 1e-3, t.max_torque_permille)
         except DextarError as exc:
             raise ConfigError(f"config table [drive]: {exc}") from None
 
@@ -303,8 +311,6 @@ class Scenario:
 
     def program_request(self) -> ProgramRequest:
         """The program of a task file (``[program]``, ``[[move]]``, ``[motors]``) in SI."""
-        from ..program import ProgramRequest
-
         if not self.moves:
             raise ConfigError("the task has no move: add [[move]] tables")
         m = self.si_model
@@ -319,16 +325,12 @@ class Scenario:
         """A sweep's :class:`~dextar.design.evaluate.Task` and design space: a program task
         (``[program]`` and ``[[move]]``) or a run task (``[path]`` and ``[law]``; a law that
         does not depend on the robot is computed once here), in SI."""
-        from .design_task import design_task
-
         return design_task(self, samples=samples, seed=seed)
 
     def model_file(self, robot_mm: FiveBar, mode: str, inertia: Inertia, comment: str) -> str:
         """A config file of ``inertia`` (SI) on ``robot_mm`` with this scenario's friction
         speed and gravity and its ``[motors]`` and ``[tolerances]`` as the file gives them
         (``identified.toml``, ``best.toml``)."""
-        from ..output.config_file import model_toml
-
         return model_toml(robot_mm, mode, self.assembly, inertia,
                           coulomb_speed_deg_s=self.friction_table.coulomb_speed_deg_s,
                           gravity_mm_s2=self.gravity_table.vector,
@@ -337,10 +339,6 @@ class Scenario:
     def law(self, kind: str | None = None) -> Law:
         """The configured law, or the registered law ``kind`` with its defaults and the
         configured duration. The path is checked first (reach and singularities)."""
-        from ..dynamics.along_path import RobotAlongPath
-        from ..laws import LawRequest, law_type
-        from ..trajectory import check_path
-
         check_path(self.robot, self.path, mode=self.mode, tolerances=self.tolerances,
                    units=self.units)
         table = self.law_table
@@ -357,8 +355,6 @@ class Scenario:
 
     def inputs(self) -> RunInputs:
         """What the analysis of a run needs, in run units (no config beyond this point)."""
-        from ..analysis import RunInputs
-
         p = self.paper
         return RunInputs(self.robot, self.robot_mm, self.path, self.path_spec, self.mode,
                          self.assembly, self.inertia, self.units, self.output.samples,
@@ -367,8 +363,6 @@ class Scenario:
 
     def trajectory(self, law: Law | None = None, samples: int | None = None) -> Trajectory:
         """The law sampled along the path (``[output].samples`` by default)."""
-        from ..trajectory import sample_trajectory
-
         return sample_trajectory(self.robot, self.path, law or self.law(), mode=self.mode,
                                  samples=samples or self.output.samples,
                                  tolerances=self.tolerances, units=self.units)
@@ -392,10 +386,10 @@ def scenario_from_dict(doc: Mapping[str, Any], *, source: str | None = None,
         sc = Scenario(sc.tables, source, sc.moves, sc.doc, text)
     try:  # build the run's objects now: a bad value fails here, named by its table
         _ = (sc.units, sc.robot, sc.path, sc.inertia)
-    except ConfigError:
-        raise
     except DextarError as exc:
-        raise ConfigError(f"config: {exc}") from None
+        said = str(exc) if isinstance(exc, ConfigError) else f"config: {exc}"
+        raise ConfigError(said + (f" (note: {'; '.join(sc.notes)})" if sc.notes else "")
+                          ) from None
     return sc
 
 
@@ -404,15 +398,37 @@ def scenario_from_dict(doc: Mapping[str, Any], *, source: str | None = None,
 MODEL_TABLES = ("robot", "inertia", "friction", "gravity")
 
 
+#: The first line dextar writes at the top of a model it fitted to data (``identified.toml``,
+#: and ``calibrated.toml`` alike): ``# identified by dextar from DATA (STATUS: ...)``; the
+#: status is the verb when the fit succeeded.
+_FITTED_BY = re.compile(r"# (?P<verb>\w+) by dextar from (?P<data>.*?) \((?P<status>[^():]+): ")
+
+
+def check_model_status(model: str | FilePath, text: bytes) -> None:
+    """Refuse (:class:`ConfigError`) a model file whose first line says dextar's fit of it did
+    not succeed (``# identified by dextar from DATA (poor fit: ...)``): its status names
+    what to fix, and the user may delete that line to use the model anyway."""
+    first = text.split(b"\n", 1)[0].decode("utf-8", errors="replace").rstrip("\r")
+    m = _FITTED_BY.match(first)
+    if m is None or m["status"] == m["verb"]:
+        return
+    raise ConfigError(f"--model {str(model)!r} is a model dextar {m['verb']} from {m['data']} "
+                      f"with the status {m['status']!r}, not {m['verb']!r} (its first line "
+                      "gives the reasons): it is not used. Fit it again from better data, or "
+                      "delete that first line to use it anyway")
+
+
 def load_scenario(path: str | FilePath | None = None, *,
                   model: str | FilePath | None = None) -> Scenario:
     """Read a config file (or none: the paper's example) into a :class:`Scenario`; the file
     is read once. ``model``: a model file whose robot, inertia, friction and gravity replace
-    the config's (its other tables kept): what ``--model identified.toml`` does."""
+    the config's (its other tables kept): what ``--model identified.toml`` does; a model file
+    whose first line says its fit did not succeed is refused (:func:`check_model_status`)."""
     doc, text = ({}, b"") if path is None else read_config(path)
     source = None if path is None else str(path)
     if model is not None:
         mdoc, mtext = read_config(model)
+        check_model_status(model, mtext)
         missing = [t for t in ("robot", "inertia") if t not in mdoc]
         if missing:
             raise ConfigError(f"--model {str(model)!r} has no [{missing[0]}] table: a model "
@@ -426,36 +442,6 @@ def load_scenario(path: str | FilePath | None = None, *,
     if path is None and model is None:
         return scenario_from_dict({})
     return scenario_from_dict(doc, source=source, text=text)
-
-
-def load_robot_table(path: str | FilePath | None) -> RobotTable:
-    """``[robot]`` of a config file (every table's name checked; the DexTAR without a
-    file)."""
-    return load_kinematics(path)[0]
-
-
-def load_kinematics(path: str | FilePath | None
-                    ) -> tuple[RobotTable, InstrumentTable | None]:
-    """``[robot]`` and ``[instrument]`` (None when the file has none) of a config file, the
-    file read once, every table's name checked; the DexTAR without a file."""
-    if path is None:
-        return RobotTable(), None
-    doc, _ = read_config(path)
-    check_tables({k: v for k, v in doc.items() if k != "move"}, set(TABLES) | {"move"})
-    inst = doc.get("instrument")
-    return (RobotTable.from_toml(doc.get("robot", {})),
-            None if inst is None else InstrumentTable.from_toml(inst))
-
-
-def kinematic_model(robot: RobotTable, instrument: InstrumentTable | None = None
-                    ) -> KinematicModel:
-    """The calibration model (SI) of config tables: the geometry, the encoder offsets and
-    the instrument frame."""
-    from ..calibration import KinematicModel
-
-    return KinematicModel.from_config_units(
-        robot.geometry_mm, encoder_offset_deg=robot.encoder_offset_deg,
-        instrument=(instrument or InstrumentTable()).frame)
 
 
 def default_scenario() -> Scenario:

@@ -5,8 +5,9 @@ holds its values in config units (mm, deg, kg, s, N m) after :func:`read_params`
 them; errors name ``[table].key``. The conversion to the run's units happens once, where the
 :class:`~dextar.config.scenario.Scenario` builds the run's objects.
 
-A new table is a new dataclass with ``NAME``, ``PARAMS`` and (if it needs more than the
-generic reading) ``from_toml``, and one line: ``register_table(MyTable)``.
+The robot's own tables, ``[robot]`` and ``[instrument]``, are in
+:mod:`dextar.config.kinematic`; ``[program]`` in :mod:`dextar.config.program`, ``[design]`` in
+:mod:`dextar.config.design`; the registry in :mod:`dextar.config.base`.
 """
 
 from __future__ import annotations
@@ -14,152 +15,23 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, ClassVar, TypeVar
+from typing import Any, ClassVar
 
 from ..dynamics import Inertia, Rod
 from ..dynamics.friction import DEFAULT_COULOMB_SPEED_DEG_S
 from ..errors import ConfigError, DextarError
-from ..geometry import DEXTAR_MM, FiveBar, canonical_working_mode, parse_assembly_mode, preset
+from ..geometry import FiveBar
 from ..kinematics.checker import Tolerances
+from ..laws import LawType, law_type
 from ..motors import MotorLimits
 from ..output.run import FIGURES as FIGURES
 from ..params import Param, read_params, to_run_units
 from ..paths import Path, PathType, path_type
 from ..units import Units
-
-if TYPE_CHECKING:
-    from ..laws import LawType
-
-T = TypeVar("T", bound="Table")
+from .base import Table
 
 #: Most samples a run writes (a 200 s motion at 1 kHz).
 MAX_SAMPLES = 200_000
-
-
-class Table:
-    """Base of the table dataclasses: the generic reading of ``PARAMS``."""
-
-    NAME: ClassVar[str] = ""
-    PARAMS: ClassVar[dict[str, Param]] = {}
-
-    @classmethod
-    def from_toml(cls: type[T], raw: Mapping[str, object]) -> T:
-        """The table from its TOML contents (validated; absent keys take their defaults)."""
-        return cls(**read_params(cls.NAME, raw, cls.PARAMS))
-
-
-#: The table registry: TOML name -> dataclass.
-TABLES: dict[str, type[Table]] = {}
-
-
-def register_table(cls: type[T]) -> type[T]:
-    """Make ``[cls.NAME]`` a known table of the config files."""
-    TABLES[cls.NAME] = cls
-    return cls
-
-
-@dataclass(frozen=True)
-class RobotTable(Table):
-    """``[robot]``: the geometry in mm (a preset, lengths overriding it) and the modes."""
-
-    NAME: ClassVar[str] = "robot"
-    PARAMS: ClassVar[dict[str, Param]] = {
-        "preset": Param("text", "", None, "a named geometry: dextar"),
-        **{k: Param("number", "mm", None, f"length {k}", positive=True)
-           for k in ("l1", "l2", "L1", "L2", "d")},
-        "working_mode": Param("text", "", "+-", "++, +-, -+ or -- (aliases pp, pm, mp, mm)"),
-        "assembly_mode": Param("choice", "", "up", "up or down", choices=("up", "down")),
-        "encoder_offset_deg": Param("pair", "deg", (0.0, 0.0), "encoder offsets [phi, psi]: "
-                                    "geometric angle = reading + offset", minimum=-180.0,
-                                    maximum=180.0),
-        "encoder_counts": Param("number", "", None, "encoder counts per turn of a joint",
-                                positive=True, maximum=1e12),
-    }
-
-    geometry_mm: FiveBar = DEXTAR_MM
-    working_mode: str = "+-"
-    assembly_mode: str = "up"
-    #: ``(phi, psi)`` offsets in degrees: geometric angle = encoder reading + offset.
-    encoder_offset_deg: tuple[float, float] = (0.0, 0.0)
-    encoder_counts: float | None = None
-
-    @classmethod
-    def from_toml(cls, raw: Mapping[str, object]) -> RobotTable:
-        """Read ``[robot]``: without a preset, all five lengths are required;
-        ``encoder_offset_deg`` is a pair ``[phi, psi]`` (degrees)."""
-        off = raw.get("encoder_offset_deg")
-        if off is not None and not (isinstance(off, list) and len(off) == 2):
-            raise ConfigError("config key [robot].encoder_offset_deg must be a pair [phi, psi] "
-                              f"in degrees, got {type(off).__name__} {off!r}")
-        t = read_params(cls.NAME, raw, cls.PARAMS)
-        lengths: dict[str, float] = {k: t[k] for k in ("l1", "l2", "L1", "L2", "d") if k in t}
-        try:
-            if "preset" in t:
-                merged: dict[str, float] = {**preset(t["preset"]).as_dict(), **lengths}
-                geom = FiveBar(**merged)
-            elif lengths:
-                missing = [k for k in ("l1", "l2", "L1", "L2", "d") if k not in lengths]
-                if missing:
-                    raise ConfigError(f"config key [robot].{missing[0]} is required when no "
-                                      "preset is given")
-                geom = FiveBar(**lengths)
-            else:
-                geom = DEXTAR_MM
-            mode = canonical_working_mode(t["working_mode"])
-            parse_assembly_mode(t["assembly_mode"])
-        except ConfigError:
-            raise
-        except DextarError as exc:
-            raise ConfigError(f"config table [robot]: {exc}") from None
-        return cls(geom, mode, t["assembly_mode"], t["encoder_offset_deg"],
-                   t.get("encoder_counts"))
-
-    def geometric_deg(self, readings_deg: tuple[float, float]) -> tuple[float, float]:
-        """Geometric angles (deg) of encoder readings (deg): reading + offset."""
-        a, b = self.encoder_offset_deg
-        return (readings_deg[0] + a, readings_deg[1] + b)
-
-
-@dataclass(frozen=True)
-class InstrumentTable(Table):
-    """``[instrument]``: the measuring instrument (a laser tracker, a camera, a CMM) that
-    sees the robot: the pose of the robot frame in the instrument's frame (a point ``P`` of
-    the robot frame is measured at ``R(theta0) P + (x0, y0)``) and the instrument's noise.
-    It converts measured points only; every command works in the robot frame."""
-
-    NAME: ClassVar[str] = "instrument"
-    PARAMS: ClassVar[dict[str, Param]] = {
-        "x0_mm": Param("number", "mm", 0.0, "origin of the robot frame, instrument x",
-                       minimum=-1e6, maximum=1e6),
-        "y0_mm": Param("number", "mm", 0.0, "origin of the robot frame, instrument y",
-                       minimum=-1e6, maximum=1e6),
-        "theta0_deg": Param("number", "deg", 0.0, "angle of the robot frame's x axis in the "
-                            "instrument's frame", minimum=-360.0, maximum=360.0),
-        "sigma_mm": Param("number", "mm", None, "standard deviation of a measured point per "
-                          "axis (rows without sigma_mm)", positive=True, maximum=1e3),
-    }
-
-    x0_mm: float = 0.0
-    y0_mm: float = 0.0
-    theta0_deg: float = 0.0
-    sigma_mm: float | None = None
-
-    @property
-    def frame(self) -> tuple[float, float, float]:
-        """``(x0_mm, y0_mm, theta0_deg)``."""
-        return (self.x0_mm, self.y0_mm, self.theta0_deg)
-
-    def to_robot_mm(self, point_mm: tuple[float, float]) -> tuple[float, float]:
-        """A point measured in the instrument's frame (mm) in the robot frame (mm)."""
-        c, s = math.cos(math.radians(self.theta0_deg)), math.sin(math.radians(self.theta0_deg))
-        x, y = point_mm[0] - self.x0_mm, point_mm[1] - self.y0_mm
-        return (c * x + s * y, -s * x + c * y)
-
-    def to_instrument_mm(self, point_mm: tuple[float, float]) -> tuple[float, float]:
-        """A point of the robot frame (mm) in the instrument's frame (mm)."""
-        c, s = math.cos(math.radians(self.theta0_deg)), math.sin(math.radians(self.theta0_deg))
-        x, y = point_mm
-        return (c * x - s * y + self.x0_mm, s * x + c * y + self.y0_mm)
 
 
 @dataclass(frozen=True)
@@ -219,16 +91,12 @@ class LawTable(Table):
         if "samples" in raw:
             raise ConfigError("config key [law].samples is not known: use [output].samples "
                               "(the number of samples written)")
-        from ..laws import law_type  # the laws (and scipy) only for a table that names one
-
         kind = law_type(raw.get("type", "optimal"))
         return cls(kind.name, read_params(cls.NAME, raw, kind.params, ignore=("type",)))
 
     @property
     def kind(self) -> LawType:
         """The registered law."""
-        from ..laws import law_type
-
         return law_type(self.type)
 
     def run_values(self, units: Units) -> dict[str, Any]:
@@ -256,12 +124,18 @@ class InertiaTable(Table):
     PARAMS: ClassVar[dict[str, Param]] = {
         "effector_mass": Param("number", "kg", 1.0, "end-effector mass", positive=True),
         "payload": Param("number", "kg", 0.0, "payload at P", minimum=0.0),
-        "proximal_mass": _pair("kg", "proximal rods' masses", None, minimum=0.0),
-        "distal_mass": _pair("kg", "distal rods' masses", None, minimum=0.0),
-        "proximal_com": _pair("mm", "proximal centres of mass from the joint"),
-        "distal_com": _pair("mm", "distal centres of mass from the elbow"),
-        "proximal_inertia": _pair("", "proximal inertias about the com, kg mm^2", minimum=0.0),
-        "distal_inertia": _pair("", "distal inertias about the com, kg mm^2", minimum=0.0),
+        "proximal_mass": _pair("kg", "proximal rods' masses (default 0.08 x effector_mass)",
+                               None, minimum=0.0),
+        "distal_mass": _pair("kg", "distal rods' masses (default 0.1 x effector_mass)", None,
+                             minimum=0.0),
+        "proximal_com": _pair("mm", "proximal centres of mass from the joint (default: half "
+                              "the rod)"),
+        "distal_com": _pair("mm", "distal centres of mass from the elbow (default: half the "
+                            "rod)"),
+        "proximal_inertia": _pair("", "proximal inertias about the com, kg mm^2 (default: a "
+                                  "uniform rod, m l^2 / 12)", minimum=0.0),
+        "distal_inertia": _pair("", "distal inertias about the com, kg mm^2 (default: a "
+                                "uniform rod, m L^2 / 12)", minimum=0.0),
         "rotor_inertia": _pair("", "rotor inertias, kg mm^2", 0.0, minimum=0.0),
     }
 
@@ -356,6 +230,9 @@ class ControlTable(Table):
                               positive=True, maximum=1e6),
         "initial_error_deg": Param("point", "", (0.0, 0.0), "initial joint error [deg, deg], "
                                    "each within +-90"),
+        "tolerance_mm": Param("number", "mm", None, "the task error within which the motion "
+                              "is followed (default 3 % of the robot's reach); past it "
+                              "simulate exits 1", positive=True, maximum=1e9),
     }
 
     natural_frequency_hz: float = 10.0
@@ -364,6 +241,7 @@ class ControlTable(Table):
     payload: float | None = None
     torque_limit: float | None = None
     initial_error_deg: tuple[float, float] = (0.0, 0.0)
+    tolerance_mm: float | None = None
 
     @classmethod
     def from_toml(cls, raw: Mapping[str, object]) -> ControlTable:
@@ -386,6 +264,9 @@ class ControlTable(Table):
                 self.torque_limit),
             "torque_limit_nm": self.torque_limit,
             "initial_error": tuple(math.radians(v) for v in self.initial_error_deg),
+            "tolerance": None if self.tolerance_mm is None else units.length(
+                self.tolerance_mm),
+            "tolerance_mm": self.tolerance_mm,
         }
 
 
@@ -481,7 +362,8 @@ class MotorsTable(Table):
 
     NAME: ClassVar[str] = "motors"
     PARAMS: ClassVar[dict[str, Param]] = {
-        "peak_torque": _pair("N m", "peak torques", None, positive=True),
+        "peak_torque": _pair("N m", "peak torques (required when the table is given)", None,
+                             positive=True),
         "rms_torque": _pair("N m", "continuous (RMS) torque ratings", None, positive=True),
         "max_speed_rpm": _pair("", "maximum speeds, rpm", None, positive=True),
         "knee_speed_rpm": _pair("", "end of full torque, rpm (< max_speed_rpm)", None,
@@ -554,8 +436,11 @@ class DriveTable(Table):
         "encoder_counts": _pair("", "counts per motor turn", 4096.0, positive=True),
         "rated_torque_Nm": _pair("", "motor-side rated torque, N m (0x6076)", None,
                                  positive=True),
-        "pvt_period_ms": Param("number", "", 10.0, "period of the PVT points, ms",
-                               positive=True, maximum=1000.0),
+        "pvt_period_ms": Param("number", "", 10.0, "period of the PVT points, ms (a whole "
+                               "number of servo ticks)", positive=True, maximum=1000.0),
+        "max_torque_permille": _pair("", "largest torque the drive gives, per-mille of the "
+                                     "rated torque (0x6072); a torque feedforward beyond it "
+                                     "does not fit (exit 1)", None, positive=True),
     }
 
     gear_ratio: tuple[float, float] = (1.0, 1.0)
@@ -563,6 +448,7 @@ class DriveTable(Table):
     rated_torque_Nm: tuple[float, float] | None = None
     pvt_period_ms: float = 10.0
     given: bool = False
+    max_torque_permille: tuple[float, float] | None = None
 
     @classmethod
     def from_toml(cls, raw: Mapping[str, object]) -> DriveTable:
@@ -575,10 +461,9 @@ class DriveTable(Table):
         if any(c != int(c) for c in t.encoder_counts):
             raise ConfigError(f"config key [drive].encoder_counts {list(t.encoder_counts)} "
                               "must be whole numbers")
+        if t.max_torque_permille is not None and t.rated_torque_Nm is None:
+            raise ConfigError("config key [drive].max_torque_permille needs "
+                              "[drive].rated_torque_Nm (the torque it is a per-mille of)")
         return t
 
 
-for _cls in (RobotTable, PathTable, LawTable, InertiaTable, FrictionTable, GravityTable,
-             ControlTable, PaperTable, OutputTable, TolerancesTable, MotorsTable, DriveTable,
-             InstrumentTable):
-    register_table(_cls)

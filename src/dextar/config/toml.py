@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError
+from ..registry import UnknownNameError
 
 
 def read_config(path: str | Path) -> tuple[dict[str, Any], bytes]:
@@ -38,7 +39,7 @@ def check_tables(doc: Mapping[str, Any], known: Set[str]) -> None:
     """Every top-level name of ``doc`` is a known table holding a table."""
     for name, value in doc.items():
         if name not in known:
-            raise ConfigError(f"config table [{name}] is not known; known tables: "
-                              f"{', '.join(sorted(known))}")
+            raise UnknownNameError(f"config table [{name}] is not known; known tables: "
+                                   f"{', '.join(sorted(known))}", name, tuple(sorted(known)))
         if not isinstance(value, dict):
             raise ConfigError(f"config key {name!r} must be a table [{name}]")

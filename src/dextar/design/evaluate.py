@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from .._arrays import Array
+from .._lazy import lazy_module
 from ..dynamics import Inertia, Model, RobotAlongPath, Rod, inverse_dynamics
 from ..errors import DextarError
 from ..geometry import FiveBar
@@ -28,6 +29,8 @@ from ..program import Move, ProgramRequest, ProgramResult, sizing
 from ..trajectory import check_path, sample_trajectory
 from ..units import SI
 from .space import LENGTHS, METRICS
+
+ndimage = lazy_module("scipy.ndimage")
 
 #: Grid of the workspace map behind ``workspace_area_mm2`` (points per side).
 AREA_RESOLUTION = 61
@@ -134,7 +137,6 @@ def usable_area_mm2(robot_mm: FiveBar, mode: str, start_mm: Sequence[float],
     x, y = ws.x, ws.y
     i = int(np.argmin(np.abs(y - start_mm[1])))
     j = int(np.argmin(np.abs(x - start_mm[0])))
-    from scipy import ndimage
 
     labels, _ = ndimage.label(free)
     lab = labels[i, j]

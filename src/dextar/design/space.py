@@ -16,7 +16,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._arrays import Array
+from .._lazy import lazy_module
 from ..errors import ConfigError
+
+qmc = lazy_module("scipy.stats.qmc")
 
 #: The columns of a design, in mm.
 LENGTHS = ("l1", "l2", "L1", "L2", "d")
@@ -99,7 +102,6 @@ class DesignSpace:
         k = len(self.dims)
         n = self.samples
         if self.sampling == "sobol":
-            from scipy.stats import qmc  # (scipy.stats costs half a second to import)
 
             with warnings.catch_warnings():  # not a power of 2: balance is not needed here
                 warnings.simplefilter("ignore", UserWarning)

@@ -9,6 +9,7 @@ Rows reach the caller chunk by chunk (``on_chunk``), in the order chunks finish.
 
 from __future__ import annotations
 
+import importlib.util
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -16,8 +17,12 @@ from itertools import islice
 from typing import Any
 
 from .._arrays import Array
+from .._lazy import lazy_module
 from ..errors import ConfigError
 from .evaluate import Task, evaluate_chunk
+
+#: Dask's distributed scheduler (the ``design`` extra), imported when a sweep runs.
+dask_distributed = lazy_module("distributed")
 
 #: How to get the extra that holds Dask.
 INSTALL_HINT = "pip install -e '.[design]' (or pip install 'dextar[design]')"
@@ -38,12 +43,9 @@ class SweepStats:
 
 def require_dask() -> Any:
     """The ``distributed`` module, or a :class:`ConfigError` naming the extra to install."""
-    try:
-        import distributed
-    except ImportError:
-        raise ConfigError(f"dextar design needs Dask (dask.distributed): {INSTALL_HINT}"
-                          ) from None
-    return distributed
+    if importlib.util.find_spec("distributed") is None:
+        raise ConfigError(f"dextar design needs Dask (dask.distributed): {INSTALL_HINT}")
+    return dask_distributed
 
 
 def chunks_of(indices: Sequence[int], size: int) -> list[list[int]]:

@@ -1,11 +1,13 @@
 """Dynamics: inertial parameters, exact inverse and forward dynamics, the paper's model."""
 
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
+from .._lazy import lazy_attributes
 from .exact import (
     Model,
     Reactions,
     TorqueResult,
+    accelerations,
     bias_forces,
     gravity_torques,
     inverse_dynamics,
@@ -20,19 +22,13 @@ from .inertia import Inertia, Rod, paper_inertia
 if TYPE_CHECKING:
     from .along_path import RobotAlongJointLine, RobotAlongPath, time_optimal_law
 
-#: The robot along a path, imported on first use: it plans laws, and the laws bring scipy,
-#: which the model, its inertia and its exact dynamics do not need.
-_ALONG_PATH = ("RobotAlongJointLine", "RobotAlongPath", "time_optimal_law")
+# The robot along a path plans laws (dextar.laws, dextar.paths): imported when first used,
+# so that the model, its inertia and its exact dynamics (a calibration's model file, an
+# identification) load no law or path module.
+__getattr__, __dir__ = lazy_attributes(__name__, dict.fromkeys(
+    ("RobotAlongJointLine", "RobotAlongPath", "time_optimal_law"), ".along_path"))
 
 
-def __getattr__(name: str) -> Any:
-    if name in _ALONG_PATH:
-        from . import along_path
-
-        return getattr(along_path, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-__all__ = ["Inertia", "Model", "Reactions", "Rod", "bias_forces", "gravity_torques",
+__all__ = ["Inertia", "Model", "Reactions", "Rod", "accelerations", "bias_forces", "gravity_torques",
            "inverse_dynamics", "joint_reactions", "kinetic_energy", "mass_matrix",
            "paper_inertia", "state_dynamics", "TorqueResult", "trajectory_torques", "RobotAlongJointLine", "RobotAlongPath", "time_optimal_law"]

@@ -8,8 +8,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._arrays import Array
+from .._lazy import lazy_module
 from ..errors import ConvergenceError, ParameterError, SingularityError
-from .exact import Model, inverse_dynamics, mass_matrix, state_dynamics
+from .exact import Model, accelerations, state_dynamics
+
+integrate = lazy_module("scipy.integrate")
+interpolate = lazy_module("scipy.interpolate")
 
 TorqueFunction = Callable[[float, Array, Array], Array]
 
@@ -61,9 +65,8 @@ def torques_from_samples(t: Array, tau: Array) -> TorqueFunction:
     tau = np.asarray(tau, dtype=float)
     if tau.shape != (t.size, 2):
         raise ParameterError(f"torque samples must have shape ({t.size}, 2), got {tau.shape}")
-    from scipy.interpolate import CubicSpline
 
-    spl = CubicSpline(t, tau, axis=0)
+    spl = interpolate.CubicSpline(t, tau, axis=0)
 
     def fn(time: float, _q: Array, _dq: Array) -> Array:
         return np.asarray(spl(time))
@@ -91,7 +94,6 @@ def forward_dynamics(model: Model, torque: TorqueFunction, q0: object, dq0: obje
     ConvergenceError
         If the integrator fails.
     """
-    from scipy.integrate import solve_ivp
 
     t_eval = np.asarray(t_eval, dtype=float)
     if t_eval.ndim != 1 or t_eval.size < 2 or np.any(np.diff(t_eval) <= 0):
@@ -112,13 +114,12 @@ def forward_dynamics(model: Model, torque: TorqueFunction, q0: object, dq0: obje
         tau = np.asarray(torque(time, q, dq), dtype=float)
         return np.concatenate([dq, np.linalg.solve(M, tau - h)])
 
-    sol = solve_ivp(rhs, (t_eval[0], t_eval[-1]), y0, method=method, t_eval=t_eval, rtol=rtol,
+    sol = integrate.solve_ivp(rhs, (t_eval[0], t_eval[-1]), y0, method=method, t_eval=t_eval, rtol=rtol,
                     atol=atol, max_step=max_step)
     if not sol.success:
         raise ConvergenceError(f"forward dynamics failed at t = {sol.t[-1]:.6g}: {sol.message}")
     q, dq = sol.y[:2].T, sol.y[2:].T
     tau = np.array([torque(ti, qi, dqi) for ti, qi, dqi in zip(sol.t, q, dq, strict=True)])
-    h = inverse_dynamics(model, q, dq, np.zeros_like(q), t=sol.t)
-    ddq = np.linalg.solve(mass_matrix(model, q), (tau - h)[..., None])[..., 0]
+    ddq = accelerations(model, q, dq, tau, t=sol.t)
     return ForwardResult(t=sol.t, q=q, dq=dq, tau=tau, status=int(sol.status),
                          message=str(sol.message), ddq=ddq, nfev=nfev)

@@ -19,11 +19,13 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from .._arrays import Array
+from .._lazy import lazy_module
 from ..errors import ParameterError
 from .filtering import Conditioned
+
+spatial = lazy_module("scipy.spatial")
 
 #: Largest joint-space distance (rad) from a visited pose that counts as inside.
 REGION_RADIUS = math.radians(10.0)
@@ -84,7 +86,7 @@ class JointRegion:
 
     def distance(self, q: Array) -> Array:
         """Joint-space distance (n,) of poses ``q`` (n, 2) to the nearest pose of the region."""
-        d, _ = cKDTree(self.q).query(np.asarray(q, float).reshape(-1, 2))
+        d, _ = spatial.cKDTree(self.q).query(np.asarray(q, float).reshape(-1, 2))
         return np.asarray(d)
 
     def contains(self, q: Array, dq: Array) -> tuple[Array, Array]:

@@ -83,13 +83,16 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import ndimage, signal
 
 from .._arrays import Array
+from .._lazy import lazy_module
 from ..dynamics.exact import Model
 from ..dynamics.regressor import regressor
 from ..errors import NumericalError, ParameterError
 from .data import MotionData
+
+ndimage = lazy_module("scipy.ndimage")
+signal = lazy_module("scipy.signal")
 
 #: The state filter's cut-off never exceeds this fraction of the sample rate.
 STATE_FRACTION = 0.1
@@ -249,7 +252,7 @@ def _lowpass(x: Array, fc: float, fs: float) -> Array:
     return np.asarray(signal.sosfiltfilt(sos, x, axis=0))
 
 
-def _speed_noise(floor: Array, fc: float, fs: float, derivative: bool) -> Array:
+def filtered_noise(floor: Array, fc: float, fs: float, derivative: bool) -> Array:
     """Standard deviation of a white noise of one-sided density ``floor`` (k,) after the
     zero-phase filter at ``fc`` and, with ``derivative``, the central difference."""
     f = np.linspace(0.0, 0.5 * fs, 4097)
@@ -258,6 +261,9 @@ def _speed_noise(floor: Array, fc: float, fs: float, derivative: bool) -> Array:
     if derivative:
         gain = gain * (fs * np.sin(2 * np.pi * f / fs)) ** 2
     return np.asarray(np.sqrt(floor * float(np.trapezoid(gain, f))))
+
+
+_speed_noise = filtered_noise
 
 
 def uncertain_sign(dq: Array, min_speed: Array) -> Array:

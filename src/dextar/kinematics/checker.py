@@ -91,6 +91,13 @@ def pose_distances(robot: FiveBar, q: Array, P: Array) -> PoseDistances:
     return PoseDistances(np.minimum(b1, b2), np.abs(det), det)
 
 
+def not_a_number(P: Array) -> str:
+    """Why a point that is not finite is no point: ``"is not a number (x is NaN)"``."""
+    bad = [f"{c} is {'NaN' if np.isnan(v) else 'infinite'}"
+           for c, v in zip("xy", np.asarray(P, float), strict=False) if not np.isfinite(v)]
+    return f"is not a number ({' and '.join(bad)})"
+
+
 def check_reach(robot: FiveBar, P: Array, where: Callable[[int], str],
                 point: Callable[[Array], str], length: Callable[[float], str]) -> None:
     """Raise :class:`ReachError` for the first point (n, 2) out of reach of a leg.
@@ -98,6 +105,10 @@ def check_reach(robot: FiveBar, P: Array, where: Callable[[int], str],
     ``where(i)`` names the sample (a time, a path parameter, an index), ``point(P)`` and
     ``length(x)`` put a point and a distance in the user's words.
     """
+    finite = np.isfinite(P).all(axis=-1)
+    if not finite.all():
+        i = int(np.flatnonzero(~finite)[0])
+        raise ReachError(f"{where(i)}: point {point(P[i])} {not_a_number(P[i])}")
     out, rho = reach_violation(robot, P)
     bad = out > 0
     if bad.any():

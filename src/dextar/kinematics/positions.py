@@ -15,6 +15,7 @@ import numpy as np
 from .._arrays import Array, as_points, blocks, cos_sin, cross, flat_index, where
 from ..errors import AssemblyError, ReachError
 from ..geometry import FiveBar, parse_assembly_mode, parse_working_mode
+from .checker import not_a_number
 
 
 def _leg_solve(
@@ -38,6 +39,9 @@ def _leg_solve(
 def _reach_error(
     P: Array, shape: tuple[int, ...], i: int, rho2: float, l: float, L: float, leg: int
 ) -> ReachError:
+    if not np.isfinite(P[i]).all():
+        return ReachError(f"point ({P[i, 0]:.6g}, {P[i, 1]:.6g})"
+                          f"{where(flat_index(i, shape), shape)} {not_a_number(P[i])}")
     rho = float(np.sqrt(rho2))
     rin, rout = abs(l - L), l + L
     out = max(rin - rho, rho - rout, 0.0)

@@ -16,8 +16,10 @@ import numpy as np
 
 from .._arrays import Array
 from ..errors import ParameterError
+from ..params import Param
 from ..paths import Path
 from ..units import Units
+from .registry import LawType, register_law
 
 
 def _positive(name: str, value: float) -> float:
@@ -166,7 +168,10 @@ class TrapezoidalLaw(Law):
                 raise ParameterError(f"trapezoid: distance {S:.6g} cannot be covered in "
                                      f"duration {T:.6g} with amax {a:.6g} (needs at least "
                                      f"{tmin:.6g})")
-            v = 0.5 * (a * T - math.sqrt(disc))
+            # the smaller root of v^2 - a T v + a S = 0, without the cancellation of
+            # (a T - sqrt(disc)) / 2, which gave v = 0 (no motion at all) where a T^2 >> S
+            # (a 1e9 s trapezoid over 123 mm: found by the long-motion fuzz shape)
+            v = 2.0 * a * S / (a * T + math.sqrt(disc))
             if v > vm * (1 + 1e-12):
                 raise ParameterError(f"trapezoid: duration {T:.6g} needs cruise speed {v:.6g} "
                                      f"above vmax {vm:.6g}")
@@ -196,8 +201,10 @@ class TrapezoidalLaw(Law):
         return cls(S, v * (1.0 + 1e-12), v / (rho * T), T)
 
     def report(self, units: Units) -> dict[str, Any]:
-        """The limits and the cruise speed (run units)."""
-        return {"vmax": self.vmax, "amax": self.amax, "cruise_speed": self.cruise}
+        """The limits and the cruise speed (run units; ``vmax`` None when none was given:
+        a trapezoid of a duration without one)."""
+        return {"vmax": self.vmax if math.isfinite(self.vmax) else None, "amax": self.amax,
+                "cruise_speed": self.cruise}
 
     def breakpoints(self) -> Array:
         """The ends of the acceleration and deceleration phases."""
@@ -306,9 +313,6 @@ def _fit_trapezoid(r: Any, shortest: Any) -> TrapezoidalLaw:
 
 
 def _register() -> None:
-    from ..params import Param
-    from .registry import LawType, register_law
-
     duration = Param("number", "s", 1.0, "motion time", positive=True)
     register_law(LawType("uniform", {"duration": duration},
                          lambda r: UniformLaw(r.path.length, r.params["duration"]),

@@ -49,10 +49,16 @@ import numpy as np
 from numpy.polynomial import chebyshev as cheb
 
 from .._arrays import Array
+from .._lazy import lazy_module
 from ..errors import ConvergenceError, ParameterError
+from ..params import Param
 from ..paths import Path
 from ..units import Units
 from .base import Law, _positive, law_cost
+from .registry import LawType, register_law
+
+integrate = lazy_module("scipy.integrate")
+interpolate = lazy_module("scipy.interpolate")
 
 
 def line_solution(G: float, tau: Array) -> Array:
@@ -513,8 +519,20 @@ class _Solution(NamedTuple):
     integrals: tuple[float, float] | None = None
 
 
+def _said(T: float, eta: float, m: float, S: float, units: Units | None) -> dict[str, str]:
+    """The law's figures in words, in the user's units (s, s^2/kg, kg, mm) when the run's
+    are known, else as they are."""
+    if units is None:
+        return {"eta": f"eta = {eta:g}", "duration": f"duration {T:g}", "mass": f"mass {m:g}",
+                "length": f"{S:.6g}"}
+    return {"eta": f"eta = {eta * units.time_s**2 / units.mass_kg:g} s^2/kg",
+            "duration": f"duration {T * units.time_s:g} s",
+            "mass": f"mass {m * units.mass_kg:g} kg", "length": f"{S * units.length_mm:.6g} mm"}
+
+
 def solve_optimal_law(path: Path, *, duration: float = 1.0, eta: float = 0.1, mass: float = 1.0,
-                      tol: float = 1e-10, max_nodes: int = 1024) -> OptimalLaw:
+                      tol: float = 1e-10, max_nodes: int = 1024,
+                      units: Units | None = None) -> OptimalLaw:
     """Solve the paper's optimal law of motion along ``path``.
 
     Parameters
@@ -531,6 +549,8 @@ def solve_optimal_law(path: Path, *, duration: float = 1.0, eta: float = 0.1, ma
         Target for the ODE residual between the nodes, relative to ``1 + max |s''''|``.
     max_nodes : int
         Largest number of Chebyshev nodes tried (per element).
+    units : Units, optional
+        The run's units, so that an error speaks the user's (s, kg, s^2/kg, mm).
 
     Returns
     -------
@@ -547,10 +567,12 @@ def solve_optimal_law(path: Path, *, duration: float = 1.0, eta: float = 0.1, ma
     m = _positive("mass", mass)
     S = path.length
     G = T / math.sqrt(eta * m)
-    if G > 1e4:
-        raise ParameterError(f"eta = {eta:g} is too small for duration {T:g} and mass {m:g}: "
-                             f"boundary layers of relative width {1 / G:.1e} (need "
-                             f"T / sqrt(eta m) <= 1e4)")
+    said = _said(T, eta, m, S, units)
+    if not G <= 1e4:
+        raise ParameterError(f"{said['eta']} is too small for {said['duration']} and "
+                             f"{said['mass']}: boundary layers of relative width {1 / G:.1e} "
+                             f"(need duration / sqrt(eta mass) <= 1e4, here {G:.3g}): a larger "
+                             "eta or a shorter duration")
     if path.constant_curvature is not None:
         sol = _solve_spectral(path.constant_curvature * S, G, tol, max_nodes)
     else:
@@ -559,8 +581,9 @@ def solve_optimal_law(path: Path, *, duration: float = 1.0, eta: float = 0.1, ma
             sol = _solve_local(path, S, G, max(tol, 1e-8))
     if sol.sigma is None:
         raise ConvergenceError(
-            f"optimal law did not converge for eta = {eta:g}, mass = {m:g}, duration {T:g} on "
-            f"a path of length {S:.6g} (G = T/sqrt(eta m) = {G:.4g}) with {sol.method}")
+            f"optimal law did not converge for {said['eta']}, {said['mass']}, "
+            f"{said['duration']} on a path of length {said['length']} (duration / sqrt(eta "
+            f"mass) = {G:.4g}) with {sol.method}")
     resid, nodes = sol.residual, sol.nodes
     law = OptimalLaw(distance=S, duration=T, eta=eta, mass=m, sigma=sol.sigma, residual=resid,
                      nodes=nodes, iterations=sol.iterations,
@@ -768,13 +791,11 @@ def _solve_local(path: Path, S: float, G: float, tol: float) -> _Solution:
     refinement (scipy's solve_bvp), by continuation in the curvature (``kappa -> lam kappa``,
     ``lam`` from 0, the straight line whose solution is exact, to 1) with adaptive steps, at
     most MAX_CONTINUATION_SOLVES solves."""
-    from scipy.integrate import solve_bvp
-    from scipy.interpolate import make_interp_spline
 
     # curvature along the normalised arc length, tabulated once at 4097 nodes and interpolated
     # by a quintic spline (smooth, so the mesh refinement does not chase interpolation kinks)
     grid = np.linspace(0.0, 1.0, 4097)
-    K_of = make_interp_spline(grid, path.curvature(path.parameter_at(grid * S))[0] * S, k=5)
+    K_of = interpolate.make_interp_spline(grid, path.curvature(path.parameter_at(grid * S))[0] * S, k=5)
     Ks_of = K_of.derivative()
 
     def curvature(sig: Array) -> tuple[Array, Array]:
@@ -805,7 +826,7 @@ def _solve_local(path: Path, S: float, G: float, tol: float) -> _Solution:
     lam, step, solves = 0.0, 1.0, 0
     while lam < 1.0:
         target = min(1.0, lam + step)
-        trial = solve_bvp(make(target), bc, mesh, guess, tol=tol if target == 1.0 else 1e-5,
+        trial = integrate.solve_bvp(make(target), bc, mesh, guess, tol=tol if target == 1.0 else 1e-5,
                           max_nodes=50_000)
         solves += 1
         if trial.success:
@@ -830,15 +851,13 @@ def _solve_local(path: Path, S: float, G: float, tol: float) -> _Solution:
 
 
 def _register() -> None:
-    from ..params import Param
-    from .registry import LawType, register_law
-
     register_law(LawType(
         "optimal",
         {"duration": Param("number", "s", 1.0, "motion time", positive=True),
          "eta": Param("number", "s^2/kg", 0.1, "weight of the mean-square inertia forces",
                       positive=True)},
         lambda r: solve_optimal_law(r.path, duration=r.params["duration"], eta=r.params["eta"],
+                                    units=r.units,
                                     mass=r.mass),
         "the paper's optimal law: minimise (m/2) Int |rdot|^2 + (eta m^2/2) Int |rddot|^2"))
 

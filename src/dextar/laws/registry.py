@@ -15,13 +15,15 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from ..errors import ConfigError
 from ..params import Param
 from ..paths import Path
+from ..registry import Registry
 from ..units import Units
-from .base import Law
+
+if TYPE_CHECKING:  # (the laws' modules import this one to register themselves)
+    from .base import Law
 
 
 @dataclass(frozen=True)
@@ -55,7 +57,7 @@ class LawRequest:
 
 #: ``shortest(family, t_min) -> T``: the shortest duration ``T >= t_min`` for which the law
 #: ``family(T)`` stays within the motors (given by the planner that fits a duration).
-Shortest = Callable[[Callable[[float], Law], float], float]
+Shortest = Callable[[Callable[[float], "Law"], float], float]
 
 
 @dataclass(frozen=True)
@@ -90,18 +92,17 @@ class LawType:
     fit: Callable[[LawRequest, Shortest], Law] | None = None
 
 
-LAW_TYPES: dict[str, LawType] = {}
+#: The laws by config name; installed packages add theirs through the entry-point group
+#: ``dextar.laws``.
+LAW_TYPES: Registry[LawType] = Registry("law", "config key [law].type", group="dextar.laws")
 
 
 def register_law(kind: LawType) -> LawType:
     """Add a law to the registry (a later registration of the same name replaces it)."""
-    LAW_TYPES[kind.name] = kind
-    return kind
+    return LAW_TYPES.register(kind)
 
 
-def law_type(name: object) -> LawType:
-    """The registered law ``name``; a :class:`ConfigError` lists the known ones."""
-    if not isinstance(name, str) or name not in LAW_TYPES:
-        raise ConfigError(f"config key [law].type must be one of {', '.join(LAW_TYPES)}, got "
-                          f"{name!r}")
-    return LAW_TYPES[name]
+def law_type(name: object, where: str | None = None) -> LawType:
+    """The registered law ``name``; an :class:`~dextar.registry.UnknownNameError` (a
+    :class:`~dextar.errors.ConfigError`) naming ``where`` lists the known ones."""
+    return LAW_TYPES.lookup(name, where)

@@ -43,8 +43,9 @@ import numpy as np
 
 from .._arrays import Array
 from .._compiled import usable
-from ..errors import InfeasibleError, ParameterError
+from ..errors import ConfigError, InfeasibleError, ParameterError
 from ..motors import MotorLimits
+from ..params import Param
 from ..units import Units
 from .base import Law
 from .constraints import (
@@ -57,6 +58,7 @@ from .constraints import (
     ratios_by_kind,
     speed_cap,
 )
+from .registry import LawType, register_law
 
 try:  # the reachability analysis compiled (_reach.c), built by pip where a C compiler is
     from . import _reach as _compiled
@@ -610,8 +612,6 @@ def _law(S: float, s: Array, x: Array, tmax: tuple[float, float],
 
 def _build(r: Any) -> TimeOptimalLaw:
     """The registered builder: limits from ``[law]`` when given, else from ``[motors]``."""
-    from ..errors import ConfigError
-
     p = r.params
     motors = r.motors
     if p.get("torque_limit") is not None:
@@ -623,9 +623,6 @@ def _build(r: Any) -> TimeOptimalLaw:
 
 
 def _register() -> None:
-    from ..params import Param
-    from .registry import LawType, register_law
-
     register_law(LawType(
         "time-optimal",
         {"torque_limit": Param("pair", "N m", None, "motor torque limits [A, D] (default: "

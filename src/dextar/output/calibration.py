@@ -11,22 +11,30 @@ import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from matplotlib.figure import Figure
 
 from .._arrays import Array
-from ..calibration.accuracy import AccuracyMap
+from .._lazy import lazy_module
+from ..calibration.accuracy import AccuracyMap, accuracy_map
 from ..calibration.data import PoseData, rows_text
-from ..calibration.fit import CalibrationResult, Errors
+from ..calibration.fit import CalibrationResult, Errors, encoder_std
 from ..calibration.model import FRAME, KinematicModel, to_file_units
 from ..calibration.poses import PoseSelection
 from ..errors import NumericalError
 from ..geometry import WORKING_MODES, FiveBar
 from .config_file import toml_number as _num
+from .figures import png_bytes
 from .files import OutputDir
 from .html_page import figures, page
+
+if TYPE_CHECKING:  # the real module; at run time matplotlib is imported where first used
+    import matplotlib.figure as mfigure
+    from matplotlib.figure import Figure
+else:
+    mfigure = lazy_module("matplotlib.figure")
+
 
 #: Colour of each working mode in the figures.
 MODE_COLOURS = {"++": "tab:blue", "+-": "tab:orange", "-+": "tab:green", "--": "tab:red"}
@@ -34,6 +42,9 @@ STATUS_WORDS = {0: "calibrated", 1: "not converged", 2: "residuals above the sta
                 3: "outliers"}
 #: The status code of a fit whose data hold outliers (no calibrated config is written).
 OUTLIERS = 3
+#: The status code of a fit that did not converge (no calibrated config is written: its
+#: parameters are where the solver stopped, not a calibration).
+NOT_CONVERGED = 1
 #: Every file of ``dextar calibrate``.
 CALIBRATION_FILES = ("calibrated.toml", "parameters.csv", "summary.json", "residuals.png",
                      "accuracy.png", "report.html")
@@ -53,7 +64,7 @@ def poses_csv(sel: PoseSelection) -> str:
 
 def poses_summary(sel: PoseSelection) -> dict[str, Any]:
     """The selection's figures, JSON-ready: count per mode, the index, O1, O3, condition
-    number, singularity distances."""
+    number, singularity distances, the modes asked for without a pose, the region (mm)."""
     o = sel.observability
     return {"status": sel.status, "success": sel.success, "message": sel.message,
             "n_poses": len(sel), "n_candidates": sel.n_candidates,
@@ -61,13 +72,15 @@ def poses_summary(sel: PoseSelection) -> dict[str, Any]:
             "assembly": sel.assembly, "parameters": list(sel.parameters), "index": sel.index,
             "o1": o.o1, "o3": o.o3, "condition_number": o.condition_number,
             "min_type1_distance": float(sel.type1.min()),
-            "min_type2_distance": float(sel.type2.min())}
+            "min_type2_distance": float(sel.type2.min()),
+            "missing_modes": list(sel.missing_modes),
+            "region_mm": None if sel.region is None else [1e3 * v for v in sel.region]}
 
 
 def poses_figure(sel: PoseSelection, robot: FiveBar) -> Figure:
     """The poses over the legs' reach of ``robot`` (m), coloured by working mode, numbered in
     visiting order (robot frame, mm)."""
-    fig = Figure(figsize=(7.0, 5.6))
+    fig = mfigure.Figure(figsize=(7.0, 5.6))
     ax = fig.subplots()
     _robot_outline(ax, robot)
     P = 1e3 * sel.points
@@ -213,7 +226,7 @@ def residuals_figure(res: CalibrationResult, validation: PoseData | None = None)
     seen (the key gives the scale); a second row for held-out poses (``validation``, the
     :class:`PoseData` of ``res.validation``) when given."""
     rows = 2 if (validation is not None and res.validation is not None) else 1
-    fig = Figure(figsize=(11.0, 4.6 * rows))
+    fig = mfigure.Figure(figsize=(11.0, 4.6 * rows))
     axes = np.atleast_2d(fig.subplots(rows, 2, squeeze=False))
     robot = res.calibrated.robot
     R = res.calibrated.rotation()
@@ -244,7 +257,7 @@ def accuracy_figure(maps: Sequence[AccuracyMap], points: Mapping[str, Array] | N
     n = len(maps)
     cols = 1 if n == 1 else 2
     rows = (n + cols - 1) // cols
-    fig = Figure(figsize=(6.0 * cols, 4.8 * rows))
+    fig = mfigure.Figure(figsize=(6.0 * cols, 4.8 * rows))
     axes = np.atleast_1d(fig.subplots(rows, cols, squeeze=False)).ravel()
     vals = np.concatenate([1e6 * m.std[m.valid] for m in maps]) if maps else np.zeros(0)
     vmax = float(np.quantile(vals, 0.95)) if vals.size else 1.0
@@ -365,11 +378,13 @@ def _toml_value(v: Any) -> str:
 def calibrated_toml(model: KinematicModel, *, working_mode: str, assembly_mode: str,
                     frame_identified: bool = True, encoder_counts: float | None = None,
                     extra: Mapping[str, Any] | None = None, comment: str = "",
-                    sigma_mm: float | None = None) -> str:
+                    sigma_mm: float | None = None,
+                    region_mm: Sequence[float] | None = None) -> str:
     """A config whose ``[robot]`` is the calibrated robot (lengths in mm and
     ``encoder_offset_deg = [phi, psi]``, with ``encoder_counts`` when given) and whose
     ``[instrument]`` (``x0_mm, y0_mm, theta0_deg``) is the identified frame (when
-    ``frame_identified``; ``sigma_mm`` the instrument's noise, kept with it); the tables of
+    ``frame_identified``; ``sigma_mm`` the instrument's noise and ``region_mm`` where it
+    measures, kept with it); the tables of
     ``extra`` (the rest of the user's config, raw TOML values; arrays of tables as lists of
     tables) follow as given."""
     r = FiveBar(*(to_file_units(n, v) for n, v in model.robot.as_dict().items()))
@@ -392,10 +407,13 @@ def calibrated_toml(model: KinematicModel, *, working_mode: str, assembly_mode: 
         x0, y0, th = (model.in_file_units()[n] for n in FRAME)
         lines += ["", "[instrument]           # the robot frame in the instrument's frame",
                   f"x0_mm = {_num(x0)}", f"y0_mm = {_num(y0)}", f"theta0_deg = {_num(th)}"]
-    elif sigma_mm is not None:
+    elif sigma_mm is not None or region_mm is not None:
         lines += ["", "[instrument]           # points measured in the robot frame"]
     if sigma_mm is not None:
         lines.append(f"sigma_mm = {_num(sigma_mm)}   # per axis")
+    if region_mm is not None:
+        lines.append(f"region = [{', '.join(_num(v) for v in region_mm)}]   # mm, robot "
+                     "frame: xmin, xmax, ymin, ymax")
     for name, table in (extra or {}).items():
         if name in ("robot", "instrument") or name in top:
             continue
@@ -418,23 +436,21 @@ def calibration_files(res: CalibrationResult, *, data: str, config: str = "",
                       extra: Mapping[str, Any] | None = None,
                       validation: PoseData | None = None, figures: bool = True,
                       resolution: int = 121, dpi: int = 110, outliers: Sequence[int] = (),
-                      outlier_message: str = "", sigma_mm: float | None = None
-                      ) -> dict[str, str | bytes]:
-    """Every file of ``dextar calibrate`` by name: ``calibrated.toml``, ``parameters.csv``,
-    ``summary.json`` and, with ``figures``, ``residuals.png``, ``accuracy.png`` and
-    ``report.html`` (the accuracy maps of the working modes of the kept poses, in
+                      outlier_message: str = "", sigma_mm: float | None = None,
+                      region_mm: Sequence[float] | None = None) -> dict[str, str | bytes]:
+    """Every file of ``dextar calibrate`` by name: ``calibrated.toml`` (not for a fit that
+    did not converge), ``parameters.csv``, ``summary.json`` and, with ``figures``,
+    ``residuals.png``, ``accuracy.png`` and ``report.html`` (the accuracy maps of the working modes of the kept poses, in
     ``assembly_mode``, with the encoders' rounding of ``encoder_counts`` per turn).
 
     ``extra`` holds the user's other config tables (raw TOML values) to carry into
     ``calibrated.toml``; ``validation`` the held-out poses of ``res.validation`` (drawn in
     ``residuals.png``); ``resolution`` the accuracy maps' grid, ``dpi`` the figures';
-    ``sigma_mm`` the instrument's noise (``[instrument].sigma_mm``), kept in the config. With ``outliers`` (the rows of a fit that kept them, see :func:`calibration_summary`)
+    ``sigma_mm`` the instrument's noise (``[instrument].sigma_mm``) and ``region_mm`` where
+    it measures (``[instrument].region``), kept in the config.
+    With ``outliers`` (the rows of a fit that kept them, see :func:`calibration_summary`)
     every file but ``calibrated.toml`` is written: a diagnosis, not a calibration.
     """
-    from ..calibration.accuracy import accuracy_map
-    from ..calibration.fit import encoder_std
-    from .figures import png_bytes
-
     kept = res.data.subset(res.kept)
     reading_std = None if encoder_counts is None else encoder_std(encoder_counts)
     modes = [m for m in WORKING_MODES if m in kept.modes]
@@ -448,11 +464,11 @@ def calibration_files(res: CalibrationResult, *, data: str, config: str = "",
                f"{summary['rms_error_before_mm']:.4g} -> {summary['rms_error_after_mm']:.4g} "
                f"mm RMS over {summary['n_poses']} poses)")
     files: dict[str, str | bytes] = {}
-    if not outliers:
+    if not outliers and res.status != NOT_CONVERGED:
         files["calibrated.toml"] = calibrated_toml(
             res.calibrated, working_mode=working_mode, assembly_mode=assembly_mode,
             frame_identified=res.frame == "instrument", encoder_counts=encoder_counts,
-            extra=extra, comment=comment, sigma_mm=sigma_mm)
+            extra=extra, comment=comment, sigma_mm=sigma_mm, region_mm=region_mm)
     files["parameters.csv"] = parameters_csv(res)
     files["summary.json"] = json.dumps(summary, indent=2, allow_nan=False) + "\n"
     if figures:
@@ -493,7 +509,11 @@ def poses_text(sel: PoseSelection, where: str) -> str:
 
 
 def poses_warnings(sel: PoseSelection) -> list[str]:
-    """A warning when the selection relaxed its spacing."""
+    """A warning when the selection relaxed its spacing; the working modes without a pose
+    (exit 1)."""
+    if sel.missing_modes:
+        return [f"dextar poses: {sel.message.split('; ')[-1]}: choose --modes among those "
+                "with poses, widen the region or lower the margin"]
     return [] if sel.success else [f"dextar poses: warning: {sel.message}"]
 
 
@@ -577,15 +597,18 @@ class CalibrationRun:
         nominal robot assumed."""
         res = self.result
         if self.outliers:  # one line: the rows, what to do, where the diagnosis is
-            return [f"dextar calibrate: {self.problem} (--robust soft_l1); the fit with them "
+            them = "it" if len(self.outliers) == 1 else "them"
+            return [f"dextar calibrate: {self.problem} (--robust soft_l1); the fit with {them} "
                     f"kept is in {self.out} (no calibrated.toml)"]
         out: list[str] = []
         if res.status != 0:
             stated = (f"; or [instrument].sigma_mm = {self.sigma_mm:g} mm understates the "
                       "instrument's noise" if res.status == 2 and res.data.sigma is None
                       and self.sigma_mm is not None else "")
+            unwritten = (f"; no calibrated.toml written (the files in {self.out} are a "
+                         "diagnosis)" if res.status == NOT_CONVERGED else "")
             out.append(f"dextar calibrate: {STATUS_WORDS.get(res.status)}: "
-                       f"{res.message}{stated}")
+                       f"{res.message}{stated}{unwritten}")
         if res.rejected:
             out.append(f"dextar calibrate: note: the robust loss {self.robust} rejected "
                        f"row{'s' if len(res.rejected) > 1 else ''} "

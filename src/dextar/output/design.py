@@ -10,22 +10,29 @@ import json
 import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from matplotlib.figure import Figure
 
 from .._arrays import Array
+from .._lazy import lazy_module
 from ..design.pareto import Choice
 from ..design.space import LENGTHS, METRICS, DesignSpace
 from ..design.sweep import SweepStats
 from ..errors import ConfigError
 from ..geometry import FiveBar
 from ..kinematics import workspace_map
-from .figures import plot_workspace
+from .figures import plot_workspace, png_bytes, svg_bytes
 from .files import OutputDir, write_text
 from .html_page import figures, grid, page, table
 from .tables import number
+
+if TYPE_CHECKING:  # the real module; at run time matplotlib is imported where first used
+    import matplotlib.figure as mfigure
+    from matplotlib.figure import Figure
+else:
+    mfigure = lazy_module("matplotlib.figure")
+
 
 #: Columns of designs.csv and pareto.csv.
 COLUMNS = ("design", *(f"{k}_mm" for k in LENGTHS), "feasible", "reason", *METRICS)
@@ -79,7 +86,7 @@ def parse_line(line: str) -> dict[str, Any] | None:
 def pareto_figure(F: Array, pareto: Array, best: int, names: Sequence[str]) -> Figure:
     """The feasible designs on the first two objectives (minimised; a maximised objective
     is drawn with its sign), the Pareto designs marked, the chosen one starred."""
-    fig = Figure(figsize=(6.0, 4.6))
+    fig = mfigure.Figure(figsize=(6.0, 4.6))
     ax = fig.subplots()
     if F.shape[1] == 1:
         ax.plot(np.sort(F[:, 0]), ".", color="0.6", label="feasible designs (sorted)")
@@ -104,7 +111,7 @@ def scatter_matrix(X: Array, feasible: Array, names: Sequence[str]) -> Figure:
     """Every pair of varied lengths (mm; tied lengths are one axis), feasible designs in
     blue, the others in grey."""
     k = X.shape[1]
-    fig = Figure(figsize=(2.2 * k + 1, 2.2 * k + 1))
+    fig = mfigure.Figure(figsize=(2.2 * k + 1, 2.2 * k + 1))
     axes = fig.subplots(k, k, squeeze=False)
     for i in range(k):
         for j in range(k):
@@ -288,8 +295,6 @@ def write_sweep_outputs(od: OutputDir, summary: Mapping[str, Any], choice: Choic
     if best_toml is not None:
         od.write_text("best.toml", best_toml)
     if with_figures and choice.best >= 0 and best_figure is not None:
-        from .figures import png_bytes, svg_bytes
-
         X = np.array([[r[k] for k in LENGTHS] for r in rows])
         names = list(summary["objectives"])
         for name, fig in (

@@ -9,21 +9,39 @@ import json
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from matplotlib.figure import Figure
 
 from .._arrays import Array
+from .._lazy import lazy_module
 from ..dynamics import Model, inverse_dynamics
 from ..dynamics.regressor import NAMES
 from ..identification.data import MotionData
-from ..identification.excite import ExcitationResult
-from ..identification.fit import IdentificationResult, Validation
+from ..identification.excite import (
+    COND_CEILING,
+    REFERENCE_WORDS,
+    ExcitationResult,
+    coverage_floors,
+)
+from ..identification.fit import (
+    RESIDUAL_FACTOR,
+    UNCERTAINTY_LIMIT,
+    IdentificationResult,
+    Validation,
+)
 from ..identification.fit import validate as validate_fit
 from .config_file import toml_number as _num
+from .figures import png_bytes
 from .files import OutputDir
 from .html_page import figures, page
+
+if TYPE_CHECKING:  # the real module; at run time matplotlib is imported where first used
+    import matplotlib.figure as mfigure
+    from matplotlib.figure import Figure
+else:
+    mfigure = lazy_module("matplotlib.figure")
+
 
 
 def excitation_columns(model: Model, res: ExcitationResult, rate: float) -> dict[str, Array]:
@@ -51,9 +69,64 @@ def excitation_payload(res: ExcitationResult, harmonics: int, base_hz: float, sa
             "status": res.status, "message": res.message, "out": out,
             "headroom": [float(v) for v in res.headroom],
             "headroom_note": "each motor's peak use of its torque (at its speed) and speed",
+            "attempts": res.attempts,
+            **({} if res.coverage is None else {"coverage": _coverage(res)}),
             **({} if math.isnan(res.region_coverage) else {
                 "task_coverage": res.region_coverage,
                 "task_speed_ratio": [float(v) for v in res.region_speed_ratio]})}
+
+
+def _coverage(res: ExcitationResult) -> dict[str, Any]:
+    """The excitation's coverage against its advisory floors (JSON)."""
+    c = res.coverage
+    assert c is not None
+    ref = c.reference
+    return {"floors": {**coverage_floors(), "condition_number": COND_CEILING},
+            "advisory": True,
+            "range_deg": [float(v) for v in np.degrees(c.range)],
+            "reference_range_deg": [float(v) for v in np.degrees(ref.range)],
+            "peak_speed_rad_s": [float(v) for v in c.speed],
+            "reference_speed_rad_s": [float(v) for v in ref.speed],
+            "rated_speed_rad_s": [_finite(v) for v in ref.rated_speed],
+            "speed_of_rated": [_finite(v) for v in c.rated_fraction],
+            "peak_acceleration_rad_s2": [float(v) for v in c.acceleration],
+            "reference_acceleration_rad_s2": [float(v) for v in ref.acceleration],
+            "fractions": {k: [float(x) for x in v] for k, v in c.fractions.items()},
+            "met": c.met, "missed": list(c.missed),
+            "note": f"each motor's range, peak speed and peak acceleration over a reference "
+                    f"(the range: {ref.range_of}; the speed and acceleration: the top "
+                    "harmonic sweeping that range, capped by the motors), which a motion of "
+                    "both motors may exceed; the peak speed also over the motors' rated "
+                    "speed. The floors are advisory (a design below them is made again from "
+                    "new deterministic starts, then kept with a warning): identify's verdict "
+                    "tells whether the data fix the model"}
+
+
+def coverage_text(res: ExcitationResult, task: bool) -> str:
+    """The excitation's coverage in words (``dextar excite``'s summary)."""
+    c = res.coverage
+    assert c is not None
+    fr, ref = c.fractions, c.reference
+
+    def two(x: Array, fmt: str) -> str:
+        return " / ".join(format(float(v), fmt) for v in x)
+
+    rated = ("" if not np.isfinite(c.rated_fraction).all() else
+             f"; {two(100 * c.rated_fraction, '.3g')} % of the rated "
+             f"{two(ref.rated_speed, '.3g')} rad/s")
+    floors = " / ".join(f"{100 * v:g}" for v in coverage_floors().values())
+    return (f"coverage, motor A / D: range {two(np.degrees(c.range), '.3g')} deg "
+            f"({two(100 * fr['range'], '.3g')} % of {'the task' if task else 'each motor'}'s "
+            f"{'range' if task else 'free range from the rest pose, the other at rest'}), "
+            f"peak speed {two(c.speed, '.3g')} rad/s ({two(100 * fr['speed'], '.3g')} % of "
+            f"{REFERENCE_WORDS['speed']}{rated}), peak acceleration "
+            f"{two(c.acceleration, '.3g')} rad/s^2 ({two(100 * fr['acceleration'], '.3g')} % "
+            f"of {REFERENCE_WORDS['acceleration']}); advisory floors {floors} %, "
+            f"{res.attempts} design{'s' if res.attempts > 1 else ''}")
+
+
+def _finite(v: float) -> float | None:
+    return float(v) if math.isfinite(v) else None
 
 
 def _rms(x: Array) -> list[float]:
@@ -90,6 +163,23 @@ class IdentificationReport:
             "fit_quality": [float(v) for v in res.fit_quality],
             "fit_quality_note": "RMS residual / RMS torque per motor (motor A, motor D)",
             "torque_scale": [float(v) for v in res.torque_scale],
+            "torque_noise_Nm": [float(v) for v in res.torque_noise],
+            "explained_fit_quality": [float(v) for v in res.explained_quality],
+            "explained_fit_quality_note": (
+                "the fit quality the torques' noise (after the parallel filter) and the "
+                f"filters explain; a poor fit beyond {RESIDUAL_FACTOR:g}x it"),
+            "prediction_uncertainty": [_finite(v) for v in res.uncertainty],
+            "prediction_uncertainty_reference": res.reference,
+            "prediction_uncertainty_limit": UNCERTAINTY_LIMIT,
+            "prediction_uncertainty_note": (
+                "RMS standard deviation of the torques predicted along the reference over "
+                "their RMS, per motor (the parameters' covariance propagated; 1 sigma). "
+                "Without --task the reference is the recorded motion, its poses and speeds "
+                "named: the verdict covers motions like it; elsewhere a prediction "
+                "extrapolates (--task measures the uncertainty along the motion the model "
+                "is for, --validate names the samples of another motion outside)"),
+            "reasons": list(res.reasons),
+            "unphysical_distance_sigmas": res.unphysical_distance,
             "poorly_determined": list(res.poorly_determined),
             "base_parameters": [{"name": n, "meaning": m, "unit": u, "value": float(v),
                                  "std": float(s),
@@ -129,7 +219,11 @@ class IdentificationReport:
                  f"parallel filter {res.parallel_hz:.3g} Hz): {res.method}, condition number "
                  f"{res.condition_number:.4g}, RMS residual {res.rms_residual[0]:.4g}, "
                  f"{res.rms_residual[1]:.4g} N m, fit quality {res.fit_quality[0]:.2%}, "
-                 f"{res.fit_quality[1]:.2%} of the RMS torques",
+                 f"{res.fit_quality[1]:.2%} of the RMS torques (noise and filters explain "
+                 f"{res.explained_quality[0]:.2%}, {res.explained_quality[1]:.2%}); "
+                 f"predicted torques along {res.reference} uncertain by "
+                 f"{res.uncertainty[0]:.2%}, {res.uncertainty[1]:.2%} of their RMS (limit "
+                 f"{UNCERTAINTY_LIMIT:.0%})",
                  *(f"  {n:<7} = {v: .6g} +- {sd:.2g} {u}  ({m})" for n, m, u, v, sd in
                    zip(res.base.names, res.base.meanings, res.base.units, res.beta, res.std,
                        strict=True))]
@@ -140,6 +234,25 @@ class IdentificationReport:
                          f"{s['validation_inside_fraction']:.1%} of its samples inside the "
                          "excited region")
         return lines
+
+
+def model_comment(res: IdentificationResult, data_path: str, config: str | None) -> str:
+    """The comment at the top of ``identified.toml``: its first line names the status as
+    ``dextar calibrate``'s ``calibrated.toml`` does, ``identified by dextar from DATA
+    (STATUS: ...)``, with every reason when the status is not "identified" (``--model``
+    refuses such a file: :func:`dextar.config.scenario.load_scenario`)."""
+    if res.success:
+        what = (f"identified: {res.method}, condition number {res.condition_number:.4g}; "
+                f"predicted torques along {res.reference} uncertain by "
+                f"{100 * res.uncertainty[0]:.3g} / {100 * res.uncertainty[1]:.3g} % of their "
+                "RMS, motor A / D")
+    else:
+        said = res.message.replace("\n", " ")  # every reason, the worst first
+        what = (said if said.startswith(f"{res.status_text}:")
+                else f"{res.status_text}: {said}") + "; dextar refuses this file as --model"
+    return (f"identified by dextar from {data_path} ({what})\nbase parameters reproduced "
+            "exactly; the split between rods, rotor and payload that the torques cannot see "
+            f"follows {config or 'the defaults'}")
 
 
 #: Every file an identification may write.
@@ -155,8 +268,6 @@ def write_identification(out: str, rep: IdentificationReport, model_toml: str, *
         od.write_text("identified.toml", model_toml)
         od.write_text("parameters.csv", parameters_csv(rep.result))
         if with_figures:
-            from .figures import png_bytes
-
             png = png_bytes(fit_figure(rep.panels))
             od.write_bytes("fit.png", png)
             od.write_text("report.html", identification_report(rep.summary, {"fit": png}))
@@ -180,7 +291,7 @@ def parameters_csv(res: IdentificationResult) -> str:
 def fit_figure(panels: Sequence[tuple[str, Array, Array, Array]]) -> Figure:
     """Measured against predicted torques and their residuals; one column per data set
     ``(title, t (m,), measured (m, 2), predicted (m, 2))``."""
-    fig = Figure(figsize=(5.2 * len(panels), 6.4))
+    fig = mfigure.Figure(figsize=(5.2 * len(panels), 6.4))
     axes = fig.subplots(3, len(panels), squeeze=False, sharex="col")
     for j, (title, t, meas, pred) in enumerate(panels):
         for k, name in enumerate(("motor A", "motor D")):
@@ -222,6 +333,12 @@ def identification_report(summary: Mapping[str, Any], pngs: dict[str, bytes]) ->
              ("RMS residual [N m]", ", ".join(f"{v:.4g}" for v in summary["rms_residual_Nm"])),
              ("fit quality: RMS residual / RMS torque",
               ", ".join(f"{v:.3%}" for v in summary["fit_quality"])),
+             ("fit quality the noise and filters explain",
+              ", ".join(f"{v:.3%}" for v in summary["explained_fit_quality"])),
+             (f"predicted-torque uncertainty along {summary['prediction_uncertainty_reference']}"
+              f" (limit {summary['prediction_uncertainty_limit']:.0%})",
+              ", ".join("inf" if v is None else f"{v:.3%}"
+                        for v in summary["prediction_uncertainty"])),
              ("parameters with a relative std above 50 %",
               ", ".join(summary["poorly_determined"]) or "none")]
     if "validation_rms_error_Nm" in summary:

@@ -7,7 +7,8 @@ has no rotary inertia, so riding on either rod is the same). Motors at A and D d
 ``phi`` and ``psi`` with unit gear; rotor inertia becomes joint ``armature``, viscous friction
 joint ``damping`` and Coulomb friction joint ``frictionloss`` (MuJoCo's dry friction, a stiff
 soft constraint: its regularisation differs from dextar's ``tanh`` only below the
-regularisation speed). Units are those of the robot and inertia given (the run's units).
+regularisation speed). Units are those of the robot and inertia given: SI (m, kg, s) for a
+model MuJoCo users expect (``dextar export mjcf`` writes SI unless ``--units paper``).
 
 With a start state the model holds a keyframe ``start``: the motion's first sample with the
 loop closed and the motion's velocities. Load it with::
@@ -39,6 +40,11 @@ def _fmt(*values: float) -> str:
     return " ".join(f"{v:.17g}" for v in values)
 
 
+def _comment(text: str) -> str:
+    """``text`` safe inside an XML comment (no ``--``)."""
+    return text.replace("--", "- -")
+
+
 def _inertial(mass: float, com: float, izz: float) -> str:
     # a planar rod along local x: principal inertias (tiny, izz, izz) keep MuJoCo's
     # triangle inequality; MuJoCo needs strictly positive values
@@ -49,10 +55,12 @@ def _inertial(mass: float, com: float, izz: float) -> str:
 
 
 def to_mjcf(model: Model, *, name: str = "dextar",
-            start: tuple[Array, Array] | None = None) -> str:
+            start: tuple[Array, Array] | None = None,
+            units: str = "the units of the model given") -> str:
     """The MJCF text of ``model``: geometry, inertia, gravity, rotor inertia, viscous and
     Coulomb friction, and, given ``start = (q0, dq0)`` (each (2,)), a keyframe ``start`` with
-    the loop closed at that state."""
+    the loop closed at that state; ``units`` names the model's units in the file's comment
+    (pass an SI model for MuJoCo's usual units)."""
     r, ine = model.robot, model.inertia
     p1, p2 = ine.proximal
     d1, d2 = ine.distal
@@ -87,7 +95,7 @@ def to_mjcf(model: Model, *, name: str = "dextar",
         key = (f'  <keyframe>\n    <key name="start" qpos="{_fmt(*qpos[0])}" '
                f'qvel="{_fmt(*qvel[0])}"/>\n  </keyframe>\n')
     return f"""<mujoco model="{name}">
-  <!-- five-bar exported by dextar; units are the run's units -->
+  <!-- five-bar exported by dextar; {_comment(units)} -->
   <compiler angle="radian"/>
   <option gravity="{_fmt(gx, gy, 0)}" timestep="0.0001" integrator="RK4">
     <flag contact="disable"/>

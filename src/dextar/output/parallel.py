@@ -134,7 +134,7 @@ class Forked(Generic[R]):
             signal.pthread_sigmask(signal.SIG_SETMASK, held)  # a held interrupt comes here
         except BaseException:
             signal.pthread_sigmask(signal.SIG_SETMASK, held)
-            self._close()  # (the block is not entered: its exit would not end the child)
+            self.close()  # (the block is not entered: its exit would not end the child)
             raise
         return self
 
@@ -160,9 +160,9 @@ class Forked(Generic[R]):
 
     def __exit__(self, kind: type[BaseException] | None, exc: BaseException | None,
                  tb: TracebackType | None) -> None:
-        self._close()
+        self.close()
 
-    def _close(self) -> None:
+    def close(self) -> None:
         """End the child if it still runs (its work is moot: this process failed or was
         interrupted) and let its pipe go."""
         if self._receive is not None:

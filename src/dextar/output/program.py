@@ -11,20 +11,24 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from functools import partial
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from matplotlib.figure import Figure
 
 from .._arrays import Array
 from ..geometry import FiveBar
 from ..kinematics import workspace_map
 from ..program import MoveTiming, ProgramResult, RmsFit, Sizing
-from ..program.drive import DriveUnits, PvtPoints
+from ..program.drive import DriveUnits, PvtPoints, csp_columns, pvt_points
 from .figures import new_figure, plot_workspace, png_bytes, svg_bytes, tight_layout, warm_up
 from .files import OutputDir
 from .html_page import figures, grid, page
+from .parallel import Job, render
 from .tables import csv_text
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
 
 #: Every file a program may write (``csp.csv`` and ``pvt.csv`` with a ``[drive]`` table).
 PROGRAM_FILES = ("setpoints.csv", "summary.json", "report.html", "csp.csv", "pvt.csv",
@@ -126,7 +130,7 @@ def setpoint_columns(res: ProgramResult,
     """``setpoints.csv``: time, move, end-effector (mm), joint motion in encoder readings
     (the geometric angles minus ``encoder_offset_deg``) and torques (SI)."""
     off = np.radians(encoder_offset_deg)
-    return {"t_s": res.t, "move": res.move_index.astype(float), "x_mm": res.P[:, 0] * 1e3,
+    return {"t_s": res.t, "move": res.move_index, "x_mm": res.P[:, 0] * 1e3,
             "y_mm": res.P[:, 1] * 1e3, "phi_rad": res.q[:, 0] - off[0],
             "psi_rad": res.q[:, 1] - off[1],
             "dphi_rad_s": res.dq[:, 0], "dpsi_rad_s": res.dq[:, 1],
@@ -140,11 +144,9 @@ def write_program(out: str, res: ProgramResult, summary: ProgramSummary, robot_m
     """Write ``setpoints.csv``, the figures (PNG and SVG), ``report.html`` and
     ``summary.json`` into ``out``, and with ``drive`` ``csp.csv`` and ``pvt.csv`` (the PVT
     points ``pvt``, computed from the drive when not given)."""
-    from ..program.drive import csp_columns, pvt_points
-
     with OutputDir(out, force=force, produces=PROGRAM_FILES) as od:
-        od.write_text("setpoints.csv", csv_text(setpoint_columns(res,
-                                                                 summary.encoder_offset_deg)))
+        od.write_text("setpoints.csv", _counts_csv(setpoint_columns(
+            res, summary.encoder_offset_deg)))
         if drive is not None:
             od.write_text("csp.csv", _counts_csv(csp_columns(res, drive)))
             od.write_text("pvt.csv", _counts_csv((pvt or pvt_points(res, drive)).columns()))
@@ -160,23 +162,26 @@ def write_program(out: str, res: ProgramResult, summary: ProgramSummary, robot_m
 
 
 def _counts_csv(columns: dict[str, Array]) -> str:
-    """CSV of the drive files: positions in counts and torques in per-mille as whole numbers,
-    the other columns as :func:`csv_text` writes them."""
-    text = csv_text(columns).splitlines()
+    """CSV of the setpoints and the drive files: the move index, positions in counts and
+    torques in per-mille as whole numbers, the other columns as :func:`csv_text` writes
+    them (the shortest text that reads back to the same double); a value that is not finite
+    is a :class:`~dextar.errors.NumericalError` naming its column and row."""
     names = list(columns)
-    whole = [n.startswith(("pos", "torque")) for n in names]
-    rows = [",".join(str(int(float(v))) if w else v for v, w in zip(r.split(","), whole,
-                                                                       strict=True))
-            for r in text[1:]]
-    return "\n".join([text[0], *rows]) + "\n"
+    texts = []
+    for n in names:
+        v = np.asarray(columns[n], dtype=float) + 0.0  # + 0.0: no negative zeros
+        if not np.isfinite(v).all():
+            csv_text({n: v})  # raises, naming the column and row
+        whole = n == "move" or n.startswith(("pos", "torque"))
+        texts.append([str(int(x)) for x in v.tolist()] if whole else
+                     list(map(repr, v.tolist())))
+    return ",".join(names) + "\n" + "".join(",".join(r) + "\n" for r in zip(*texts, strict=True))
 
 
 def _figures(res: ProgramResult, summary: ProgramSummary, robot_mm: FiveBar, mode: str
              ) -> dict[str, tuple[bytes, bytes]]:
     """Each figure's PNG and SVG, drawn on two cores where there are two
     (:mod:`dextar.output.parallel`)."""
-    from .parallel import Job, render
-
     makers: dict[str, Callable[[], Figure]] = {
         "moves": lambda: moves_figure(res, robot_mm, mode), "motion": lambda: motion_figure(res),
         "operating_points": lambda: operating_points_figure(res, summary.sizing)}

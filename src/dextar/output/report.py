@@ -34,8 +34,9 @@ def _title(s: dict[str, Any]) -> str:
 
 
 def render_report(an: Analysis, s: dict[str, Any], pngs: dict[str, bytes],
-                  gif: bytes | None = None) -> str:
-    """The run's report as one self-contained HTML page (figures and animation inline)."""
+                  gif: bytes | None = None, pace: str = "in real time") -> str:
+    """The run's report as one self-contained HTML page (figures and animation inline;
+    ``pace``: how the animation plays, in words)."""
     u = s["units"]
     intro = (f"<p>Config: {html.escape(str(s['config']))}. dextar {s['dextar_version']}. "
              f"Units: length {u['length_unit']}, mass {u['mass_unit']}, time "
@@ -45,7 +46,7 @@ def render_report(an: Analysis, s: dict[str, Any], pngs: dict[str, bytes],
              f"{u['time_unit_in_s']:g} s.</p>")
     body = [intro, "<h2>Parameters</h2>", table(_parameters(s)), "<h2>Results</h2>",
             table(_results(s)), _claims(s), "<h2>Validation</h2>", table(_validation(s)),
-            "<h2>Figures</h2>", _figures(s, pngs, gif), "<h2>Assumptions</h2><ul>",
+            "<h2>Figures</h2>", _figures(s, pngs, gif, pace), "<h2>Assumptions</h2><ul>",
             *(f"<li>{html.escape(a)}</li>" for a in s["assumptions"]), "</ul>"]
     return page(_title(s), "".join(body))
 
@@ -132,21 +133,38 @@ def _claims(s: dict[str, Any]) -> str:
 def _validation(s: dict[str, Any]) -> list[tuple[str, Any]]:
     v = s["validation"]
     fw = v["forward_resimulation"]
-    return [
+    rows: list[tuple[str, Any]] = [
+        ("checks", "passed" if v["passed"] else "FAILED: " + "; ".join(v["failed"])),
         ("power balance: max |tau.qdot - dT/dt| / max |tau.qdot| (dimensionless; the torques "
-         "against the rate of change of the exact kinetic energy, gravity and friction off)",
-         v["power_balance_relative"]),
-        ("forward re-simulation under the computed torques: final angle error / angle range "
-         "(dimensionless)", fw["final_error_relative_to_range"]),
-        ("forward re-simulation: largest angle error [rad]", fw["max_error_rad"])]
+         "against the rate of change of the exact kinetic energy, gravity and friction off; "
+         f"at most {v['power_balance_threshold']:g})", _num(v["power_balance_relative"]))]
+    if "windows" in fw:
+        u = s["units"]
+        rows += [
+            (f"forward re-simulation in {fw['windows']} windows anchored to the plan (each "
+             "starts at the planned state and runs under the planned torques): largest drift "
+             "at a window's end [rad]", _num(fw["max_drift_rad"])),
+            (f"drift / (a_peak w^2 / 2): the accelerations' error as a fraction of the peak "
+             f"joint acceleration {fw['peak_acceleration']:.4g} rad/{u['time_unit']}^2 "
+             f"(at most {fw['threshold']:g}), worst window {fw['worst_window']}",
+             _num(fw["max_drift_ratio"])),
+            ("drift per window [rad]", " ".join(_num(d) for d in fw["drift_rad"]))]
+    rows.append(("forward re-simulation", fw["message"]))
+    return rows
 
 
-def _figures(s: dict[str, Any], pngs: dict[str, bytes], gif: bytes | None) -> str:
+def _num(v: float | None) -> str:
+    """A figure in three digits, or "-" where it could not be computed."""
+    return "-" if v is None else f"{v:.3g}"
+
+
+def _figures(s: dict[str, Any], pngs: dict[str, bytes], gif: bytes | None, pace: str
+             ) -> str:
     law = s["law"]["type"]
     parts = [image(data, name, _caption(name, law)) for name, data in pngs.items()]
     if gif is not None:
         parts.append(image(gif, "animation",
-                           f"The robot following the path ({law} law), in real time.",
+                           f"The robot following the path ({law} law), {html.escape(pace)}.",
                            mime="image/gif"))
     return "".join(parts)
 

@@ -11,8 +11,12 @@ from collections.abc import Callable
 from functools import partial
 from typing import TYPE_CHECKING, Any
 
+from ..analysis.summary import is_paper_example
 from ..errors import DextarError
+from . import figures as fg
 from .files import OutputDir
+from .parallel import Job, render
+from .report import render_report
 from .tables import csv_text, run_columns
 
 if TYPE_CHECKING:
@@ -72,8 +76,6 @@ def default_figures(an: Analysis) -> tuple[str, ...]:
     """The figures that apply: every one for the paper's example; for another task none of
     the paper's illustrations of its own example (Fig. 3, its uniform law; Fig. 7, its
     masses)."""
-    from ..analysis.summary import is_paper_example
-
     if is_paper_example(an.inputs):
         return FIGURES
     return tuple(f for f in FIGURES if f not in ("fig3", "fig7"))
@@ -105,7 +107,8 @@ def write_run(od: OutputDir, an: Analysis, uniform: Trajectory, summary: dict[st
     summary["files"] = sorted(set(od.written) | {"summary.json", "report.html"})
     stage("report.html", lambda: od.write_text("report.html",
                                                _report(an, summary, pngs,
-                                                       files.get("animation.gif"))))
+                                                       files.get("animation.gif"),
+                                                       animation_frames)))
     od.write_text("summary.json", json.dumps(summary, indent=2, allow_nan=False) + "\n")
 
 
@@ -119,9 +122,6 @@ def _figures(an: Analysis, uniform: Any, wanted: tuple[str, ...], animation_fram
              ) -> dict[str, bytes]:
     """The figures in ``wanted`` (PNG, and SVG but for the workspace) and the animation, by
     file name, drawn on two cores where there are two (:mod:`dextar.output.parallel`)."""
-    from . import figures as fg
-    from .parallel import Job, render
-
     makers: dict[str, Callable[[], Any]] = {
         "fig3": lambda: fg.fig3(an, uniform), "fig4": lambda: fg.fig4(an),
         "fig5": lambda: fg.fig5(an), "fig6": lambda: fg.fig6(an), "fig7": lambda: fg.fig7(an),
@@ -146,7 +146,6 @@ def _figures(an: Analysis, uniform: Any, wanted: tuple[str, ...], animation_fram
 
 
 def _report(an: Analysis, summary: dict[str, Any], pngs: dict[str, bytes],
-            gif: bytes | None) -> str:
-    from .report import render_report
-
-    return render_report(an, summary, pngs, gif)
+            gif: bytes | None, animation_frames: int) -> str:
+    return render_report(an, summary, pngs, gif,
+                         fg.pace_words(fg.animation_pace(an, animation_frames)))

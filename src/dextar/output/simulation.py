@@ -30,8 +30,15 @@ def write_tracking(out: str, tr: Trajectory, res: ControlResult, units: Units,
             f"tau1_{u['torque']}": res.tau[:, 0], f"tau2_{u['torque']}": res.tau[:, 1],
             "saturated": res.saturated.astype(float)}
     summ = res.summary()
+    tol_mm = None if res.tolerance is None else res.tolerance * mm
+    left = res.left_at
     report = {"units": units.describe(), "control": dict(control),
               "status": res.status, "message": res.message,
+              "followed": res.status == 0, "complete": res.complete, "tolerance_mm": tol_mm,
+              "tolerance_note": "the task error within which the motion is followed: "
+                                "[control].tolerance_mm, default 3 % of the robot's reach",
+              "left_tolerance_at_s": None if left is None else float(res.t[left]
+                                                                     * units.time_s),
               "max_task_error_mm": summ["max_task_error"] * mm,
               "rms_task_error_mm": summ["rms_task_error"] * mm,
               "final_task_error_mm": summ["final_task_error"] * mm,

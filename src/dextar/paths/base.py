@@ -18,12 +18,14 @@ from typing import Any
 import numpy as np
 
 from .._arrays import Array
+from .._lazy import lazy_module
 from ..errors import ParameterError
 from .expression import Expression
 
 # scipy.interpolate is imported where a spline is first built (Spline): it costs a third of a
 # second to import (half a second with what it brings), and lines, arcs, expressions and the
 # blends of a program (closed forms and HermiteTable) never need it.
+interpolate = lazy_module("scipy.interpolate")
 
 
 class HermiteTable:
@@ -299,13 +301,11 @@ class Spline(Path):
 
     @cached_property
     def _spl(self) -> Any:
-        from scipy.interpolate import make_interp_spline
-
         w = np.asarray(self.waypoints, dtype=float)
         if len(w) == 2:  # the straight segment (a quintic would overshoot it)
-            return make_interp_spline(self._knots, w, k=1)
+            return interpolate.make_interp_spline(self._knots, w, k=1)
         bc = [(3, np.zeros(2)), (4, np.zeros(2))]
-        return make_interp_spline(self._knots, w, k=5, bc_type=(bc, bc))
+        return interpolate.make_interp_spline(self._knots, w, k=5, bc_type=(bc, bc))
 
     @property
     def constant_curvature(self) -> float | None:  # type: ignore[override]  # a property here

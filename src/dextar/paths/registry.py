@@ -11,8 +11,8 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from ..errors import ConfigError
 from ..params import REQUIRED, Param
+from ..registry import Registry
 from ..units import Units
 from .base import Arc, ExpressionPath, Line, Path, Spline
 
@@ -40,21 +40,21 @@ class PathType:
     help: str = ""
 
 
-PATH_TYPES: dict[str, PathType] = {}
+#: The path types by config name; installed packages add theirs through the entry-point
+#: group ``dextar.paths``.
+PATH_TYPES: Registry[PathType] = Registry("path type", "config key [path].type",
+                                          group="dextar.paths")
 
 
 def register_path(kind: PathType) -> PathType:
     """Add a path type to the registry (a later registration of the same name replaces it)."""
-    PATH_TYPES[kind.name] = kind
-    return kind
+    return PATH_TYPES.register(kind)
 
 
-def path_type(name: object) -> PathType:
-    """The registered type ``name``; a :class:`ConfigError` lists the known ones."""
-    if not isinstance(name, str) or name not in PATH_TYPES:
-        raise ConfigError(f"config key [path].type must be one of {', '.join(PATH_TYPES)}, got "
-                          f"{name!r}")
-    return PATH_TYPES[name]
+def path_type(name: object, where: str | None = None) -> PathType:
+    """The registered type ``name``; an :class:`~dextar.registry.UnknownNameError` (a
+    :class:`~dextar.errors.ConfigError`) naming ``where`` lists the known ones."""
+    return PATH_TYPES.lookup(name, where)
 
 
 register_path(PathType(

@@ -7,7 +7,10 @@ Conventions: motor at A first; ``counts = (q - encoder_offset) * gear_ratio * en
 (2 pi)`` (from the encoders' zero, ``encoder_offset`` the joint angle at which an encoder
 reads zero), the motor-side speed ``gear_ratio * qdot`` and torque ``tau / gear_ratio`` (an
 ideal gearbox: no loss), the torque feedforward ``round(1000 tau_motor / rated_torque)``
-(object 0x60B2, torque offset, in per-mille of the rated torque 0x6076).
+(object 0x60B2, torque offset, in per-mille of the rated torque 0x6076). A torque
+feedforward above 1000 per-mille runs the motor above its rating (named, a warning); above
+the drive's own limit ``max_torque_permille`` (0x6072) the drive cannot give it (a
+violation: the program does not fit).
 """
 
 from __future__ import annotations
@@ -20,6 +23,10 @@ import numpy as np
 from .._arrays import Array
 from ..errors import ParameterError
 from .plan import ProgramResult
+from .sizing import Violation
+
+#: The rated torque in per-mille of itself (CiA 402's unit of the torque objects).
+RATED_PERMILLE = 1000.0
 
 
 @dataclass(frozen=True)
@@ -38,6 +45,9 @@ class DriveUnits:
         The joint angle (rad) at which each encoder reads zero.
     pvt_period : float
         The period of the PVT points (s).
+    max_torque_permille : (float, float), optional
+        The largest torque each drive gives, in per-mille of its rated torque (0x6072);
+        needs the rated torque.
     """
 
     gear_ratio: tuple[float, float] = (1.0, 1.0)
@@ -45,6 +55,7 @@ class DriveUnits:
     rated_torque: tuple[float, float] | None = None
     encoder_offset: tuple[float, float] = (0.0, 0.0)
     pvt_period: float = 0.01
+    max_torque_permille: tuple[float, float] | None = None
 
     def __post_init__(self) -> None:
         for name in ("gear_ratio", "encoder_counts"):
@@ -59,6 +70,14 @@ class DriveUnits:
                                      "numbers")
         if not (math.isfinite(self.pvt_period) and self.pvt_period > 0):
             raise ParameterError(f"PVT period {self.pvt_period!r} must be positive")
+        if self.max_torque_permille is not None:
+            v = np.asarray(self.max_torque_permille, float)
+            if v.shape != (2,) or not np.all(np.isfinite(v) & (v > 0)):
+                raise ParameterError(f"max torque {self.max_torque_permille!r} must be two "
+                                     "positive numbers (per-mille of the rated torque)")
+            if self.rated_torque is None:
+                raise ParameterError("a max torque in per-mille needs the rated torque "
+                                     "(rated_torque_Nm)")
 
     @property
     def counts_per_rad(self) -> Array:
@@ -109,12 +128,14 @@ class PvtPoints:
     Attributes
     ----------
     t : ndarray, shape (m,)
-        Every ``pvt_period`` (at the servo tick nearest each multiple) and the last tick.
+        Every ``pvt_period`` from the first servo tick to the first multiple at or after the
+        last (a whole number of servo ticks; the final pose held at rest after the last
+        tick, as the setpoints hold it).
     pos, vel : ndarray, shape (m, 2)
         Counts (rounded) and counts/s.
     max_error_counts : float
         Largest distance, in counts, between the cubic Hermite interpolation of the points
-        and the planned motion at every servo tick.
+        and the planned motion at every servo tick (the final pose held to the last point).
     """
 
     t: Array
@@ -140,19 +161,72 @@ def hermite(t: Array, tk: Array, pk: Array, vk: Array) -> Array:
 
 
 def pvt_points(res: ProgramResult, drive: DriveUnits) -> PvtPoints:
-    """The PVT points every ``drive.pvt_period`` from the setpoints, and the largest error of
-    their cubic against the planned motion (in counts, over every servo tick)."""
+    """The PVT points every ``drive.pvt_period`` from the setpoints, to the first multiple of
+    the period at or after the last servo tick (the final pose held at rest there, as the
+    setpoints hold it after the cycle), and the largest error of their cubic against the
+    planned motion (in counts, over every servo tick, the held ones included).
+
+    Raises
+    ------
+    ParameterError
+        A period that is not a whole number of servo ticks (named with the tick).
+    """
     t = res.t
-    rate = 1.0 / float(np.median(np.diff(t))) if len(t) > 1 else 1.0
-    step = max(1, int(round(drive.pvt_period * rate)))
+    tick = float(np.median(np.diff(t))) if len(t) > 1 else drive.pvt_period
+    step = max(1, int(round(drive.pvt_period / tick)))
+    if abs(step * tick - drive.pvt_period) > 1e-6 * drive.pvt_period:
+        raise ParameterError(f"PVT period {1e3 * drive.pvt_period:g} ms is not a whole number "
+                             f"of servo ticks ({1e3 * tick:.6g} ms): make [drive].pvt_period_ms "
+                             f"a multiple of it (e.g. {1e3 * step * tick:.6g} ms)")
     idx = np.arange(0, len(t), step)
-    if idx[-1] != len(t) - 1:
-        idx = np.append(idx, len(t) - 1)
     pos = np.round(drive.counts(res.q[idx]))
     vel = res.dq[idx] * drive.counts_per_rad
+    # every time from its whole number of servo ticks, as the setpoints' own (k / rate): a
+    # sum of rounded times had written 1.7080000000000002 s for the 7 ms period's 1.708 s
+    rate = res.servo_rate_hz or 1.0 / tick
     planned = drive.counts(res.q)
-    err = float(np.abs(hermite(t, t[idx], pos, vel) - planned).max()) if len(idx) > 1 else 0.0
-    return PvtPoints(t[idx], pos, vel, err)
+    ticks = idx
+    if idx[-1] != len(t) - 1:  # one period more: the final pose, held at rest
+        hold = step - (len(t) - 1 - idx[-1])
+        ticks = np.append(idx, idx[-1] + step)
+        pos = np.vstack([pos, np.round(planned[-1:])])
+        vel = np.vstack([vel, np.zeros((1, 2))])
+        planned = np.vstack([planned, np.repeat(planned[-1:], hold, axis=0)])
+    tk = ticks / rate
+    ts = np.arange(len(planned)) / rate
+    err = float(np.abs(hermite(ts, tk, pos, vel) - planned).max()) if len(tk) > 1 else 0.0
+    return PvtPoints(tk, pos, vel, err)
+
+
+def torque_checks(res: ProgramResult, drive: DriveUnits) -> tuple[list[Violation], list[str]]:
+    """The torque feedforward against the drives: a :class:`Violation` per motor whose
+    peak (per-mille of its rated torque) exceeds the drive's ``max_torque_permille``, and a
+    warning per motor above its rating (1000 per-mille) within that limit (or without one);
+    the motor, the peak, the rated torque, the move and the time named. Nothing without a
+    rated torque."""
+    if drive.rated_torque is None:
+        return [], []
+    pm = np.abs(drive.permille(res.tau))
+    violations: list[Violation] = []
+    warnings: list[str] = []
+    for i, name in enumerate(("A", "D")):
+        k = int(np.argmax(pm[:, i]))
+        peak = float(pm[k, i])
+        rated = float(drive.rated_torque[i])
+        limit = None if drive.max_torque_permille is None else float(
+            drive.max_torque_permille[i])
+        if limit is not None and peak > limit:
+            violations.append(Violation(
+                name, f"torque feedforward (per-mille of the rated torque {rated:g} N m)",
+                peak, limit, int(res.move_index[k]), float(res.t[k])))
+        elif peak > RATED_PERMILLE:
+            within = f", within the drive's {limit:g}" if limit is not None else ""
+            warnings.append(
+                f"motor {name}'s torque feedforward reaches {peak:g} per-mille of its rated "
+                f"torque {rated:g} N m ({1e-3 * peak * rated:.4g} N m at the motor) at t = "
+                f"{float(res.t[k]):.4g} s in move {int(res.move_index[k])}: above its rating "
+                f"(1000 per-mille){within}")
+    return violations, warnings
 
 
 def drive_report(res: ProgramResult, drive: DriveUnits, rotor_inertia: tuple[float, float]
@@ -185,6 +259,8 @@ def drive_report(res: ProgramResult, drive: DriveUnits, rotor_inertia: tuple[flo
         if drive.rated_torque is not None:
             m["peak_torque_permille"] = float(1000 * np.abs(tm[:, i]).max()
                                               / drive.rated_torque[i])
+        if drive.max_torque_permille is not None:
+            m["max_torque_permille"] = float(drive.max_torque_permille[i])
         motors.append(m)
     return {"gear_ratio": list(drive.gear_ratio), "encoder_counts": list(drive.encoder_counts),
             "encoder_offset_deg": [math.degrees(v) for v in drive.encoder_offset],

@@ -21,7 +21,7 @@ from ..trajectory import JointLine, Trajectory, sample_joint_trajectory
 from ..units import SI
 from .laws import LengthPath, move_law
 from .moves import Move, MoveType, move_type, register_move
-from .plan import MovePlan, PlanContext, PlanState, along_path, mode_at
+from .plan import MovePlan, PlanContext, PlanState, along_path, check_assembly, mode_at
 
 #: Samples of a move's own sampling (a fitted duration is checked on them).
 MOVE_SAMPLES = 401
@@ -89,7 +89,9 @@ def _plan_joint(ctx: PlanContext, mv: Move, state: PlanState) -> MovePlan:
     if mv.get("to_q") is not None:
         q1 = _point(mv, "to_q")
     else:
-        q1 = inverse_kinematics(robot, _point(mv, "to"), new_mode)
+        target = _point(mv, "to")
+        q1 = inverse_kinematics(robot, target, new_mode)
+        check_assembly(robot, q1, target, new_mode, ctx.assembly, "the target")
         q1 = q1 + np.round((q0 - q1) / (2 * np.pi)) * 2 * np.pi  # the nearest turn
     line = JointLine((float(q0[0]), float(q0[1])), (float(q1[0]), float(q1[1])))
 

@@ -13,8 +13,8 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from ..errors import ParameterError
 from ..params import Param
+from ..registry import Registry
 
 if TYPE_CHECKING:
     from ..paths import Path
@@ -97,17 +97,18 @@ class MoveType:
     help: str = ""
 
 
-MOVE_TYPES: dict[str, MoveType] = {}
+#: The move types by config name; installed packages add theirs through the entry-point
+#: group ``dextar.moves``.
+MOVE_TYPES: Registry[MoveType] = Registry("move type", "config key [[move]].type",
+                                          group="dextar.moves")
 
 
 def register_move(kind: MoveType) -> MoveType:
     """Add a move type to the registry (a later registration of the same name replaces it)."""
-    MOVE_TYPES[kind.name] = kind
-    return kind
+    return MOVE_TYPES.register(kind)
 
 
-def move_type(name: object) -> MoveType:
-    """The registered move type ``name``; a :class:`ParameterError` lists the known ones."""
-    if not isinstance(name, str) or name not in MOVE_TYPES:
-        raise ParameterError(f"unknown move type {name!r}; known: {', '.join(MOVE_TYPES)}")
-    return MOVE_TYPES[name]
+def move_type(name: object, where: str | None = None) -> MoveType:
+    """The registered move type ``name``; an :class:`~dextar.registry.UnknownNameError` (a
+    :class:`~dextar.errors.ConfigError`) naming ``where`` lists the known ones."""
+    return MOVE_TYPES.lookup(name, where)

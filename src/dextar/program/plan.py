@@ -16,7 +16,7 @@ Path moves joined by a blend (``blend > 0``) are one motion: each corner is repl
 quintic of continuous curvature that stays within ``blend`` of the corner
 (:mod:`dextar.paths.composite`), and the law of the first move of the chain runs over the
 whole of it, without stopping at the corners. Other moves start and end at rest. A move's law
-is any registered law (:mod:`.laws`). Everything is in SI (m, kg, s, N m, rad).
+is any registered law (:mod:`dextar.program.laws`). Everything is in SI (m, kg, s, N m, rad).
 """
 
 from __future__ import annotations
@@ -31,9 +31,14 @@ import numpy as np
 
 from .._arrays import Array
 from ..dynamics import Inertia, Model, RobotAlongPath, inverse_dynamics
-from ..errors import DextarError, ParameterError
-from ..geometry import FiveBar, canonical_working_mode
-from ..kinematics import inverse_kinematics, working_mode
+from ..errors import AssemblyError, DextarError, ParameterError
+from ..geometry import (
+    FiveBar,
+    assembly_mode_name,
+    canonical_working_mode,
+    parse_assembly_mode,
+)
+from ..kinematics import assembly_mode, direct_kinematics, inverse_kinematics, working_mode
 from ..kinematics.checker import DEFAULT_TOLERANCES, Tolerances, check_reach
 from ..laws import Law
 from ..motors import MotorLimits
@@ -218,6 +223,9 @@ class ProgramResult:
         Every move's type, in program order.
     rms_fit : RmsFit, optional
         How the cycle was fitted within the RMS ratings (``cycle = "fit-rms"``).
+    servo_rate_hz : float, optional
+        The setpoints' rate: ``t = arange(n) / servo_rate_hz`` (None: samples of another
+        kind, a sweep's run task).
     """
 
     moves: list[PlannedMove]
@@ -233,6 +241,7 @@ class ProgramResult:
     rms_limit: tuple[float, float] | None = None
     move_types: tuple[str, ...] = ()
     rms_fit: RmsFit | None = None
+    servo_rate_hz: float | None = None
 
     def timeline(self) -> list[MoveTiming]:
         """Every move of the program in order, each move of a blended chain on its own."""
@@ -411,6 +420,40 @@ def move_name(index: int, mv: Move) -> str:
     return f"move {index} ({mv.type})"
 
 
+#: How far (a fraction of the robot's reach ``max(l1 + L1, l2 + L2)``) a move may end from
+#: its target: the forward kinematics of its last setpoint against the point it was sent to.
+#: Moves that end where they were sent do so to rounding (the examples' moves: at most
+#: 2.5e-17 m on the DexTAR, whose tolerance is 1.6e-7 m); one that ends in the other assembly
+#: mode misses by tens of millimetres (a joint move to (100, 10) mm in "--": 155 mm).
+END_TOL = 1e-6
+
+
+def check_assembly(robot: FiveBar, q: Array, P: Array, mode: str, assembly: str,
+                   what: str) -> None:
+    """Refuse a point that the working mode ``mode`` reaches (angles ``q``) only in the other
+    assembly mode than the program's ``assembly`` (or at a parallel singularity, where the
+    assemblies meet): ``what`` names it ("the start", "the target")."""
+    sigma = int(assembly_mode(robot, q, P))
+    if sigma == parse_assembly_mode(assembly):
+        return
+    where = (f"{what} {SI.point_text(P)} in working mode {mode}")
+    if sigma == 0:
+        raise AssemblyError(f"{where} is at a parallel singularity, where the assembly modes "
+                            "meet: choose another point")
+    raise AssemblyError(
+        f"{where} lies in assembly mode {assembly_mode_name(sigma)}, but the program is in "
+        f"assembly mode {assembly_mode_name(-sigma)}: in that working mode the robot reaches "
+        f"it only in the other assembly mode. "
+        f"Choose another point or working mode, or set [robot].assembly_mode = "
+        f"\"{assembly_mode_name(sigma)}\" for the whole program")
+
+
+def move_target(mv: Move) -> Array | None:
+    """The point a move is sent to (m), or None (a dwell, a joint move to angles)."""
+    to = mv.get("to")
+    return None if to is None else np.asarray(to, float)
+
+
 def plan_program(robot: FiveBar, inertia: Inertia, moves: Sequence[Move], *,
                  start: tuple[float, float], working_mode: str, assembly: str = "up",
                  motors: MotorLimits | None = None,
@@ -460,6 +503,7 @@ def plan_program(robot: FiveBar, inertia: Inertia, moves: Sequence[Move], *,
     check_reach(robot, P0[None, :], lambda i: "the start", SI.point_text,
                 lambda v: f"{SI.mm(v):.6g} mm")
     q0 = inverse_kinematics(robot, P0, mode)
+    check_assembly(robot, q0, P0, mode, assembly, "the start")
     state = PlanState(P0, q0, mode)
     planned: list[PlannedMove] = []
     t0 = 0.0
@@ -477,8 +521,37 @@ def plan_program(robot: FiveBar, inertia: Inertia, moves: Sequence[Move], *,
             raise type(exc)(f"{_chain_name(group, exc)}: {exc}") from None
         planned.append(pm)
         t0 += pm.duration_s
-    return _setpoints(ctx, planned, t0, rms_limit, servo_rate_hz,
-                      tuple(mv.type for mv in moves))
+    res = _setpoints(ctx, planned, t0, rms_limit, servo_rate_hz,
+                     tuple(mv.type for mv in moves))
+    _check_ends(ctx, res, moves)
+    return res
+
+
+def _check_ends(ctx: PlanContext, res: ProgramResult, moves: Sequence[Move]) -> None:
+    """Every motion ends where it was sent: the forward kinematics (in the program's
+    assembly mode) of its last setpoint, at its end time, within :data:`END_TOL` of the
+    reach of the target of its last move.
+
+    Raises
+    ------
+    AssemblyError
+        Naming the move, its target, where it ends and how far apart.
+    """
+    robot = ctx.robot
+    tol = END_TOL * max(robot.l1 + robot.L1, robot.l2 + robot.L2)
+    for pm in res.moves:
+        last = pm.members[-1][0] if pm.members else pm.index
+        target = move_target(moves[last])
+        if target is None:
+            continue
+        q_end = pm.sample(np.array([pm.duration_s]))[1][-1]
+        end = direct_kinematics(robot, q_end, ctx.assembly)
+        miss = float(np.hypot(*(end - target)))
+        if not miss <= tol:
+            raise AssemblyError(
+                f"{move_name(last, moves[last])}: sent to {SI.point_text(target)}, it ends at "
+                f"{SI.point_text(end)} (the forward kinematics of its last setpoint in assembly "
+                f"mode {ctx.assembly}), {SI.mm(miss):.4g} mm away")
 
 
 def _chains(moves: Sequence[Move]) -> list[list[tuple[int, Move]]]:
@@ -655,4 +728,4 @@ def _setpoints(ctx: PlanContext, planned: list[PlannedMove], cycle: float,
         ddq[past] = 0.0
     tau = inverse_dynamics(ctx.free_model, q, dq, ddq)
     return ProgramResult(planned, cycle, t, move, P, q, dq, ddq, tau, ctx.motors, rms_limit,
-                         types)
+                         types, servo_rate_hz=rate)
