@@ -33,9 +33,11 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg import lapack
 
 from ..._arrays import Array
+from ..._lazy import lazy_module
+
+lapack = lazy_module("scipy.linalg.lapack")
 
 #: States per knot (arc length, speed, acceleration, duration), equalities per interval
 #: (the exact integration and the duration's continuity), border variables (the slack).
