@@ -191,8 +191,13 @@ class Constraint(ABC):
         return False
 
     @abstractmethod
+    def sample_ratios(self, js: JointSamples) -> Array:
+        """The ratio of the limited quantity to its limit at each sample (n,), or for a limit
+        on a rate between each two consecutive samples (n - 1,)."""
+
     def ratio(self, js: JointSamples) -> float:
         """Largest ratio of the limited quantity to its limit on the samples."""
+        return float(self.sample_ratios(js).max(initial=0.0))
 
     @abstractmethod
     def scaled(self, scales: Mapping[str, float]) -> Constraint:
@@ -236,9 +241,9 @@ class TorqueLimit(Constraint):
         """A viscous friction's bound is a tangent."""
         return bool(np.any(co.viscous > 0))
 
-    def ratio(self, js: JointSamples) -> float:
-        """Largest ``|tau_i| / peak_i``."""
-        return MotorLimits(self.peak).torque_ratio(js.tau, js.dq)
+    def sample_ratios(self, js: JointSamples) -> Array:
+        """``max_i |tau_i| / peak_i`` at each sample."""
+        return _torque_ratios(MotorLimits(self.peak), js)
 
     def scaled(self, scales: Mapping[str, float]) -> TorqueLimit:
         """The peak torques tightened by ``scales["torque"]``."""
@@ -264,9 +269,9 @@ class SpeedLimit(Constraint):
             return np.asarray(np.min(np.where(co.dq_ds != 0, (wmax / np.abs(co.dq_ds)) ** 2,
                                               np.inf), axis=1))
 
-    def ratio(self, js: JointSamples) -> float:
-        """Largest ``|qdot_i| / max_speed_i``."""
-        return float((np.abs(js.dq) / np.asarray(self.max_speed, float)).max())
+    def sample_ratios(self, js: JointSamples) -> Array:
+        """``max_i |qdot_i| / max_speed_i`` at each sample."""
+        return np.asarray((np.abs(js.dq) / np.asarray(self.max_speed, float)).max(axis=1))
 
     def scaled(self, scales: Mapping[str, float]) -> SpeedLimit:
         """The speeds tightened by ``scales["speed"]``."""
@@ -316,9 +321,9 @@ class TorqueSpeedEnvelope(Constraint):
         """The envelope's ``sqrt(x)`` is bounded by a tangent."""
         return True
 
-    def ratio(self, js: JointSamples) -> float:
-        """Largest ``|tau_i|`` over the torque available at the sample's speed."""
-        return MotorLimits(self.peak, self.max_speed, self.knee).torque_ratio(js.tau, js.dq)
+    def sample_ratios(self, js: JointSamples) -> Array:
+        """``max_i |tau_i|`` over the torque available at the sample's speed."""
+        return _torque_ratios(MotorLimits(self.peak, self.max_speed, self.knee), js)
 
     def scaled(self, scales: Mapping[str, float]) -> TorqueSpeedEnvelope:
         """Peak tightened by ``scales["torque"]``, speeds by ``scales["speed"]``."""
@@ -348,16 +353,28 @@ class AccelerationLimit(Constraint):
         return PointRows(np.concatenate([d1, -d1], axis=1), np.concatenate([d2, -d2], axis=1),
                          np.concatenate([amax, amax], axis=1))
 
-    def ratio(self, js: JointSamples) -> float:
-        """Largest ``|qddot_i| / max_acceleration_i`` (0 without accelerations)."""
+    def sample_ratios(self, js: JointSamples) -> Array:
+        """``max_i |qddot_i| / max_acceleration_i`` at each sample (0 without
+        accelerations)."""
         if js.ddq is None:
-            return 0.0
-        return float((np.abs(js.ddq) / np.asarray(self.max_acceleration, float)).max())
+            return np.zeros(len(js.tau))
+        return np.asarray((np.abs(js.ddq) / np.asarray(self.max_acceleration, float))
+                          .max(axis=1))
 
     def scaled(self, scales: Mapping[str, float]) -> AccelerationLimit:
         """The accelerations tightened by ``scales["acceleration"]``."""
         return replace(self, max_acceleration=_pair(np.asarray(self.max_acceleration, float)
                                                     * scales.get("acceleration", 1.0)))
+
+
+def _torque_ratios(motors: MotorLimits, js: JointSamples) -> Array:
+    """``max_i |tau_i| / available torque_i`` at each sample (``inf`` where a torque is asked
+    of a motor that has none left)."""
+    avail = motors.available_torque(js.dq)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r = np.where(avail > 0, np.abs(js.tau) / avail,
+                     np.where(np.abs(js.tau) > 0, np.inf, 0.0))
+    return np.asarray(r.max(axis=1))
 
 
 def _rate(values: Array | None, t: Array | None) -> Array | None:
@@ -377,10 +394,11 @@ class JerkLimit(Constraint):
     kind: str = "jerk"
     order: int = 3
 
-    def ratio(self, js: JointSamples) -> float:
-        """Largest ``|d qddot_i / dt| / max_jerk_i`` between consecutive samples."""
+    def sample_ratios(self, js: JointSamples) -> Array:
+        """``max_i |d qddot_i / dt| / max_jerk_i`` between consecutive samples."""
         r = _rate(js.ddq, js.t)
-        return 0.0 if r is None else float((np.abs(r) / np.asarray(self.max_jerk, float)).max())
+        return np.zeros(0) if r is None else np.asarray(
+            (np.abs(r) / np.asarray(self.max_jerk, float)).max(axis=1))
 
     def scaled(self, scales: Mapping[str, float]) -> JerkLimit:
         """The jerks tightened by ``scales["jerk"]``."""
@@ -397,11 +415,11 @@ class TorqueRateLimit(Constraint):
     kind: str = "torque_rate"
     order: int = 3
 
-    def ratio(self, js: JointSamples) -> float:
-        """Largest ``|d tau_i / dt| / max_torque_rate_i`` between consecutive samples."""
+    def sample_ratios(self, js: JointSamples) -> Array:
+        """``max_i |d tau_i / dt| / max_torque_rate_i`` between consecutive samples."""
         r = _rate(js.tau, js.t)
-        return 0.0 if r is None else float((np.abs(r) / np.asarray(self.max_torque_rate,
-                                                                     float)).max())
+        return np.zeros(0) if r is None else np.asarray(
+            (np.abs(r) / np.asarray(self.max_torque_rate, float)).max(axis=1))
 
     def scaled(self, scales: Mapping[str, float]) -> TorqueRateLimit:
         """The rates tightened by ``scales["torque_rate"]``."""
