@@ -40,7 +40,7 @@ check finds an excess of a kind, the solver tightens every constraint of that ki
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from functools import cached_property
 from typing import Protocol
@@ -49,6 +49,7 @@ import numpy as np
 
 from .._arrays import Array
 from ..motors import MotorLimits
+from ..registry import Registry
 from .base import Law
 
 
@@ -427,22 +428,62 @@ class TorqueRateLimit(Constraint):
                                                    * scales.get("torque_rate", 1.0)))
 
 
+@dataclass(frozen=True)
+class ConstraintType:
+    """A kind of limit the laws honour, built from the motors' limits.
+
+    Attributes
+    ----------
+    name : str
+        Its name in :data:`CONSTRAINT_TYPES` (and in the docs).
+    build : callable
+        ``build(motors)``: the constraint for these limits, or None where they do not set it
+        (a speed limit without ``max_speed``).
+    help : str
+        One line for the docs.
+    """
+
+    name: str
+    build: Callable[[MotorLimits], Constraint | None]
+    help: str = ""
+
+
+#: The limits every time-optimal law (second and third order) plans within, in the order
+#: they are built. A new limit is a :class:`Constraint` and one ``register`` call; an
+#: installed package adds one through the entry-point group ``dextar.constraints``.
+CONSTRAINT_TYPES: Registry[ConstraintType] = Registry("constraint", "constraint",
+                                                      group="dextar.constraints")
+
+
+def _finite_speed(m: MotorLimits) -> Constraint | None:
+    return (SpeedLimit(m.max_speed) if np.isfinite(np.asarray(m.max_speed, float)).any()
+            else None)
+
+
+for _kind in (
+        ConstraintType("torque", lambda m: TorqueLimit(m.peak_torque),
+                       "each motor's peak torque (with friction)"),
+        ConstraintType("speed", _finite_speed, "each motor's speed limit, when finite"),
+        ConstraintType("envelope", lambda m: None if m.knee_speed is None else
+                       TorqueSpeedEnvelope(m.peak_torque, m.max_speed, m.knee_speed),
+                       "the torque-speed envelope, when it has a knee"),
+        ConstraintType("acceleration", lambda m: None if m.max_acceleration is None else
+                       AccelerationLimit(m.max_acceleration),
+                       "each joint's acceleration limit, when given"),
+        ConstraintType("jerk", lambda m: None if m.max_jerk is None else
+                       JerkLimit(m.max_jerk), "each joint's jerk limit, when given"),
+        ConstraintType("torque_rate", lambda m: None if m.max_torque_rate is None else
+                       TorqueRateLimit(m.max_torque_rate),
+                       "each motor's torque rate limit, when given")):
+    CONSTRAINT_TYPES.register(_kind)
+
+
 def motor_constraints(motors: MotorLimits) -> tuple[Constraint, ...]:
-    """The motors' limits as constraints: the peak torque, the speed limit (when finite), the
-    torque-speed envelope (when it has a knee), and the acceleration, jerk and torque-rate
-    limits (when given)."""
-    out: list[Constraint] = [TorqueLimit(motors.peak_torque)]
-    if np.isfinite(np.asarray(motors.max_speed, float)).any():
-        out.append(SpeedLimit(motors.max_speed))
-    if motors.knee_speed is not None:
-        out.append(TorqueSpeedEnvelope(motors.peak_torque, motors.max_speed, motors.knee_speed))
-    if motors.max_acceleration is not None:
-        out.append(AccelerationLimit(motors.max_acceleration))
-    if motors.max_jerk is not None:
-        out.append(JerkLimit(motors.max_jerk))
-    if motors.max_torque_rate is not None:
-        out.append(TorqueRateLimit(motors.max_torque_rate))
-    return tuple(out)
+    """The motors' limits as constraints, one per registered :class:`ConstraintType` that
+    the limits set (:data:`CONSTRAINT_TYPES`: the peak torque, the speed limit when finite,
+    the torque-speed envelope when it has a knee, and the acceleration, jerk and torque-rate
+    limits when given)."""
+    return tuple(c for kind in CONSTRAINT_TYPES.values() if (c := kind.build(motors)) is not None)
 
 
 def point_rows(constraints: Sequence[Constraint], tangent: Tangent) -> PointRows:
