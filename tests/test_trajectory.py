@@ -67,3 +67,24 @@ def test_spline_path_trajectory():
     h = tr.t[1] - tr.t[0]
     fd = (tr.q[2:] - tr.q[:-2]) / (2 * h)
     assert np.abs(fd - tr.dq[1:-1]).max() < 1e-4 * np.abs(tr.dq).max()
+
+
+def test_a_path_across_the_parallel_singularity_curve_passes_only_where_planned():
+    """The geometry checker refuses a crossing of the parallel singularity curve unless it is
+    one of the path's crossings the caller plans (find_crossings), and only there."""
+    from dextar.errors import SingularityError
+    from dextar.trajectory import check_path, find_crossings
+
+    from .crossing_cases import CASES
+
+    case = CASES["dextar"]
+    with pytest.raises(SingularityError, match="parallel"):
+        check_path(case.robot, case.path, mode="+-")
+    crossings = find_crossings(case.robot, case.path, mode="+-")
+    checked = check_path(case.robot, case.path, mode="+-", crossings=crossings)
+    assert checked.distances.type2.min() < 1e-3  # it passed the singularity itself
+    # a crossing excused elsewhere on the path does not excuse this one
+    from dataclasses import replace
+    moved = replace(crossings[0], s=crossings[0].s * 0.5)
+    with pytest.raises(SingularityError, match="parallel"):
+        check_path(case.robot, case.path, mode="+-", crossings=(moved,))

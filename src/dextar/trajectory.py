@@ -6,6 +6,7 @@ kinematics (``B qdot = A Pdot`` and its derivative), never from finite differenc
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -25,6 +26,7 @@ from .kinematics import (
     elbows,
     inverse_kinematics,
     joint_rates,
+    parallel_indicator,
     task_acceleration,
     working_mode,
 )
@@ -56,7 +58,11 @@ class Trajectory:
     q, dq, ddq : ndarray, shape (n, 2)
         Actuator angles ``(phi, psi)`` (unwrapped, radians), rates and accelerations.
     mode, assembly : str
-        Working mode and assembly mode along the motion.
+        Working mode and assembly mode along the motion (at its start, when it crosses the
+        parallel singularity curve).
+    crossings : tuple of Crossing
+        Where the motion crosses the parallel singularity curve (each crossing changes the
+        assembly mode), in the order of the path.
     """
 
     robot: FiveBar
@@ -77,6 +83,12 @@ class Trajectory:
     q: Array
     dq: Array
     ddq: Array
+    crossings: tuple[Crossing, ...] = ()
+
+    @property
+    def end_assembly(self) -> str:
+        """The assembly mode at the motion's end (the start's, flipped by each crossing)."""
+        return self.crossings[-1].assembly_after if self.crossings else self.assembly
 
     def columns(self) -> dict[str, Array]:
         """The plan columns: ``t, p, dp, ddp, x, y, dx, dy, ddx, ddy, phi, psi, dphi, dpsi,
@@ -112,7 +124,8 @@ def path_motion(path: Path, law: Law, t: Array) -> tuple[Array, ...]:
 def sample_trajectory(robot: FiveBar, path: Path, law: Law, *, mode: str = "+-",
                       samples: int = 1001, times: Array | None = None,
                       tolerances: Tolerances = DEFAULT_TOLERANCES,
-                      units: Units | None = None, checked: bool = True) -> Trajectory:
+                      units: Units | None = None, checked: bool = True,
+                      crossings: Sequence[Crossing] = ()) -> Trajectory:
     """Sample ``law`` along ``path`` and map it to joint space in working mode ``mode``.
 
     Parameters
@@ -134,6 +147,9 @@ def sample_trajectory(robot: FiveBar, path: Path, law: Law, *, mode: str = "+-",
     checked : bool
         Run the geometry checker on the samples (False only for re-sampling a path that was
         checked already, as the time-optimal law's output check does).
+    crossings : sequence of Crossing
+        The path's crossings of the parallel singularity curve that the motion may make
+        (:func:`find_crossings`); the checker refuses any other.
 
     Returns
     -------
@@ -161,13 +177,18 @@ def sample_trajectory(robot: FiveBar, path: Path, law: Law, *, mode: str = "+-",
         check_reach(robot, P, lambda i: f"the path leaves the workspace {where(i)}",
                     words.point, words.length)
     q = inverse_kinematics(robot, P, mode, unwrap=True)
+    crossings = tuple(crossings)
     if checked:
         check_poses(robot, q, P, tolerances=tolerances, where=where, point=words.point,
-                    mode=mode)
+                    mode=mode, excused=crossing_excused(crossings, s, tolerances)
+                    if crossings else None)
     dq, ddq = joint_rates(robot, q, P, dP, ddP, tol=0.0)
-    sig = assembly_mode(robot, q[:1], P[:1])  # the motion's, named by its first pose
-    return Trajectory(robot, path, law, mode, assembly_mode_name(int(sig[0])), t, s, ds, dds,
-                      p, dp, ddp, P, dP, ddP, q, dq, ddq)
+    if crossings:
+        start = crossings[0].assembly_before
+    else:
+        start = assembly_mode_name(int(assembly_mode(robot, q[:1], P[:1])[0]))  # the first pose's
+    return Trajectory(robot, path, law, mode, start, t, s, ds, dds, p, dp, ddp, P, dP, ddP, q,
+                      dq, ddq, crossings)
 
 
 @dataclass(frozen=True)
@@ -193,10 +214,11 @@ class CheckedPath:
 
 def check_path(robot: FiveBar, path: Path, *, mode: str = "+-", samples: int = 2001,
                tolerances: Tolerances = DEFAULT_TOLERANCES,
-               units: Units | None = None) -> CheckedPath:
+               units: Units | None = None, crossings: Sequence[Crossing] = ()) -> CheckedPath:
     """Check a path before any law is planned on it: ``samples`` points equally spaced in the
     path parameter, within reach and clear of both singularity types in working mode ``mode``
-    (the geometry checker). Errors name the path parameter and the point (in mm with
+    (the geometry checker), but for the ``crossings`` of the parallel singularity curve
+    given (:func:`find_crossings`). Errors name the path parameter and the point (in mm with
     ``units``).
 
     Returns
@@ -216,9 +238,137 @@ def check_path(robot: FiveBar, path: Path, *, mode: str = "+-", samples: int = 2
     check_reach(robot, P, lambda i: f"the path leaves the workspace at p = {p[i]:.6g}",
                 words.point, words.length)
     q = inverse_kinematics(robot, P, mode, unwrap=True)
+    excused = (crossing_excused(tuple(crossings), path.arc_length(p), tolerances)
+               if crossings else None)
     d = check_poses(robot, q, P, tolerances=tolerances, where=lambda i: f"at p = {p[i]:.6g}",
-                    point=words.point, mode=mode)
+                    point=words.point, mode=mode, excused=excused)
     return CheckedPath(p, P, q, d)
+
+
+#: A crossing of the parallel singularity curve must be transversal: the normalised distance
+#: ``det A / (L1 L2)`` must change at least this fast per unit of the robot's reach
+#: ``max(l1 + L1, l2 + L2)`` along the path (the lines across the DexTAR's curve change by
+#: 2-4 per reach; a path that grazes the curve changes at 0 there and is refused: its torques
+#: would need a degeneracy condition of higher order).
+MIN_CROSSING_SLOPE = 0.05
+
+
+@dataclass(frozen=True)
+class Crossing:
+    """Where a path crosses the parallel (type 2) singularity curve of a working mode.
+
+    Attributes
+    ----------
+    p, s : float
+        Path parameter and arc length of the crossing.
+    P, q : ndarray, shape (2,)
+        The end-effector and the motor angles there (B, C and P aligned).
+    normal : ndarray, shape (2,)
+        The unit normal to the aligned distal rods: the direction along which the motors
+        cannot push the end-effector at the crossing (the degeneracy condition asks the
+        end-effector's force to have no component along it).
+    slope : float
+        ``d(det A / (L1 L2)) / ds`` there (per unit length), nonzero: a transversal crossing.
+    assembly_before, assembly_after : str
+        The assembly modes on either side.
+    """
+
+    p: float
+    s: float
+    P: Array
+    q: Array
+    normal: Array
+    slope: float
+    assembly_before: str
+    assembly_after: str
+
+    def window(self, distance: float) -> float:
+        """The arc length on either side within which the normalised distance to the
+        singularity is below ``distance`` (to first order)."""
+        return float(distance / abs(self.slope))
+
+
+def find_crossings(robot: FiveBar, path: Path, *, mode: str = "+-", samples: int = 2001,
+                   units: Units | None = None) -> tuple[Crossing, ...]:
+    """The path's crossings of the parallel singularity curve in working mode ``mode``: the
+    sign changes of ``det A`` on ``samples`` points equally spaced in the path parameter,
+    each refined by bisection to rounding.
+
+    Raises
+    ------
+    ReachError
+        The path leaves the workspace.
+    SingularityError
+        A crossing that is not transversal (:data:`MIN_CROSSING_SLOPE`).
+    """
+    mode = working_mode_name(parse_working_mode(mode))
+    words = _Words(units)
+    p = np.linspace(path.p0, path.p1, samples)
+    P = path.position(p)
+    check_reach(robot, P, lambda i: f"the path leaves the workspace at p = {p[i]:.6g}",
+                words.point, words.length)
+
+    def indicator(pp: Array) -> Array:
+        PP = path.position(pp)
+        return parallel_indicator(robot, inverse_kinematics(robot, PP, mode), PP)
+
+    sig = indicator(p)
+    sg = np.sign(sig)
+    # a sign change between samples i and i + 1 (an exact zero counts with its right side)
+    idx = np.flatnonzero((sg[:-1] != sg[1:]) & (sg[:-1] != 0))
+    idx = np.array([i for i in idx if not (sg[i + 1] == 0 and i + 2 < samples
+                                            and sg[i + 2] == sg[i])], dtype=int)
+    if idx.size == 0:
+        return ()
+    lo, hi = p[idx].copy(), p[idx + 1].copy()
+    flo = sig[idx].copy()
+    for _ in range(80):  # bisection: the bracket halves to rounding
+        mid = 0.5 * (lo + hi)
+        fm = indicator(mid)
+        left = np.sign(fm) == np.sign(flo)
+        lo, flo = np.where(left, mid, lo), np.where(left, fm, flo)
+        hi = np.where(left, hi, mid)
+    ps = 0.5 * (lo + hi)
+    reach = max(robot.l1 + robot.L1, robot.l2 + robot.L2)
+    span = path.p1 - path.p0
+    out = []
+    for k, pk in enumerate(ps):
+        delta = 1e-5 * span
+        a, b = max(pk - delta, path.p0), min(pk + delta, path.p1)
+        fa, fb = indicator(np.array([a, b]))
+        slope = float((fb - fa) / (float(path.arc_length(b)) - float(path.arc_length(a))))
+        Pk = path.position(np.array([pk]))[0]
+        qk = inverse_kinematics(robot, Pk, mode)
+        if not abs(slope) * reach >= MIN_CROSSING_SLOPE:
+            raise SingularityError(
+                f"at p = {pk:.6g}: the path meets the parallel (type 2) singularity curve at "
+                f"P = {words.point(Pk)} in working mode {mode} without crossing it "
+                f"transversally (the normalised distance changes by {abs(slope) * reach:.3g} "
+                f"per reach, below {MIN_CROSSING_SLOPE:g}): no motion passes it with bounded "
+                "torques")
+        B, _ = elbows(robot, qk)
+        u = Pk - B
+        normal = np.array([-u[1], u[0]]) / float(np.hypot(u[0], u[1]))
+        before = -int(np.sign(sig[idx[k]]))  # assembly sign = -sign(det A)
+        out.append(Crossing(float(pk), float(path.arc_length(pk)), Pk, qk, normal, slope,
+                            assembly_mode_name(before), assembly_mode_name(-before)))
+    return tuple(out)
+
+
+def crossing_excused(crossings: Sequence[Crossing], s: Array,
+                     tolerances: Tolerances = DEFAULT_TOLERANCES) -> Array:
+    """The samples at arc lengths ``s`` (n,) (increasing) whose parallel-singularity checks
+    a planned crossing excuses: within four times the checker's tolerance of the crossing
+    (to first order in its slope), and the sample just past it (the sign change)."""
+    s = np.asarray(s, float)
+    out = np.zeros(s.shape, bool)
+    for c in crossings:
+        out |= np.abs(s - c.s) <= 4.0 * c.window(max(tolerances.type2, 1e-12))
+        k = int(np.searchsorted(s, c.s, side="left"))
+        out[min(k, len(s) - 1)] = True
+        if k > 0:
+            out[k - 1] = True
+    return out
 
 
 @dataclass(frozen=True)

@@ -21,17 +21,19 @@ from ..design.evaluate import Task
 from ..design.space import DesignSpace
 from ..dynamics import Inertia, Model
 from ..dynamics.along_path import RobotAlongPath
+from ..dynamics.crossing import RobotAcrossPath
 from ..errors import ConfigError, DextarError
 from ..geometry import FiveBar
 from ..kinematics.checker import Tolerances
 from ..laws import Law, LawRequest, law_type
+from ..laws.constraints import PathDynamics
 from ..motors import MotorLimits
 from ..output.config_file import model_toml
 from ..params import read_params
 from ..paths import Path
 from ..program import Move, ProgramRequest
 from ..program.drive import DriveUnits
-from ..trajectory import Trajectory, check_path, sample_trajectory
+from ..trajectory import Crossing, Trajectory, check_path, find_crossings, sample_trajectory
 from ..units import SI, Units
 from .base import TABLES, Table
 from .design import DesignTable
@@ -336,19 +338,59 @@ class Scenario:
                           gravity_mm_s2=self.gravity_table.vector,
                           extra=self.raw("motors", "tolerances"), comment=comment)
 
+    @cached_property
+    def crossings(self) -> tuple[Crossing, ...]:
+        """The path's crossings of the parallel singularity curve that ``[path].assembly_mode``
+        asks for (none when it is not given); refused by name where the path does not reach
+        that assembly mode."""
+        asked = self.path_table.assembly_mode
+        if asked is None:
+            return ()
+        found = find_crossings(self.robot, self.path, mode=self.mode, units=self.units)
+        end = self.assembly if len(found) % 2 == 0 else found[-1].assembly_after
+        if end != asked:
+            how = ("does not cross the parallel (type 2) singularity curve" if not found else
+                   f"crosses the parallel (type 2) singularity curve {len(found)} times")
+            raise ConfigError(
+                f"config key [path].assembly_mode = \"{asked}\": the path {how} of working "
+                f"mode {self.mode} from [robot].assembly_mode = \"{self.assembly}\", so it "
+                f"ends in assembly mode {end}")
+        return found
+
     def law(self, kind: str | None = None) -> Law:
         """The configured law, or the registered law ``kind`` with its defaults and the
-        configured duration. The path is checked first (reach and singularities)."""
+        configured duration. The path is checked first (reach and singularities: a crossing
+        of the parallel singularity curve only where ``[path].assembly_mode`` asks for one,
+        planned by the time-optimal law under the degeneracy condition)."""
+        crossings = self.crossings
         check_path(self.robot, self.path, mode=self.mode, tolerances=self.tolerances,
-                   units=self.units)
+                   units=self.units, crossings=crossings)
         table = self.law_table
         if kind is not None and kind != table.type:
             lt = law_type(kind)
             raw = {"duration": table.duration_s} if "duration" in lt.params else {}
             table = LawTable(kind, read_params("law", raw, lt.params))
         lt = table.kind
-        dynamics = (RobotAlongPath(self.model(), self.path, self.mode, self.units)
-                    if lt.needs_dynamics else None)
+        dynamics: PathDynamics | None = (RobotAlongPath(self.model(), self.path, self.mode,
+                                                        self.units)
+                                         if lt.needs_dynamics else None)
+        if crossings:
+            where = ", ".join(self.units.point_text(c.P) for c in crossings)
+            if lt.name != "time-optimal":
+                raise ConfigError(
+                    f"config key [law].type = \"{lt.name}\": the path crosses the parallel "
+                    f"(type 2) singularity curve at {where} ([path].assembly_mode), which only "
+                    "the time-optimal law plans under the degeneracy condition; another law "
+                    "would need unbounded torques there")
+            motors = self.motors
+            if motors is not None and motors.third_order:
+                raise ConfigError(
+                    f"config table [motors]: the path crosses the parallel (type 2) "
+                    f"singularity curve at {where}, planned by the second-order time-optimal "
+                    "law; max_jerk or max_torque_rate asks the jerk-limited one, which does "
+                    "not impose the degeneracy condition")
+            dynamics = RobotAcrossPath(replace(self.model(), tol=0.0), self.path, self.mode,
+                                       crossings, self.units)
         request = LawRequest(self.path, table.run_values(self.units), self.effector_mass,
                              dynamics, self.units, self.motors)
         return lt.build(request)
@@ -365,7 +407,8 @@ class Scenario:
         """The law sampled along the path (``[output].samples`` by default)."""
         return sample_trajectory(self.robot, self.path, law or self.law(), mode=self.mode,
                                  samples=samples or self.output.samples,
-                                 tolerances=self.tolerances, units=self.units)
+                                 tolerances=self.tolerances, units=self.units,
+                                 crossings=self.crossings)
 
 
 def scenario_from_dict(doc: Mapping[str, Any], *, source: str | None = None,

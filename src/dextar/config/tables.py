@@ -39,17 +39,27 @@ class PathTable(Table):
     """``[path]``: a registered path type and its keys (config units)."""
 
     NAME: ClassVar[str] = "path"
+    #: The keys of every path type.
+    COMMON: ClassVar[dict[str, Param]] = {
+        "assembly_mode": Param(
+            "choice", "", None, "the assembly mode at the path's end, up or down (default: "
+            "[robot].assembly_mode, the start's); another one asks the path to cross the "
+            "parallel (type 2) singularity curve of the working mode, which the time-optimal "
+            "law does under the degeneracy condition", choices=("up", "down"))}
 
     type: str = "arc"
     values: Mapping[str, Any] = field(default_factory=lambda: {
         "radius": 120.0, "center": (0.0, 0.0), "start_deg": 0.0, "end_deg": 180.0})
+    assembly_mode: str | None = None
 
     @classmethod
     def from_toml(cls, raw: Mapping[str, object]) -> PathTable:
-        """Read ``[path]`` against the keys its type registered."""
+        """Read ``[path]`` against the keys its type registered (and :attr:`COMMON`)."""
         kind = path_type(raw.get("type", "arc"))
-        values = read_params(cls.NAME, raw, kind.params, ignore=("type",))
-        return cls(kind.name, values)
+        values = read_params(cls.NAME, raw, kind.params, ignore=("type", *cls.COMMON))
+        common = read_params(cls.NAME, {k: v for k, v in raw.items() if k in cls.COMMON},
+                             cls.COMMON)
+        return cls(kind.name, values, common.get("assembly_mode"))
 
     @property
     def kind(self) -> PathType:
@@ -68,6 +78,8 @@ class PathTable(Table):
     def summary(self) -> dict[str, Any]:
         """The path as configured, JSON-ready (lengths in mm, angles in degrees)."""
         out: dict[str, Any] = {"type": self.type}
+        if self.assembly_mode is not None:
+            out["assembly_mode"] = self.assembly_mode
         for k, v in self.values.items():
             unit = self.kind.params[k].unit
             name = f"{k}_mm" if unit == "mm" else k

@@ -11,9 +11,11 @@ from ..analysis import Analysis, analyze
 from ..config import Scenario
 from ..dynamics import Model
 from ..dynamics.paper import paper_model_limits
+from ..errors import ConfigError
 from ..laws import Law
 from ..output.mjcf import to_mjcf
 from ..simulation import ControlResult, simulate_computed_torque
+from ..simulation.crossing import simulate_crossing
 from ..trajectory import Trajectory
 
 
@@ -61,8 +63,20 @@ class Torques:
     paper_model_reason: str | None
 
 
+def refuse_crossing(sc: Scenario, command: str) -> None:
+    """Refuse, by name, a path across the parallel singularity curve for a job whose
+    analysis evaluates the torques in the motor angles (``run``, ``torques``)."""
+    if sc.path_table.assembly_mode is not None and sc.crossings:
+        raise ConfigError(
+            f"config key [path].assembly_mode: the path crosses the parallel (type 2) "
+            f"singularity curve, which dextar {command} does not analyse (its torques, paper "
+            "model and checks are in the motor angles, unbounded there): dextar plan, simulate "
+            "and program plan it, with its torques bounded under the degeneracy condition")
+
+
 def torques(sc: Scenario) -> Torques:
     """The configured law's exact (and paper-model) torques along the path."""
+    refuse_crossing(sc, "torques")
     an = analyze(sc.inputs(), sc.law())
     why = None if an.paper is not None else paper_model_limits(sc.robot, sc.inertia)
     return Torques(sc, an, why)
@@ -96,11 +110,21 @@ class Simulated:
 def simulate(sc: Scenario) -> Simulated:
     """Track the configured motion with computed torque on the config's model, the plant's
     masses off by ``[control].mass_error`` and carrying ``[control].payload`` unknown to the
-    controller."""
+    controller; a motion across the parallel singularity curve (``[path].assembly_mode``)
+    with its planned torques and the singularity-robust task-space loop of
+    :mod:`dextar.simulation.crossing`."""
     tr = sc.trajectory()
     c = sc.control
     plant = sc.inertia.scaled_masses(1.0 + c["mass_error"])
     plant = plant.with_(payload=plant.payload + c["payload"])
+    if tr.crossings:  # the planned torques and a singularity-robust task-space loop
+        res = simulate_crossing(
+            tr, Model(sc.robot, sc.inertia, tr.assembly, tol=0.0),
+            Model(sc.robot, plant, tr.assembly, tol=0.0),
+            natural_frequency=c["natural_frequency"], damping=c["damping"],
+            torque_limit=c["torque_limit"], initial_error=c["initial_error"],
+            tolerance=c["tolerance"], time_s=sc.units.time_s, length_mm=sc.units.length_mm)
+        return Simulated(sc, tr, res, c)
     res = simulate_computed_torque(
         tr, Model(sc.robot, sc.inertia, tr.assembly), Model(sc.robot, plant, tr.assembly),
         natural_frequency=c["natural_frequency"], damping=c["damping"],

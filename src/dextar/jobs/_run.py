@@ -13,6 +13,7 @@ from ..analysis import Analysis, analyze, run_summary, validation
 from ..config import Scenario
 from ..output.parallel import Forked
 from ..trajectory import Trajectory
+from ._motion import refuse_crossing
 
 #: ``stage(name, fn) -> fn()``: runs one named step (the command's progress and timings).
 Stage = Callable[[str, Callable[[], Any]], Any]
@@ -68,6 +69,7 @@ def run(sc: Scenario, *, stage: Stage = _plain) -> RunResult:
     waits for them), so that a caller drawing the figures meanwhile uses both cores.
 
     ``stage(name, fn)`` runs each named step (``dextar run`` times them and shows them)."""
+    refuse_crossing(sc, "run")
     inputs = sc.inputs()
     an: Analysis = stage(f"{sc.law_table.type} law, trajectory and torques",
                          lambda: analyze(inputs, sc.law()))

@@ -124,13 +124,17 @@ def check_poses(robot: FiveBar, q: Array, P: Array, *,
                 tolerances: Tolerances = DEFAULT_TOLERANCES, type1: bool = True,
                 type2: bool = True, crossings: bool = True,
                 joint_limits: Array | None = None, where: Callable[[int], str],
-                point: Callable[[Array], str], mode: str = "") -> PoseDistances:
+                point: Callable[[Array], str], mode: str = "",
+                excused: Array | None = None) -> PoseDistances:
     """Check a sequence of poses ``(q, P)`` (each (n, 2)) and return their distances.
 
     Raises :class:`SingularityError` for the first pose within the tolerance of a singularity
     (or, with ``crossings``, a parallel singularity crossed between two samples) and
     :class:`ReachError` for a joint outside ``joint_limits`` ((2, 2) rows ``[min, max]`` in
-    rad). ``where(i)`` and ``point(P)`` word the sample and the point.
+    rad). ``where(i)`` and ``point(P)`` word the sample and the point. ``excused`` (n,) marks
+    the samples whose parallel-singularity checks are skipped: those at a planned crossing
+    of the parallel singularity curve (:func:`dextar.trajectory.find_crossings`), which the
+    law makes under the degeneracy condition.
     """
     d = pose_distances(robot, q, P)
     in_mode = f" in working mode {mode}" if mode else ""
@@ -142,7 +146,10 @@ def check_poses(robot: FiveBar, q: Array, P: Array, *,
         if crossings and len(P) > 1:
             s = np.sign(d.type2_signed)
             crossed[1:] = s[1:] != s[:-1]
-        checks.append((2, (d.type2 < tolerances.type2) | crossed, d.type2, tolerances.type2))
+        bad2 = (d.type2 < tolerances.type2) | crossed
+        if excused is not None:
+            bad2 &= ~np.asarray(excused, bool)
+        checks.append((2, bad2, d.type2, tolerances.type2))
     first = [(int(np.flatnonzero(bad)[0]), kind, dist, tol) for kind, bad, dist, tol in checks
              if bad.any()]
     if first:

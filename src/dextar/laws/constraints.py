@@ -26,6 +26,12 @@ solver (:mod:`dextar.laws.time_optimal`) takes any sequence of them. The kinds:
   ``max(x0, x_knee)``: conservative, and exact at the tangent point.
 * :class:`AccelerationLimit`: ``|qddot_i| = |q'_i u + q''_i x| <= max_acceleration_i``, linear
   in ``(u, x)`` like the torque rows.
+* :class:`DegeneracyCondition`: at a crossing of the parallel (type 2) singularity curve,
+  the equality ``cu u + cx x + cg = 0`` that the path dynamics carry for that grid point
+  (:attr:`PathCoefficients.conditions`): the end-effector's force has no component normal to
+  the aligned distal rods (Briot & Arakelian, IJRR 2008), so the torques stay bounded there;
+  the torque rows at that point are the limit of the torques along a motion that meets it
+  (:mod:`dextar.dynamics.crossing`).
 * :class:`JerkLimit` and :class:`TorqueRateLimit`: third order, ``|qdddot_i|`` and
   ``|d tau_i / dt|`` bounded. They have no rows in ``(u, x)`` (the jerk involves ``sdddot``):
   the jerk-limited law (:mod:`dextar.laws.smooth`) linearises them in its own variables, and
@@ -54,6 +60,19 @@ from .base import Law
 
 
 @dataclass(frozen=True)
+class ConditionRow:
+    """An equality ``cu u + cx x + cg = 0`` on the path's acceleration ``u = sddot`` and squared
+    speed ``x = sdot^2`` at grid point ``index`` (a degeneracy condition: the normal component
+    of the end-effector's force at a crossing of the parallel singularity curve, in force
+    units)."""
+
+    index: int
+    cu: float
+    cx: float
+    cg: float
+
+
+@dataclass(frozen=True)
 class PathCoefficients:
     """The path dynamics on a grid of arc lengths: ``tau = a u + b x + g + f``.
 
@@ -73,6 +92,14 @@ class PathCoefficients:
         ``q''`` (for the joint accelerations; None: zero, a straight line in joint space).
     coulomb_speed : float
         The regularisation speed of the Coulomb friction (``tanh(qdot / coulomb_speed)``).
+    conditions : tuple of ConditionRow
+        Equalities the motion must meet at some grid points (the degeneracy conditions of
+        crossings of the parallel singularity curve); :class:`DegeneracyCondition` imposes
+        them.
+    holdable : ndarray of bool, shape (N + 1,), optional
+        The grid points where holding the robot still is a meaningful check (None: all);
+        near a crossing of the parallel singularity curve no finite torque holds it there,
+        and the motion passes.
     """
 
     s: Array
@@ -85,6 +112,8 @@ class PathCoefficients:
     viscous: Array
     d2q_ds2: Array | None = None
     coulomb_speed: float = 1.0
+    conditions: tuple[ConditionRow, ...] = ()
+    holdable: Array | None = None
 
     @property
     def ddq_ds(self) -> Array:
@@ -366,6 +395,45 @@ class AccelerationLimit(Constraint):
         """The accelerations tightened by ``scales["acceleration"]``."""
         return replace(self, max_acceleration=_pair(np.asarray(self.max_acceleration, float)
                                                     * scales.get("acceleration", 1.0)))
+
+
+@dataclass(frozen=True)
+class DegeneracyCondition(Constraint):
+    """The equalities of :attr:`PathCoefficients.conditions` (the degeneracy conditions of the
+    path's crossings of the parallel singularity curve), as two opposite rows at their grid
+    points (none elsewhere). Its ratio is 0: the condition holds to rounding at its grid
+    point by construction, and its residual along the planned law is measured by
+    :func:`dextar.dynamics.crossing.crossing_margins`."""
+
+    kind: str = "degeneracy"
+
+    def rows(self, tangent: Tangent) -> PointRows | None:
+        """``cu u + cx x <= -cg`` and ``-(cu u + cx x) <= cg`` at each condition's point,
+        scaled to unit size (rows of zeros elsewhere)."""
+        co = tangent.co
+        if not co.conditions:
+            return None
+        n = len(co.s)
+        pu, px, ph = np.zeros((n, 2)), np.zeros((n, 2)), np.zeros((n, 2))
+        for c in co.conditions:
+            scale = max(abs(c.cu), abs(c.cx), abs(c.cg), 1e-300)
+            row = np.array([c.cu, c.cx, -c.cg]) / scale
+            pu[c.index], px[c.index], ph[c.index] = (np.array([row[0], -row[0]]),
+                                                     np.array([row[1], -row[1]]),
+                                                     np.array([row[2], -row[2]]))
+        return PointRows(pu, px, ph)
+
+    def sample_ratios(self, js: JointSamples) -> Array:
+        """0 at every sample (see the class doc)."""
+        return np.zeros(len(js.dq))
+
+    def ratio(self, js: JointSamples) -> float:
+        """0 (see the class doc)."""
+        return 0.0
+
+    def scaled(self, scales: Mapping[str, float]) -> DegeneracyCondition:
+        """Itself: an equality is not tightened."""
+        return self
 
 
 def _torque_ratios(motors: MotorLimits, js: JointSamples) -> Array:

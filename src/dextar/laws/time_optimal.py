@@ -50,6 +50,7 @@ from ..units import Units
 from .base import Law
 from .constraints import (
     Constraint,
+    DegeneracyCondition,
     PathCoefficients,
     PathDynamics,
     Tangent,
@@ -165,7 +166,12 @@ def solve_time_optimal_law(dynamics: PathDynamics, *,
         :mod:`dextar.laws.constraints`); one of them must limit the torques.
     grid : int or ndarray, shape (N + 1,)
         Number of equal segments in arc length, or the grid's arc lengths (increasing from 0
-        to the path's length; finer where the dynamics change fast, e.g. in a blend).
+        to the path's length; finer where the dynamics change fast, e.g. in a blend). A
+        dynamics with an ``adjust_grid(s)`` method moves grid points where it needs them (a
+        crossing of the parallel singularity curve:
+        :class:`dextar.dynamics.crossing.RobotAcrossPath`), and coefficients with
+        ``conditions`` add :class:`~dextar.laws.constraints.DegeneracyCondition` to the
+        constraints.
     tol : float
         Allowed relative excess of a torque or speed over its limit on the check samples.
     units : Units, optional
@@ -187,8 +193,13 @@ def solve_time_optimal_law(dynamics: PathDynamics, *,
         raise ParameterError(f"tolerance {tol!r} must be in (0, 1)")
     length = float(dynamics.length)
     s_grid = _grid(grid, length)
+    adjust = getattr(dynamics, "adjust_grid", None)  # grid points a dynamics needs (crossings)
+    if adjust is not None:
+        s_grid = adjust(s_grid)
     co = dynamics.coefficients(s_grid)
     tmax = np.asarray(_torque_limit(cons), float)
+    if co.conditions and not any(isinstance(c, DegeneracyCondition) for c in cons):
+        cons = (*cons, DegeneracyCondition())  # a crossing's condition: never left out
     _check_holding(co, tmax, units)
     ds = np.diff(co.s)
     # the tightening of each kind of limit (the message names torque and speed always)
@@ -270,7 +281,7 @@ def _verdict(law: TimeOptimalLaw, ratio: dict[str, float], scales: dict[str, flo
         "; limits tightened by " + " and ".join(f"{1 - v:.2%} ({k})" for k, v in scales.items())
         + " so that they hold between the grid points")
     extra = "".join(f", {k} ratio {r:.5f}" for k, r in ratio.items()
-                    if k not in ("torque", "speed"))
+                    if k not in ("torque", "speed", "degeneracy"))
     ratios = (f"torque ratio {law.max_torque_ratio:.5f}, speed ratio "
               f"{law.max_speed_ratio:.5f}{extra}")
     if ok:
@@ -334,15 +345,20 @@ def _torque(units: Units | None, value: float) -> str:
 
 
 def _check_holding(co: PathCoefficients, tmax: Array, units: Units | None) -> None:
-    """Gravity alone must be within the limits everywhere on the path."""
+    """Gravity alone must be within the limits everywhere on the path (where holding the
+    robot still means something: :attr:`PathCoefficients.holdable`)."""
     ratio = np.abs(co.g) / tmax
+    if co.holdable is not None:
+        ratio = np.where(co.holdable[:, None], ratio, 0.0)
     if ratio.max() > 1.0:
         k, i = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
         motor = "A" if i == 0 else "D"
-        raise InfeasibleError(
+        exc = InfeasibleError(
             f"no motion within the limits: the motor at {motor} needs "
             f"{_torque(units, abs(co.g[k, i]))} to hold the robot still against gravity at "
             f"{_describe(co, int(k), units)}, above its limit {_torque(units, tmax[i])}")
+        exc.holding = True  # type: ignore[attr-defined]  # (gravity alone, not the motion)
+        raise exc
 
 
 def _rows(co: PathCoefficients, ds: Array, constraints: Sequence[Constraint],

@@ -358,9 +358,12 @@ def svg_bytes(fig: Any) -> bytes:
     return buf.getvalue()
 
 
-def tracking_figure(res: Any, units: Any, mass_error: float, payload_kg: float) -> Any:
+def tracking_figure(res: Any, units: Any, mass_error: float, payload_kg: float,
+                    crossings: Array | None = None) -> Any:
     """Computed-torque tracking: task and joint errors, and the applied torques against the
-    saturation limit (dashed) with the saturated samples marked."""
+    saturation limit (dashed) with the saturated samples marked; with ``crossings`` (the
+    times of the motion's crossings of the parallel singularity curve, run units) the
+    tracking of the planned torques and the singularity-robust loop, the crossings marked."""
     fig = new_figure((6.4, 8))
     axes = fig.subplots(3, 1, sharex=True)
     mm = units.length_mm
@@ -381,10 +384,17 @@ def tracking_figure(res: Any, units: Any, mass_error: float, payload_kg: float) 
                          * np.sign(res.tau[sat][np.arange(sat.sum()),
                                                 np.abs(res.tau[sat]).argmax(axis=1)]),
                          "r.", ms=3, label=f"saturated ({res.saturated.mean():.1%})")
+    crossed = np.asarray([] if crossings is None else crossings, float)
+    for ax in axes:
+        for k, tc in enumerate(crossed):
+            ax.axvline(tc, color="red", ls="-.", lw=0.9,
+                       label="type-2 crossing" if (ax is axes[2] and k == 0) else None)
     axes[2].set_ylabel(f"torque [{units.names['torque']}]")
     axes[2].legend(fontsize=8)
     axes[2].set_xlabel(f"time [{units.names['time']}]")
-    axes[0].set_title(f"Computed-torque tracking: masses {mass_error:+.0%}, unmodelled "
+    how = ("Planned torques + singularity-robust task-space loop" if crossed.size else
+           "Computed-torque tracking")
+    axes[0].set_title(f"{how}: masses {mass_error:+.0%}, unmodelled "
                       f"payload {payload_kg:g} kg", fontsize=10)
     tight_layout(fig)
     return fig
@@ -397,9 +407,12 @@ def plot_workspace(
     pose: tuple[Array, Array] | None = None,
     unit: str = "mm",
     ax: Any = None,
+    crossings: Array | None = None,
 ) -> Any:
     """Draw a :class:`WorkspaceMap`: dexterity colour map, type-1 circles (dashed blue),
-    type-2 curves (red), pivots, and optionally a path (n, 2) and a pose ``(q, P)``.
+    type-2 curves (red) with the region of each assembly mode (``down`` hatched: they meet on
+    the curves), pivots, and optionally a path (n, 2), where it crosses the type-2 curves
+    (``crossings`` (k, 2): red stars) and a pose ``(q, P)``.
 
     Returns the matplotlib figure.
     """
@@ -416,6 +429,13 @@ def plot_workspace(
     t2 = np.ma.masked_where(~ws.reachable, ws.type2)
     if np.any(t2 > 0) and np.any(t2 < 0):
         ax.contour(ws.x, ws.y, t2, levels=[0.0], colors="red", linewidths=1.5)
+    # the assembly modes' regions: sign((B - C) x (P - C)) = -sign(det A), "down" hatched
+    down = (ws.reachable & (ws.type2 > 0)).astype(float)
+    if down.any():
+        ax.contourf(ws.x, ws.y, down, levels=[0.5, 1.5], colors="none", hatches=["////"])
+        ax.fill([], [], fc="none", hatch="////", ec="0.3", label="assembly mode down")
+    if (ws.reachable & (ws.type2 < 0)).any():
+        ax.fill([], [], fc="none", ec="0.3", label="assembly mode up")
     theta = np.linspace(0, 2 * np.pi, 361)
     for centre, l, L in ((r.A, r.l1, r.L1), (r.D, r.l2, r.L2)):
         for rad in {abs(l - L), l + L}:
@@ -430,6 +450,10 @@ def plot_workspace(
         path = np.asarray(path)
         ax.plot(path[:, 0], path[:, 1], "w-", lw=2.5)
         ax.plot(path[:, 0], path[:, 1], "k-", lw=1.2, label="path")
+    if crossings is not None and len(crossings):
+        pts = np.asarray(crossings, float).reshape(-1, 2)
+        ax.plot(pts[:, 0], pts[:, 1], "*", color="red", mec="white", mew=0.8, ms=14,
+                label="type-2 crossing")
     if pose is not None:
         q, P = pose
         B, C = elbows(r, q)

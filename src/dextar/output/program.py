@@ -101,6 +101,7 @@ class ProgramSummary:
             *(f"  move {m.index} ({m.type}): {m.law or 'dwell'} {m.duration_s:.4g} s from "
               f"{m.start_s:.4g} s" + (", blended into the next" if m.blended_with_next else "")
               for m in self.moves),
+            *(crossing_line(m.index, c) for m in self.moves for c in m.crossings),
             *(f"  motor {m.motor}: peak {m.peak_torque_Nm:.4g} N m, RMS {m.rms_torque_Nm:.4g} "
               f"N m, peak speed {m.peak_speed_rad_s:.4g} rad/s" for m in self.sizing.motors),
             *([] if self.rms_fit is None else [
@@ -123,6 +124,19 @@ class ProgramSummary:
             return ""
         a, b = self.encoder_offset_deg
         return f"; angles in encoder readings, offsets [{a:g}, {b:g}] deg"
+
+
+def crossing_line(index: int, c: dict[str, Any]) -> str:
+    """A crossing of the parallel singularity curve in words (``summary.json``'s entry)."""
+    x, y = c["point_mm"]
+    peak = ", ".join(f"{v:.4g}" for v in c["torque_peak_Nm"])
+    ratio = "" if c["torque_peak_ratio"] is None else (
+        " (" + ", ".join(f"{v:.4f}" for v in c["torque_peak_ratio"]) + " of the peak torque)")
+    return (f"  move {index} crosses the parallel singularity curve at ({x:.4g}, {y:.4g}) mm "
+            f"at t = {c['time_s']:.6g} s, {c['speed_mm_s']:.4g} mm/s, assembly mode "
+            f"{c['assembly_before']} -> {c['assembly_after']}: degeneracy condition's residual "
+            f"{c['residual_N']:.3g} N ({c['residual_ratio']:.2g} of its terms), torque peak "
+            f"near it {peak} N m{ratio}")
 
 
 def setpoint_columns(res: ProgramResult,
@@ -197,12 +211,41 @@ def _figures(res: ProgramResult, summary: ProgramSummary, robot_mm: FiveBar, mod
     return render(jobs)
 
 
+def crossing_points(res: ProgramResult) -> Array:
+    """Where the program's moves cross the parallel singularity curve (k, 2), mm."""
+    pts = [1e3 * np.asarray(c.crossing.P) for pm in res.moves for c in pm.crossings]
+    return np.array(pts).reshape(-1, 2)
+
+
+def crossing_times(res: ProgramResult) -> Array:
+    """When the program's moves cross the parallel singularity curve (k,), s."""
+    return np.array([pm.start_s + c.t for pm in res.moves for c in pm.crossings])
+
+
+def mode_changes(res: ProgramResult, mode: str) -> Array:
+    """Where a move ends in another working mode than it started in (k, 2), mm."""
+    out, prev = [], mode
+    for pm in res.moves:
+        if pm.mode and pm.mode != prev:
+            out.append(1e3 * np.asarray(pm.sample(np.array([pm.duration_s]))[0][-1]))
+        prev = pm.mode or prev
+    return np.array(out).reshape(-1, 2)
+
+
 def moves_figure(res: ProgramResult, robot_mm: FiveBar, mode: str) -> Figure:
-    """The end-effector's path over the workspace map of the starting working mode, each move
-    numbered at its middle."""
+    """The end-effector's path over the workspace map of the starting working mode (its
+    assembly modes' regions and singularity curves), each move numbered at its middle, the
+    crossings of the parallel singularity curve (red stars) and the working-mode changes
+    (black diamonds) marked."""
     ws = workspace_map(robot_mm, mode, resolution=241)
-    fig: Figure = plot_workspace(ws, path=res.P * 1e3, unit="mm")
+    fig: Figure = plot_workspace(ws, path=res.P * 1e3, unit="mm",
+                                 crossings=crossing_points(res))
     ax = fig.axes[0]
+    changes = mode_changes(res, mode)
+    if len(changes):
+        ax.plot(changes[:, 0], changes[:, 1], "D", color="black", mec="white", ms=8,
+                label="working-mode change")
+        ax.legend(loc="lower right", fontsize=8)
     pts = res.P * 1e3
     span = float(np.ptp(pts, axis=0).max()) or 1.0
     lo, hi = pts.min(axis=0) - 0.35 * span, pts.max(axis=0) + 0.35 * span  # the moves' region
@@ -276,9 +319,12 @@ def motion_figure(res: ProgramResult) -> Figure:
             ax_tau.plot(t, avail, color=style, ls="--", lw=0.8)
             ax_tau.plot(t, -avail, color=style, ls="--", lw=0.8)
     changes = t[1:][np.diff(res.move_index) != 0]  # where the next move starts
+    crossed = crossing_times(res)
     for ax in axes:
         for tc in changes:
             ax.axvline(tc, color="grey", ls=":", lw=0.8)
+        for tc in crossed:
+            ax.axvline(tc, color="red", ls="-.", lw=0.9)
         ax.grid(alpha=0.3)
     ax_q.set_ylabel("angle [deg]")
     ax_v.set_ylabel("speed [rad/s]")
@@ -291,8 +337,8 @@ def motion_figure(res: ProgramResult) -> Figure:
     ax_tau.set_ylabel("torque [N m]")
     ax_tau.set_xlabel("time [s]")
     ax_q.legend(fontsize=8)
-    ax_q.set_title("Joint motion and torques (dashed: the motors' limits; dotted: moves)",
-                   fontsize=10)
+    ax_q.set_title("Joint motion and torques (dashed: the motors' limits; dotted: moves"
+                   + ("; red: type-2 crossings)" if len(crossed) else ")"), fontsize=10)
     tight_layout(fig)
     return fig
 
@@ -331,9 +377,10 @@ def program_report(summary: ProgramSummary, pngs: dict[str, bytes]) -> str:
     """A self-contained HTML page: the moves, the sizing, the violations and the figures."""
     esc = html.escape
     moves = grid(("move", "type", "law", "start [s]", "duration [s]", "min type-1 distance",
-                  "min type-2 distance"),
+                  "min type-2 distance", "modes at its end"),
                  [(m.index, m.type, m.law or "dwell", m.start_s, m.duration_s,
-                   m.min_type1_distance, m.min_type2_distance) for m in summary.moves])
+                   m.min_type1_distance, m.min_type2_distance,
+                   f"{m.working_mode} {m.assembly_mode}".strip()) for m in summary.moves])
     keys = [("peak_torque_Nm", "peak torque [N m]"), ("rms_torque_Nm", "RMS torque [N m]"),
             ("peak_speed_rad_s", "peak speed [rad/s]"), ("peak_power_W", "peak power [W]"),
             ("energy_J", "energy delivered [J]"),
@@ -352,10 +399,25 @@ def program_report(summary: ProgramSummary, pngs: dict[str, bytes]) -> str:
                   [(label, *(m.get(k, "-") for m in motors)) for k, label in keys])
     viol = "".join(f"<li>{esc(v.text())}</li>" for v in summary.sizing.violations
                    ) or "<li>none</li>"
+    rows = [(m.index, f"{c['time_s']:.6g}", "(" + ", ".join(f"{v:.4g}" for v in c["point_mm"])
+             + ")", f"{c['speed_mm_s']:.4g}",
+             f"{c['assembly_before']} -> {c['assembly_after']}", f"{c['residual_N']:.3g}",
+             f"{c['residual_ratio']:.2g}", ", ".join(f"{v:.4g}" for v in c["torque_peak_Nm"]),
+             "-" if c["torque_peak_ratio"] is None else
+             ", ".join(f"{v:.4f}" for v in c["torque_peak_ratio"]))
+            for m in summary.moves for c in m.crossings]
+    crossings = "" if not rows else (
+        "<h2>Crossings of the parallel singularity curve</h2><p>Each planned under the "
+        "degeneracy condition (the end-effector's force has no component normal to the aligned "
+        "distal rods there): its residual, and the torque peak within the crossing's "
+        "neighbourhood (normalised distance to the singularity below 0.05).</p>"
+        + grid(("move", "time [s]", "point [mm]", "speed [mm/s]", "assembly mode",
+                "residual [N]", "residual / terms", "torque peak [N m]", "peak / limit"),
+               rows))
     name = Path(summary.config).name
     return page(
         f"Program {name}: {summary.status} the motors",
         f"<p>Task file {esc(summary.config)}. Cycle time {summary.cycle_time_s:.4f} s; "
         f"setpoints at {summary.servo_rate_hz:g} Hz. Units: {esc(summary.units)}.</p>"
-        f"<h2>Moves</h2>{moves}<h2>Motor sizing</h2>{sizing}<h2>Violations</h2>"
+        f"<h2>Moves</h2>{moves}{crossings}<h2>Motor sizing</h2>{sizing}<h2>Violations</h2>"
         f"<ul>{viol}</ul><h2>Figures</h2>{figures(pngs)}")

@@ -7,6 +7,7 @@ from typing import Any
 
 import numpy as np
 
+from ..dynamics.crossing import crossing_time
 from ..simulation import ControlResult
 from ..trajectory import Trajectory
 from ..units import Units
@@ -30,6 +31,7 @@ def write_tracking(out: str, tr: Trajectory, res: ControlResult, units: Units,
             f"tau1_{u['torque']}": res.tau[:, 0], f"tau2_{u['torque']}": res.tau[:, 1],
             "saturated": res.saturated.astype(float)}
     summ = res.summary()
+    crossed = [crossing_time(tr.law, c.s) for c in tr.crossings]
     tol_mm = None if res.tolerance is None else res.tolerance * mm
     left = res.left_at
     report = {"units": units.describe(), "control": dict(control),
@@ -44,7 +46,18 @@ def write_tracking(out: str, tr: Trajectory, res: ControlResult, units: Units,
               "final_task_error_mm": summ["final_task_error"] * mm,
               "max_joint_error_deg": float(np.degrees(summ["max_joint_error_rad"])),
               "saturated_fraction": summ["saturated_fraction"]}
-    fig = tracking_figure(res, units, control["mass_error"], control["payload_kg"])
+    if tr.crossings:
+        report["controller"] = ("the planned torques (the degeneracy condition met at each "
+                                "crossing) and a task-space PD through the damped "
+                                "least-squares inverse of E = A^T B^-1")
+        report["crossings"] = [{"time_s": float(t * units.time_s),
+                                "point_mm": [float(v * mm) for v in c.P],
+                                "assembly_before": c.assembly_before,
+                                "assembly_after": c.assembly_after}
+                               for t, c in zip(crossed, tr.crossings, strict=True)]
+        report["final_assembly_mode"] = tr.end_assembly if res.status == 0 else None
+    fig = tracking_figure(res, units, control["mass_error"], control["payload_kg"],
+                          np.array(crossed) if crossed else None)
     with OutputDir(out, force=force, produces=TRACKING_FILES) as od:
         od.write_text("tracking.csv", csv_text(cols))
         od.write_bytes("tracking.png", png_bytes(fig))

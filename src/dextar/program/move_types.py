@@ -4,13 +4,14 @@ config keys, registered with :func:`dextar.program.moves.register_move`)."""
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
 from .._arrays import Array
 from ..dynamics import RobotAlongJointLine, gravity_torques
-from ..errors import DextarError, ParameterError
+from ..errors import AssemblyError, DextarError, ParameterError
 from ..geometry import canonical_working_mode
 from ..kinematics import direct_kinematics, inverse_kinematics, singularity_distances
 from ..laws import Law
@@ -21,7 +22,15 @@ from ..trajectory import JointLine, Trajectory, sample_joint_trajectory
 from ..units import SI
 from .laws import LengthPath, move_law
 from .moves import Move, MoveType, move_type, register_move
-from .plan import MovePlan, PlanContext, PlanState, along_path, check_assembly, mode_at
+from .plan import (
+    MovePlan,
+    PlanContext,
+    PlanState,
+    canonical_assembly,
+    check_assembly,
+    mode_at,
+    plan_along,
+)
 
 #: Samples of a move's own sampling (a fitted duration is checked on them).
 MOVE_SAMPLES = 401
@@ -51,10 +60,13 @@ def _plan_path_move(ctx: PlanContext, mv: Move, state: PlanState) -> MovePlan:
     kind = move_type(mv.type)
     assert kind.path is not None  # registered with a path below
     path = kind.path(mv, state.P)
-    law, sample, q1, poses = along_path(ctx, mv, path, state, ctx.grid, samples=MOVE_SAMPLES)
-    end = PlanState(_point(mv, "to"), q1, state.mode)  # exactly where the move was sent
-    return MovePlan(law, law.duration, sample, end, float(poses.distances.type1.min()),
-                    float(poses.distances.type2.min()))
+    pp = plan_along(ctx, mv, path, state, ctx.grid, samples=MOVE_SAMPLES,
+                    targets=[(path.length, mv.get("assembly_mode"), "")])
+    # exactly where the move was sent, in the assembly mode its path reaches
+    end = PlanState(_point(mv, "to"), pp.q1, state.mode, pp.end_assembly)
+    d = pp.poses.distances
+    return MovePlan(pp.law, pp.law.duration, pp.sample, end, float(d.type1.min()),
+                    float(d.type2.min()), pp.torques, pp.crossings)
 
 
 def _plan_dwell(ctx: PlanContext, mv: Move, state: PlanState) -> MovePlan:
@@ -70,7 +82,7 @@ def _plan_dwell(ctx: PlanContext, mv: Move, state: PlanState) -> MovePlan:
 
     motors = ctx.motors
     if motors is not None:
-        g = gravity_torques(ctx.free_model, state.q)
+        g = gravity_torques(replace(ctx.free_model, assembly=state.assembly), state.q)
         ratio = np.abs(g) / np.asarray(motors.peak_torque)
         if ratio.max() > 1.0:
             i = int(np.argmax(ratio))
@@ -84,33 +96,42 @@ def _plan_dwell(ctx: PlanContext, mv: Move, state: PlanState) -> MovePlan:
 def _plan_joint(ctx: PlanContext, mv: Move, state: PlanState) -> MovePlan:
     """A straight line in joint space to ``to_q`` (rad) or to ``to`` (m) in ``working_mode``
     (the nearest turn); it may change the working mode."""
-    robot, q0 = ctx.robot, state.q
+    robot, q0, assembly = ctx.robot, state.q, state.assembly
+    asked = mv.get("assembly_mode")
+    if asked is not None and canonical_assembly(asked) != assembly:
+        raise AssemblyError(
+            f"assembly_mode = \"{canonical_assembly(asked)}\", but a joint move stays in "
+            f"assembly mode {assembly}: a straight line in joint space meets the parallel "
+            "(type 2) singularity curve only at the edge of the joints' region where the "
+            "distal rods still meet, and cannot pass it; change the assembly mode with a line "
+            "or an arc across the curve")
     new_mode = canonical_working_mode(mv.get("working_mode") or state.mode)
     if mv.get("to_q") is not None:
         q1 = _point(mv, "to_q")
     else:
         target = _point(mv, "to")
         q1 = inverse_kinematics(robot, target, new_mode)
-        check_assembly(robot, q1, target, new_mode, ctx.assembly, "the target")
+        check_assembly(robot, q1, target, new_mode, assembly, "the target")
         q1 = q1 + np.round((q0 - q1) / (2 * np.pi)) * 2 * np.pi  # the nearest turn
     line = JointLine((float(q0[0]), float(q0[1])), (float(q1[0]), float(q1[1])))
 
     def jtraj(law: Law, times: Array | None = None) -> Trajectory:
-        return sample_joint_trajectory(robot, line, law, assembly=ctx.assembly, times=times,
+        return sample_joint_trajectory(robot, line, law, assembly=assembly, times=times,
                                        samples=MOVE_SAMPLES, tolerances=ctx.tolerances,
                                        units=SI)
 
-    law = move_law(mv, LengthPath(line.length), RobotAlongJointLine(ctx.model, line, SI),
-                   ctx.motors, ctx.grid, jtraj, ctx.model)
+    model = replace(ctx.model, assembly=assembly)
+    law = move_law(mv, LengthPath(line.length), RobotAlongJointLine(model, line, SI),
+                   ctx.motors, ctx.grid, jtraj, model)
     tr = jtraj(law)
     d1, d2 = singularity_distances(robot, tr.q, tr.P)
-    P1 = direct_kinematics(robot, q1, ctx.assembly)
+    P1 = direct_kinematics(robot, q1, assembly)
 
     def sample(t: Array) -> tuple[Array, Array, Array, Array]:
         s = jtraj(law, np.clip(t, 0.0, law.duration))
         return s.P, s.q, s.dq, s.ddq
 
-    end = PlanState(P1, q1, mode_at(robot, q1, P1, new_mode))
+    end = PlanState(P1, q1, mode_at(robot, q1, P1, new_mode), assembly)
     return MovePlan(law, law.duration, sample, end, float(d1.min()), float(d2.min()))
 
 
@@ -132,15 +153,20 @@ def _check_joint(v: Mapping[str, Any]) -> str | None:
 
 
 _TO = Param("point", "mm", REQUIRED, "target point [x, y] in mm")
+_ASSEMBLY = Param("choice", "", None, "the assembly mode at the move's end, up or down "
+                  "(default: unchanged); another than the start's makes the path cross the "
+                  "parallel (type 2) singularity curve under the degeneracy condition "
+                  "(law time-optimal)", choices=("up", "down"))
 
-register_move(MoveType("line", {"to": _TO}, _plan_path_move, path=line_path,
-                       help="a straight segment to a point"))
+register_move(MoveType("line", {"to": _TO, "assembly_mode": _ASSEMBLY}, _plan_path_move,
+                       path=line_path, help="a straight segment to a point"))
 register_move(MoveType(
     "arc", {"to": _TO,
             "via": Param("point", "mm", None, "an intermediate point [x, y] in mm"),
             "center": Param("point", "mm", None, "the centre [x, y] in mm"),
             "direction": Param("choice", "", "ccw", "ccw or cw (about a centre)",
-                               choices=("ccw", "cw"))},
+                               choices=("ccw", "cw")),
+            "assembly_mode": _ASSEMBLY},
     _plan_path_move, path=arc_path, check=_check_arc,
     help="an arc through 'via' to a point, or about 'center'"))
 register_move(MoveType(
@@ -150,6 +176,9 @@ register_move(MoveType(
     "joint", {"to": Param("point", "mm", None, "target point [x, y] in mm"),
               "to_deg": Param("point", "deg", None, "target angles [phi, psi] in deg (encoder "
                               "readings: geometric angle - [robot].encoder_offset_deg)"),
-              "working_mode": Param("text", "", None, "the target's working mode")},
+              "working_mode": Param("text", "", None, "the target's working mode"),
+              "assembly_mode": Param("choice", "", None, "up or down: a joint move keeps "
+                                     "the assembly mode (refused if another)",
+                                     choices=("up", "down"))},
     _plan_joint, check=_check_joint, si_keys={"to_deg": "to_q"},
     help="a straight line in joint space (it may change the working mode)"))

@@ -26,12 +26,19 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from functools import cached_property
+from typing import Any
 
 import numpy as np
 
 from .._arrays import Array
 from ..dynamics import Inertia, Model, RobotAlongPath, inverse_dynamics
-from ..errors import AssemblyError, DextarError, ParameterError
+from ..dynamics.crossing import (
+    CrossingMargin,
+    PlannedTorques,
+    RobotAcrossPath,
+    crossing_margins,
+)
+from ..errors import AssemblyError, DextarError, InfeasibleError, NumericalError, ParameterError
 from ..geometry import (
     FiveBar,
     assembly_mode_name,
@@ -44,7 +51,14 @@ from ..laws import Law
 from ..motors import MotorLimits
 from ..paths import Path
 from ..paths.composite import Composite, Quintic, blended
-from ..trajectory import CheckedPath, Trajectory, check_path, sample_trajectory
+from ..trajectory import (
+    CheckedPath,
+    Crossing,
+    Trajectory,
+    check_path,
+    find_crossings,
+    sample_trajectory,
+)
 from ..units import SI
 from .laws import move_law
 from .moves import Move, move_type
@@ -97,11 +111,13 @@ class PlanContext:
 @dataclass(frozen=True)
 class PlanState:
     """Where the robot is between moves, at rest: the point (m), the joint angles (rad,
-    continuous over the program) and the working mode."""
+    continuous over the program), the working mode and the assembly mode (``""`` in a
+    move's end state: unchanged, the state's it started from)."""
 
     P: Array
     q: Array
     mode: str
+    assembly: str = ""
 
 
 @dataclass(frozen=True)
@@ -119,6 +135,12 @@ class MovePlan:
         Where the move leaves the robot, at rest.
     min_type1_distance, min_type2_distance : float
         Smallest normalised distances to the singularities along the move.
+    torques : callable, optional
+        ``torques(local times (n,)) -> (n, 2)`` feedforward torques (N m) where the exact
+        kernel on the joint motion cannot give them: a move across the parallel singularity
+        curve (None: the kernel's, in the move's assembly mode).
+    crossings : tuple of CrossingMargin
+        The move's crossings of the parallel singularity curve (local times).
     """
 
     law: Law | None
@@ -127,6 +149,8 @@ class MovePlan:
     end: PlanState
     min_type1_distance: float
     min_type2_distance: float
+    torques: Callable[[Array], Array] | None = None
+    crossings: tuple[CrossingMargin, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -151,6 +175,15 @@ class PlannedMove:
         For a blended chain of moves (one motion): the move index at each local time.
     members : tuple of (index, start_s, duration_s)
         For a blended chain: where each of its moves sits in the cycle.
+    assembly, end_assembly : str
+        The assembly mode at its start and at its end (they differ across a crossing of the
+        parallel singularity curve).
+    mode : str
+        The working mode at its end.
+    torques : callable, optional
+        The move's own feedforward torques (:attr:`MovePlan.torques`).
+    crossings : tuple of CrossingMargin
+        Its crossings of the parallel singularity curve (local times).
     """
 
     index: int
@@ -165,6 +198,11 @@ class PlannedMove:
     min_type2_distance: float
     owner: Callable[[Array], Array] | None = None
     members: tuple[tuple[int, float, float], ...] = ()
+    assembly: str = "up"
+    end_assembly: str = "up"
+    mode: str = ""
+    torques: Callable[[Array], Array] | None = None
+    crossings: tuple[CrossingMargin, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -183,6 +221,10 @@ class MoveTiming:
     blended_with_next : bool
     min_type1_distance, min_type2_distance : float
         Of the whole motion the move belongs to.
+    working_mode, assembly_mode : str
+        The modes the move ends in.
+    crossings : tuple of dict
+        Its crossings of the parallel singularity curve, JSON-ready (:func:`crossing_dict`).
     """
 
     index: int
@@ -195,6 +237,9 @@ class MoveTiming:
     blended_with_next: bool
     min_type1_distance: float
     min_type2_distance: float
+    working_mode: str = ""
+    assembly_mode: str = ""
+    crossings: tuple[dict[str, Any], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -249,14 +294,44 @@ class ProgramResult:
         for pm in self.moves:
             law = pm.law
             members = pm.members or ((pm.index, pm.start_s, pm.duration_s),)
+            peak = None if self.motors is None else self.motors.peak_torque
             for idx, start, dur in members:
+                mine = tuple(crossing_dict(c, pm.start_s, peak) for c in pm.crossings
+                             if start <= pm.start_s + c.t <= start + dur)
                 out.append(MoveTiming(
                     idx, self.move_types[idx] if self.move_types else pm.move.type,
                     law.name if law else None, int(law.status) if law else 0,
                     law.message if law else "holding still", start, dur,
                     bool(pm.members) and idx != pm.members[-1][0], pm.min_type1_distance,
-                    pm.min_type2_distance))
+                    pm.min_type2_distance, pm.mode,
+                    pm.end_assembly if idx == members[-1][0] else _assembly_at(pm, start + dur),
+                    mine))
         return out
+
+
+def _assembly_at(pm: PlannedMove, t: float) -> str:
+    """The assembly mode of a blended chain's motion at the cycle time ``t``."""
+    n = sum(1 for c in pm.crossings if pm.start_s + c.t <= t)
+    return pm.assembly if n % 2 == 0 else assembly_mode_name(-parse_assembly_mode(pm.assembly))
+
+
+def crossing_dict(c: CrossingMargin, start_s: float,
+                  peak: tuple[float, float] | None) -> dict[str, Any]:
+    """A crossing of the parallel singularity curve in ``summary.json`` (SI, mm): its time in
+    the cycle, the point, the path speed, the degeneracy condition's residual (N, and its
+    ratio to the terms that cancel in it), whether it holds, the torque peak within the
+    crossing's neighbourhood and its ratio to the motors' peak torques, the neighbourhood's
+    times and the assembly modes on either side."""
+    tp = [float(v) for v in c.torque_peak]
+    return {"time_s": start_s + c.t, "point_mm": [1e3 * float(v) for v in c.crossing.P],
+            "speed_mm_s": 1e3 * c.speed, "residual_N": c.residual,
+            "residual_ratio": c.residual_ratio, "condition_holds": c.holds,
+            "torque_peak_Nm": tp,
+            "torque_peak_ratio": None if peak is None else [v / p for v, p in
+                                                            zip(tp, peak, strict=True)],
+            "neighbourhood_s": [start_s + c.span[0], start_s + c.span[1]],
+            "assembly_before": c.crossing.assembly_before,
+            "assembly_after": c.crossing.assembly_after}
 
 
 @dataclass(frozen=True)
@@ -504,7 +579,7 @@ def plan_program(robot: FiveBar, inertia: Inertia, moves: Sequence[Move], *,
                 lambda v: f"{SI.mm(v):.6g} mm")
     q0 = inverse_kinematics(robot, P0, mode)
     check_assembly(robot, q0, P0, mode, assembly, "the start")
-    state = PlanState(P0, q0, mode)
+    state = PlanState(P0, q0, mode, assembly)
     planned: list[PlannedMove] = []
     t0 = 0.0
     for group in _chains(moves):
@@ -512,9 +587,12 @@ def plan_program(robot: FiveBar, inertia: Inertia, moves: Sequence[Move], *,
         try:
             if len(group) == 1:
                 mp = move_type(mv.type).plan(ctx, mv, state)
+                end = mp.end if mp.end.assembly else replace(mp.end, assembly=state.assembly)
                 pm = PlannedMove(i, mv, mp.law, t0, mp.duration_s, state.q, mp.end.q,
-                                 mp.sample, mp.min_type1_distance, mp.min_type2_distance)
-                state = mp.end
+                                 mp.sample, mp.min_type1_distance, mp.min_type2_distance,
+                                 assembly=state.assembly, end_assembly=end.assembly,
+                                 mode=end.mode, torques=mp.torques, crossings=mp.crossings)
+                state = end
             else:
                 pm, state = _plan_chain(ctx, group, state, t0)
         except DextarError as exc:
@@ -528,8 +606,8 @@ def plan_program(robot: FiveBar, inertia: Inertia, moves: Sequence[Move], *,
 
 
 def _check_ends(ctx: PlanContext, res: ProgramResult, moves: Sequence[Move]) -> None:
-    """Every motion ends where it was sent: the forward kinematics (in the program's
-    assembly mode) of its last setpoint, at its end time, within :data:`END_TOL` of the
+    """Every motion ends where it was sent: the forward kinematics (in the assembly mode it
+    ends in) of its last setpoint, at its end time, within :data:`END_TOL` of the
     reach of the target of its last move.
 
     Raises
@@ -545,13 +623,13 @@ def _check_ends(ctx: PlanContext, res: ProgramResult, moves: Sequence[Move]) -> 
         if target is None:
             continue
         q_end = pm.sample(np.array([pm.duration_s]))[1][-1]
-        end = direct_kinematics(robot, q_end, ctx.assembly)
+        end = direct_kinematics(robot, q_end, pm.end_assembly)
         miss = float(np.hypot(*(end - target)))
         if not miss <= tol:
             raise AssemblyError(
                 f"{move_name(last, moves[last])}: sent to {SI.point_text(target)}, it ends at "
                 f"{SI.point_text(end)} (the forward kinematics of its last setpoint in assembly "
-                f"mode {ctx.assembly}), {SI.mm(miss):.4g} mm away")
+                f"mode {pm.end_assembly}), {SI.mm(miss):.4g} mm away")
 
 
 def _chains(moves: Sequence[Move]) -> list[list[tuple[int, Move]]]:
@@ -605,12 +683,18 @@ def _plan_chain(ctx: PlanContext, group: list[tuple[int, Move]], state: PlanStat
         path, owner = _blended(tuple(pieces), tuple(float(mv.blend) for _, mv in group[:-1]))
     except ParameterError as exc:
         raise ParameterError(f"blend: {exc}") from None
+    # the assembly modes the members ask for where they end (the next member's start)
+    ends = [float(path.starts[owner.index(k + 1)]) for k in range(len(group) - 1)]
+    targets = [(s_end, mv.get("assembly_mode"), move_name(i, mv))
+               for s_end, (i, mv) in zip([*ends, path.length], group, strict=True)]
     try:
-        law, sample, q1, poses = along_path(ctx, first, path, state, chain_grid(path, ctx.grid),
-                                            samples=801)
+        pp = plan_along(ctx, first, path, state, chain_grid(path, ctx.grid), samples=801,
+                        targets=targets)
     except DextarError as exc:
-        _blame_piece(ctx, pieces, state, exc)
+        if not isinstance(exc, AssemblyError):
+            _blame_piece(ctx, pieces, state, exc)
         raise
+    law, sample, q1, poses = pp.law, pp.sample, pp.q1, pp.poses
     owners = np.array([group[o][0] for o in owner])
 
     def owner_of(t: Array) -> Array:
@@ -626,8 +710,9 @@ def _plan_chain(ctx: PlanContext, group: list[tuple[int, Move]], state: PlanStat
                     for k, (i, _) in enumerate(group))
     pm = PlannedMove(group[0][0], first, law, start_s, law.duration, state.q, q1, sample,
                      float(poses.distances.type1.min()), float(poses.distances.type2.min()),
-                     owner_of, members)
-    return pm, PlanState(P, q1, state.mode)
+                     owner_of, members, assembly=state.assembly, end_assembly=pp.end_assembly,
+                     mode=state.mode, torques=pp.torques, crossings=pp.crossings)
+    return pm, PlanState(P, q1, state.mode, pp.end_assembly)
 
 
 def _end(mv: Move, path: Path) -> Array:
@@ -656,23 +741,172 @@ def along_path(ctx: PlanContext, mv: Move, path: Path, state: PlanState, grid: i
     the path checked, the law of ``mv`` on it, the sampling ``(P, q, dq, ddq)`` at local
     times with the angles continuous with the state's (unwrapped by whole turns), the end
     angles and the checked poses (``samples``: the law's own sampling, for a fitted
-    duration)."""
+    duration). The path may not cross the parallel singularity curve (:func:`plan_along`
+    plans the moves that do)."""
+    pp = plan_along(ctx, mv, path, state, grid, samples=samples)
+    return pp.law, pp.sample, pp.q1, pp.poses
+
+
+@dataclass(frozen=True)
+class PathPlan:
+    """A task-space motion planned by :func:`plan_along`.
+
+    Attributes
+    ----------
+    law : Law
+    sample : callable
+        ``sample(local times) -> (P, q, dq, ddq)``.
+    q1 : ndarray, shape (2,)
+        The end angles, continuous with the start's.
+    poses : CheckedPath
+        The path's poses as the geometry checker checked them.
+    end_assembly : str
+        The assembly mode at its end.
+    torques : callable, optional
+        The feedforward torques at local times, for a motion across the parallel singularity
+        curve (None: the exact kernel's on the joint motion).
+    crossings : tuple of CrossingMargin
+        Its crossings of the curve (local times).
+    """
+
+    law: Law
+    sample: Sampler
+    q1: Array
+    poses: CheckedPath
+    end_assembly: str
+    torques: Callable[[Array], Array] | None = None
+    crossings: tuple[CrossingMargin, ...] = ()
+
+
+#: ``(arc length, assembly mode or None, who)``: the assembly mode a move asks for at the
+#: arc length where it ends along a motion (None: none asked), and the move's name.
+Target = tuple[float, str | None, str]
+
+
+def plan_along(ctx: PlanContext, mv: Move, path: Path, state: PlanState, grid: int | Array,
+               *, samples: int, targets: Sequence[Target] = ()) -> PathPlan:
+    """:func:`along_path` with the assembly modes ``targets`` asks for at arc lengths along
+    the path (a move's ``assembly_mode``): where they differ from the state's, the path must
+    cross the parallel singularity curve of the working mode an odd number of times before
+    (each crossing changes the assembly mode), and the law (time-optimal) makes every
+    crossing under the degeneracy condition (:mod:`dextar.dynamics.crossing`).
+
+    Raises
+    ------
+    AssemblyError
+        An assembly mode the path does not reach (it does not cross the curve, or crosses it
+        an even number of times), named with the move and its path.
+    ParameterError
+        A crossing asked of a law other than the second-order time-optimal one.
+    InfeasibleError
+        A crossing the motors' limits cannot make, with the reason.
+    """
     robot, tol, mode = ctx.robot, ctx.tolerances, state.mode
-    poses = check_path(robot, path, mode=mode, tolerances=tol, units=SI)
+    asked = [(s_end, asm, who) for s_end, asm, who in targets if asm is not None]
+    crossings: tuple[Crossing, ...] = ()
+    if asked:
+        crossings = find_crossings(robot, path, mode=mode, units=SI)
+        _check_targets(path, state, crossings, asked)
+    model = replace(ctx.model, assembly=state.assembly)
+    poses = check_path(robot, path, mode=mode, tolerances=tol, units=SI, crossings=crossings)
 
     def traj(law: Law, times: Array | None = None) -> Trajectory:
         return sample_trajectory(robot, path, law, mode=mode, times=times, samples=samples,
-                                 tolerances=tol, units=SI, checked=False)
+                                 tolerances=tol, units=SI, checked=False, crossings=crossings)
 
-    along = RobotAlongPath(ctx.model, path, mode, SI, checked=False)  # checked above
-    law = move_law(mv, path, along, ctx.motors, grid, traj, ctx.model)
     shift = np.round((state.q - poses.q[0]) / (2 * np.pi)) * 2 * np.pi
+    torques: Callable[[Array], Array] | None = None
+    margins: tuple[CrossingMargin, ...] = ()
+    if not crossings:
+        along = RobotAlongPath(model, path, mode, SI, checked=False)  # checked above
+        law = move_law(mv, path, along, ctx.motors, grid, traj, model)
+    else:
+        law, margins, torques = _across(ctx, mv, path, mode, crossings, grid, traj, model)
 
     def sample(t: Array) -> tuple[Array, Array, Array, Array]:
         st = traj(law, np.clip(t, 0.0, law.duration))
         return st.P, st.q + shift, st.dq, st.ddq
 
-    return law, sample, poses.q[-1] + shift, poses
+    end = state.assembly if len(crossings) % 2 == 0 else crossings[-1].assembly_after
+    return PathPlan(law, sample, poses.q[-1] + shift, poses, end, torques, margins)
+
+
+def _flip(assembly: str, times: int) -> str:
+    return assembly if times % 2 == 0 else assembly_mode_name(-parse_assembly_mode(assembly))
+
+
+def _check_targets(path: Path, state: PlanState, crossings: tuple[Crossing, ...],
+                   asked: Sequence[Target]) -> None:
+    """Every assembly mode asked is the one the path reaches there (named otherwise)."""
+    ends = f"from {SI.point_text(path.position(np.array([path.p0]))[0])}"
+    for s_end, asm, who in asked:
+        wanted = canonical_assembly(asm or "")
+        n = sum(1 for c in crossings if c.s < s_end)
+        got = _flip(state.assembly, n)
+        if got == wanted:
+            continue
+        who = f"{who}: " if who else ""
+        if n == 0:
+            raise AssemblyError(
+                f"{who}assembly_mode = \"{wanted}\", but its path {ends} does not cross the "
+                f"parallel (type 2) singularity curve of working mode {state.mode}, so it "
+                f"stays in assembly mode {got}: only a path across the curve changes the "
+                "assembly mode (the workspace figure draws the curve)")
+        raise AssemblyError(
+            f"{who}assembly_mode = \"{wanted}\", but its path {ends} crosses the parallel "
+            f"(type 2) singularity curve of working mode {state.mode} {n} times (at "
+            + ", ".join(SI.point_text(c.P) for c in crossings if c.s < s_end)
+            + f") and so ends in assembly mode {got}")
+
+
+def canonical_assembly(name: str) -> str:
+    """``"up"`` or ``"down"`` from a name or a sign (refused by name otherwise)."""
+    return assembly_mode_name(parse_assembly_mode(name))
+
+
+def _across(ctx: PlanContext, mv: Move, path: Path, mode: str,
+            crossings: tuple[Crossing, ...], grid: int | Array,
+            traj: Callable[[Law, Array | None], Trajectory], model: Model
+            ) -> tuple[Law, tuple[CrossingMargin, ...], Callable[[Array], Array]]:
+    """The law across the parallel singularity curve (time-optimal under the degeneracy
+    condition), its crossings' margins and its torques."""
+    where = ", ".join(SI.point_text(c.P) for c in crossings)
+    if mv.law != "time-optimal":
+        raise ParameterError(
+            f"its path crosses the parallel (type 2) singularity curve at {where}: a crossing "
+            f"needs law = \"time-optimal\", the law planned under the degeneracy condition "
+            f"there; law \"{mv.law}\" ignores it and would need unbounded torques at the "
+            "crossing")
+    if ctx.motors is not None and ctx.motors.third_order:
+        raise ParameterError(
+            f"its path crosses the parallel (type 2) singularity curve at {where}: a crossing "
+            "is planned by the second-order time-optimal law, and [motors].max_jerk or "
+            "max_torque_rate asks the jerk-limited one, which does not impose the degeneracy "
+            "condition")
+    dynamics = RobotAcrossPath(replace(model, tol=0.0), path, mode, crossings, SI)
+    try:
+        law = move_law(mv, path, dynamics, ctx.motors, grid, traj, model)
+    except InfeasibleError as exc:
+        if getattr(exc, "holding", False):  # gravity alone at a rest point: not the crossing
+            raise
+        raise InfeasibleError(
+            f"the crossing of the parallel (type 2) singularity curve at {where} cannot be "
+            f"made within the motors' limits (the degeneracy condition fixes the "
+            f"acceleration there for each speed): {exc}") from None
+    margins = crossing_margins(dynamics, law)
+    bad = [m for m in margins if not m.holds]
+    if bad:  # (the law imposes it: a failure here is a numerical one)
+        m = bad[0]
+        raise NumericalError(
+            f"the degeneracy condition at the crossing {SI.point_text(m.crossing.P)} does not "
+            f"hold along the planned law: residual {m.residual:.3g} N, "
+            f"{m.residual_ratio:.3g} of its terms")
+    planned = PlannedTorques(dynamics, law)
+
+    def torques(t: Array) -> Array:
+        return planned(np.clip(t, 0.0, law.duration))
+
+    return law, margins, torques
 
 
 @functools.lru_cache(maxsize=32)
@@ -726,6 +960,16 @@ def _setpoints(ctx: PlanContext, planned: list[PlannedMove], cycle: float,
     if past.any():
         dq[past] = 0.0
         ddq[past] = 0.0
-    tau = inverse_dynamics(ctx.free_model, q, dq, ddq)
+    tau = np.empty((n, 2))
+    for k, pm in enumerate(planned):
+        sel = np.flatnonzero((idx == k) & ~past)
+        if pm.torques is not None and sel.size:
+            tau[sel] = pm.torques(t[sel] - pm.start_s)
+        elif sel.size:
+            tau[sel] = inverse_dynamics(replace(ctx.free_model, assembly=pm.assembly), q[sel],
+                                        dq[sel], ddq[sel])
+    if past.any():
+        tau[past] = inverse_dynamics(replace(ctx.free_model, assembly=planned[-1].end_assembly),
+                                     q[past], dq[past], ddq[past])
     return ProgramResult(planned, cycle, t, move, P, q, dq, ddq, tau, ctx.motors, rms_limit,
                          types, servo_rate_hz=rate)
