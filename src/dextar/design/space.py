@@ -99,19 +99,29 @@ class DesignSpace:
     def designs(self) -> Array:
         """The sampled designs, shape (n, 5) in mm (``n = samples``; for ``grid``, the
         smallest full grid with at least ``samples`` points, cut to ``samples``)."""
+        return self.at(self.unit_sample())
+
+    def unit_sample(self) -> Array:
+        """The sample in the unit cube, shape (n, number of dimensions)."""
         k = len(self.dims)
         n = self.samples
         if self.sampling == "sobol":
 
             with warnings.catch_warnings():  # not a power of 2: balance is not needed here
                 warnings.simplefilter("ignore", UserWarning)
-                u = qmc.Sobol(d=k, scramble=True, seed=self.seed).random(n)
+                u: Array = qmc.Sobol(d=k, scramble=True, seed=self.seed).random(n)
         elif self.sampling == "random":
             u = np.random.default_rng(self.seed).random((n, k))
         else:
             m = max(2, math.ceil(n ** (1.0 / k) - 1e-9))
             axes = np.meshgrid(*([np.linspace(0.0, 1.0, m)] * k), indexing="ij")
             u = np.stack([a.ravel() for a in axes], -1)[:n]
+        return u
+
+    def at(self, u: Array) -> Array:
+        """The designs (n, 5) in mm at the points ``u`` (n, number of dimensions) of the unit
+        cube (each dimension's range scaled to [0, 1]): what a search proposes."""
+        u = np.asarray(u, float)
         out = np.tile(np.asarray(self.fixed, float), (len(u), 1))
         for j, (_name, lo, hi, cols) in enumerate(self.dims):
             for c in cols:

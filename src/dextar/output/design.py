@@ -1,5 +1,6 @@
-"""Writing a design sweep: the rows of ``designs.csv`` (one formatting for rows fresh and
-resumed, so a resumed sweep ends with the same bytes), the figures and the report."""
+"""Writing a design sweep or search: the rows of ``designs.csv`` (one formatting for rows
+fresh and resumed, so a resumed run ends with the same bytes), the figures and the
+report."""
 
 from __future__ import annotations
 
@@ -17,6 +18,7 @@ import numpy as np
 from .._arrays import Array
 from .._lazy import lazy_module
 from ..design.pareto import Choice
+from ..design.search import REFERENCE_POINT, HypervolumeCurve, SearchSettings
 from ..design.space import LENGTHS, METRICS, DesignSpace
 from ..design.sweep import SweepStats
 from ..errors import ConfigError
@@ -34,14 +36,46 @@ else:
     mfigure = lazy_module("matplotlib.figure")
 
 
+#: Most design numbers a resumed search's file may hold.
+MAX_DESIGNS = 10_000_000
 #: Columns of designs.csv and pareto.csv.
 COLUMNS = ("design", *(f"{k}_mm" for k in LENGTHS), "feasible", "reason", *METRICS)
 
 
 #: Every file a sweep may write.
 DESIGN_FILES = ("designs.csv", "sweep.json", "pareto.csv", "best.toml", "summary.json",
-                "report.html", *(f"{n}.{e}" for n in ("pareto", "designs", "best_workspace")
-                                 for e in ("png", "svg")))
+                "report.html", *(f"{n}.{e}" for n in ("pareto", "designs", "best_workspace",
+                                                      "hypervolume") for e in ("png", "svg")))
+
+#: A metric in words, for an axis (its unit follows from its name's suffix).
+METRIC_WORDS = {
+    "cycle_time_s": "cycle time",
+    "footprint_mm": "footprint (largest reach from the base's middle)",
+    "min_type1_distance": "distance to serial singularities (smallest sine)",
+    "min_type2_distance": "distance to parallel singularities (smallest sine)",
+    "gci": "dexterity (mean inverse condition number of J)",
+    "peak_torque_A_Nm": "peak torque of motor A", "peak_torque_D_Nm": "peak torque of motor D",
+    "rms_torque_A_Nm": "RMS torque of motor A", "rms_torque_D_Nm": "RMS torque of motor D",
+    "workspace_area_mm2": "usable workspace area",
+}
+#: Units of the metrics by the suffix of their names (longest first).
+UNIT_SUFFIXES = (("_mm2", "mm²"), ("_Nm", "N m"), ("_mm", "mm"), ("_kg", "kg"), ("_s", "s"),
+                 ("_N", "N"), ("_W", "W"), ("_J", "J"))
+
+
+def metric_label(objective: str) -> str:
+    """An objective (a metric name, ``-`` before one that is maximised) as an axis label in
+    words with its unit: ``"cycle time [s]"``, ``"distance to parallel singularities
+    (smallest sine) [-], maximised"``; a metric without words of its own is named from its
+    name (``shaking_force_peak_N`` -> ``"shaking force peak [N]"``)."""
+    name = objective.lstrip("-")
+    unit, stem = "-", name
+    for suffix, u in UNIT_SUFFIXES:
+        if name.endswith(suffix):
+            unit, stem = u, name[:-len(suffix)]
+            break
+    words = METRIC_WORDS.get(name, stem.replace("_", " "))
+    return f"{words} [{unit}]" + (", maximised" if objective.startswith("-") else "")
 
 
 def header() -> str:
@@ -84,23 +118,60 @@ def parse_line(line: str) -> dict[str, Any] | None:
 
 
 def pareto_figure(F: Array, pareto: Array, best: int, names: Sequence[str]) -> Figure:
-    """The feasible designs on the first two objectives (minimised; a maximised objective
-    is drawn with its sign), the Pareto designs marked, the chosen one starred."""
-    fig = mfigure.Figure(figsize=(6.0, 4.6))
-    ax = fig.subplots()
-    if F.shape[1] == 1:
+    """The feasible designs in the objectives (each pair of them), the Pareto designs
+    marked, the chosen one starred; axes in words and units, a maximised objective drawn
+    with its own sign."""
+    F = np.asarray(F, float) * np.array([-1.0 if n.startswith("-") else 1.0 for n in names])
+    k = F.shape[1]
+    labels = [metric_label(n) for n in names]
+    if k == 1:
+        fig = mfigure.Figure(figsize=(6.0, 4.6))
+        ax = fig.subplots()
         ax.plot(np.sort(F[:, 0]), ".", color="0.6", label="feasible designs (sorted)")
-        ax.set_ylabel(names[0])
+        ax.set_ylabel(labels[0])
         ax.set_xlabel("rank")
-    else:
-        ax.scatter(F[:, 0], F[:, 1], s=8, color="0.7", label="feasible designs")
-        ax.scatter(F[pareto, 0], F[pareto, 1], s=18, color="C0", label="Pareto designs")
-        ax.scatter(F[best, 0], F[best, 1], s=140, marker="*", color="C3", label="chosen")
-        ax.set_xlabel(names[0])
-        ax.set_ylabel(names[1])
-        if F.shape[1] > 2:
-            ax.set_title(f"Pareto on {F.shape[1]} objectives ({', '.join(names)}), shown on "
-                         "the first two", fontsize=8)
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        return fig
+    m = k - 1
+    fig = mfigure.Figure(figsize=(2.0 + 3.6 * m, 1.4 + 3.2 * m))
+    axes = fig.subplots(m, m, squeeze=False)
+    for i in range(m):  # row: objective i + 1; column: objective j
+        for j in range(m):
+            ax = axes[i, j]
+            if j > i:
+                ax.set_visible(False)
+                continue
+            x, y = j, i + 1
+            ax.scatter(F[:, x], F[:, y], s=6, color="0.75", label="feasible designs")
+            ax.scatter(F[pareto, x], F[pareto, y], s=14, color="C0", label="Pareto designs")
+            ax.scatter(F[best, x], F[best, y], s=140, marker="*", color="C3", label="chosen")
+            if i == m - 1:
+                ax.set_xlabel(labels[x], fontsize=8)
+            if j == 0:
+                ax.set_ylabel(labels[y], fontsize=8)
+            ax.tick_params(labelsize=7)
+            ax.grid(alpha=0.3)
+    axes[0, 0].legend(fontsize=7)
+    fig.suptitle(f"Pareto front in the {k} objectives ({sum(pareto)} of {len(F)} feasible "
+                 "designs)", fontsize=9)
+    fig.tight_layout()
+    return fig
+
+
+def hypervolume_figure(curve: HypervolumeCurve, kind: str) -> Figure:
+    """The hypervolume of the front found against the designs evaluated."""
+    fig = mfigure.Figure(figsize=(6.0, 4.2))
+    ax = fig.subplots()
+    ax.plot(curve.evaluations, curve.hypervolume, "-", color="C0", drawstyle="steps-post",
+            label=kind)
+    ax.axhline(curve.hypervolume[-1], ls=":", color="0.5", lw=1,
+               label=f"final: {curve.hypervolume[-1]:.4g}")
+    ax.set_xlabel("designs evaluated")
+    ax.set_ylabel("hypervolume of the front found [-]")
+    ax.set_title(f"objectives scaled to [0, 1] between the final front's best and worst, "
+                 f"reference point {REFERENCE_POINT:g}", fontsize=8)
+    ax.set_ylim(bottom=0.0)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
@@ -138,8 +209,10 @@ def design_report(summary: Mapping[str, Any], pareto_rows: Sequence[Mapping[str,
     esc = html.escape
     labels = {"designs": "designs", "feasible": "feasible designs",
               "feasible_fraction": "feasible fraction", "pareto": "Pareto designs",
-              "objectives": "objectives (minimised; - maximises)", "sampling": "sampling",
-              "seed": "seed", "workers": "workers", "wall_time_s": "wall time [s]",
+              "objectives": "objectives (minimised; - maximises)", "search": "search",
+              "population": "population", "seed": "seed", "workers": "workers",
+              "final_hypervolume": "hypervolume of the front (scaled by it)",
+              "wall_time_s": "wall time [s]",
               "designs_per_second": "designs per second", "evaluated": "evaluated",
               "resumed": "resumed from an earlier run"}
     facts = table([(label, _rounded(summary[k])) for k, label in labels.items()
@@ -152,7 +225,8 @@ def design_report(summary: Mapping[str, Any], pareto_rows: Sequence[Mapping[str,
               f"{best['design']}, l1 = {best['l1']:.4g}, l2 = {best['l2']:.4g}, L1 = "
               f"{best['L1']:.4g}, L2 = {best['L2']:.4g}, d = {best['d']:.4g} mm; written to "
               "best.toml.</p>") if best else "<p>No feasible design.</p>"
-    return page(f"Design sweep of {Path(str(summary['task'])).name}",
+    what = "search" if summary.get("search") == "nsga2" else "sweep"
+    return page(f"Design {what} of {Path(str(summary['task'])).name}",
                 f"<p>Task file {esc(str(summary['task']))}.</p>{facts}{chosen}"
                 f"<h2>Pareto designs</h2>{pareto}<h2>Figures</h2>{figures(pngs)}")
 
@@ -163,22 +237,24 @@ def _rounded(v: Any) -> Any:
 
 
 class DesignsFile:
-    """``designs.csv`` of a sweep in an output directory, with ``sweep.json`` (the sweep's
+    """``designs.csv`` of a sweep or search in an output directory, with ``sweep.json`` (its
     signature).
 
-    Opened fresh, or to ``resume`` (the complete rows of the same sweep kept, a line cut
+    Opened fresh, or to ``resume`` (the complete rows of the same run kept, a line cut
     short by a kill dropped); the directory's own checks (empty, ``--force``) are
     :class:`~dextar.output.files.OutputDir`'s. Rows are appended as chunks finish (flushed to
     disk each time); :meth:`finish` rewrites the file in design order, atomically."""
 
-    def __init__(self, od: OutputDir, designs: Array, signature: str, *, resume: bool,
+    def __init__(self, od: OutputDir, designs: Array | None, signature: str, *, resume: bool,
                  label: str) -> None:
-        """Read the rows to resume; nothing is written yet.
+        """Read the rows to resume (of a sweep's ``designs``, their lengths checked; of a
+        search's, ``designs`` None: the search checks each against its proposal); nothing
+        is written yet.
 
         Raises
         ------
         ConfigError
-            ``resume`` without a sweep of the same signature, or with rows of other lengths.
+            ``resume`` without a run of the same signature, or with rows of other lengths.
         """
         self.od, self.designs, self.signature = od, designs, signature
         self.csv, self.meta = od.path / "designs.csv", od.path / "sweep.json"
@@ -188,7 +264,8 @@ class DesignsFile:
             self._resume(label)
 
     def _resume(self, label: str) -> None:
-        designs, n = self.designs, len(self.designs)
+        designs = self.designs
+        n = len(designs) if designs is not None else MAX_DESIGNS
         if not (self.csv.is_file() and self.meta.is_file()):
             raise ConfigError(f"--resume: {label} holds no sweep to resume (designs.csv and "
                               "sweep.json)")
@@ -204,19 +281,14 @@ class DesignsFile:
             r = parse_line(line)
             if r is None or not 0 <= r["design"] < n:
                 continue
-            if not np.allclose([r[k] for k in LENGTHS], designs[r["design"]], rtol=1e-12):
+            if designs is not None and not np.allclose([r[k] for k in LENGTHS],
+                                                       designs[r["design"]], rtol=1e-12):
                 raise ConfigError(f"--resume: design {r['design']} in {self.csv} has other "
                                   "lengths than this sweep's")
             self.rows[r["design"]] = r
 
-    @property
-    def missing(self) -> list[int]:
-        """The designs without a row."""
-        return [i for i in range(len(self.designs)) if i not in self.rows]
-
     def __enter__(self) -> DesignsFile:
-        write_text(self.meta, json.dumps({"signature": self.signature,
-                                          "designs": len(self.designs)}) + "\n")
+        write_text(self.meta, json.dumps({"signature": self.signature}) + "\n")
         write_text(self.csv, header() + "".join(row_line(self.rows[i]) for i in
                                                 sorted(self.rows)))
         self.od.record("sweep.json")
@@ -235,9 +307,10 @@ class DesignsFile:
     def __exit__(self, *exc: object) -> None:
         self._fh.close()
 
-    def finish(self) -> list[dict[str, Any]]:
-        """Every row in design order, the file rewritten so (atomically)."""
-        ordered = [self.rows[i] for i in range(len(self.designs))]
+    def finish(self, n: int) -> list[dict[str, Any]]:
+        """The rows of designs ``0 .. n - 1`` in design order, the file rewritten so
+        (atomically)."""
+        ordered = [self.rows[i] for i in range(n)]
         write_text(self.csv, header() + "".join(row_line(r) for r in ordered))
         return ordered
 
@@ -257,14 +330,30 @@ def reason_counts(rows: Sequence[Mapping[str, Any]]) -> dict[str, int]:
 
 
 def sweep_summary(task_file: str, kind: str, space: DesignSpace, stats: SweepStats,
-                  choice: Choice, rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
-    """``summary.json`` of a sweep: counts, the sampling, the run's figures, the chosen
-    design and the reasons designs failed."""
+                  choice: Choice, rows: Sequence[Mapping[str, Any]],
+                  search: SearchSettings | None = None,
+                  hypervolume: HypervolumeCurve | None = None) -> dict[str, Any]:
+    """``summary.json`` of a sweep or search: counts, the sampling or the search, the run's
+    figures, the hypervolume against the designs evaluated, the chosen design and the
+    reasons designs failed."""
     n = len(rows)
+    how: dict[str, Any] = ({"search": space.sampling, "sampling": space.sampling,
+                            "seed": space.seed} if search is None else
+                           {"search": search.kind, "population": search.population,
+                            "evaluations": search.evaluations, "seed": search.seed,
+                            "batch": search.batch, "batches_in_flight": search.in_flight})
+    hv: dict[str, Any] = {}
+    if hypervolume is not None:
+        hv = {"final_hypervolume": float(hypervolume.hypervolume[-1]),
+              "hypervolume": {"evaluations": hypervolume.evaluations.tolist(),
+                              "value": hypervolume.hypervolume.tolist(),
+                              "ideal": hypervolume.ideal.tolist(),
+                              "nadir": hypervolume.nadir.tolist(),
+                              "reference_point": REFERENCE_POINT}}
     return {
         "task": task_file, "task_kind": kind, "designs": n,
         "feasible": len(choice.feasible), "feasible_fraction": len(choice.feasible) / n,
-        "objectives": list(space.objectives), "sampling": space.sampling, "seed": space.seed,
+        "objectives": list(space.objectives), **how,
         "varied": [name for name, *_ in space.dims],
         "mass_per_length_kg_m": (list(space.mass_per_length) if space.mass_per_length
                                  else None),
@@ -272,7 +361,7 @@ def sweep_summary(task_file: str, kind: str, space: DesignSpace, stats: SweepSta
         "workers": stats.workers, "wall_time_s": stats.wall_s,
         "designs_per_second": stats.evaluated / stats.wall_s if stats.wall_s > 0 else 0.0,
         "pareto": len(choice.pareto_rows), "best": choice.best_row,
-        "reasons": reason_counts(rows)}
+        "reasons": reason_counts(rows), **hv}
 
 
 def best_workspace_figure(robot_mm: FiveBar, mode: str, P: Array) -> Figure:
@@ -288,9 +377,11 @@ def best_workspace_figure(robot_mm: FiveBar, mode: str, P: Array) -> Figure:
 def write_sweep_outputs(od: OutputDir, summary: Mapping[str, Any], choice: Choice,
                         rows: Sequence[Mapping[str, Any]], varied: Sequence[tuple[int, str]],
                         best_toml: str | None, best_figure: Figure | None, *,
-                        with_figures: bool = True) -> None:
+                        with_figures: bool = True,
+                        hypervolume: HypervolumeCurve | None = None) -> None:
     """Write ``best.toml`` (with a feasible design), ``pareto.csv``, the figures (PNG and
-    SVG), ``report.html`` and ``summary.json`` into the sweep's directory."""
+    SVG: the front, the designs, the chosen robot's workspace, the hypervolume against the
+    designs evaluated), ``report.html`` and ``summary.json`` into the run's directory."""
     pngs: dict[str, bytes] = {}
     if best_toml is not None:
         od.write_text("best.toml", best_toml)
@@ -302,7 +393,9 @@ def write_sweep_outputs(od: OutputDir, summary: Mapping[str, Any], choice: Choic
                 ("designs", scatter_matrix(X[:, [c for c, _ in varied]],
                                            np.array([r["feasible"] for r in rows]),
                                            [f"{label} [mm]" for _, label in varied])),
-                ("best_workspace", best_figure)):
+                ("best_workspace", best_figure),
+                *((("hypervolume", hypervolume_figure(hypervolume, str(summary["search"]))),)
+                  if hypervolume is not None else ())):
             pngs[name] = png_bytes(fig)
             od.write_bytes(f"{name}.png", pngs[name])
             od.write_bytes(f"{name}.svg", svg_bytes(fig))
