@@ -39,7 +39,7 @@ import importlib.metadata
 import importlib.util
 import time
 from collections.abc import Callable, Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -161,15 +161,16 @@ class Proposer:
 
     def __init__(self, space: DesignSpace, settings: SearchSettings) -> None:
         """The algorithm set up on the space's unit cube; its first population is the
-        space's sample (``space.samples`` = the population)."""
+        space's sample (its sampling, ``population`` designs)."""
         require_pymoo()
         self.space, self.settings = space, settings
         k = len(space.dims)
         self.problem = pymoo_problem.Problem(n_var=k, n_obj=len(space.objectives),
                                              n_ieq_constr=1, xl=0.0, xu=1.0)
+        first = replace(space, samples=settings.population).unit_sample()
         self.algorithm = nsga2.NSGA2(pop_size=settings.population,
-                                     n_offsprings=settings.batch,
-                                     sampling=space.unit_sample(), eliminate_duplicates=True)
+                                     n_offsprings=settings.batch, sampling=first,
+                                     eliminate_duplicates=True)
         self.algorithm.setup(self.problem, termination=pymoo_termination.NoTermination(),
                              seed=settings.seed)
         self.pending: collections.deque[Any] = collections.deque()
