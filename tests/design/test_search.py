@@ -32,7 +32,7 @@ from .test_design import TASK, rows_of, write_task
 pytest.importorskip("distributed")
 pytest.importorskip("pymoo")
 
-SEARCH = TASK.replace("samples = 64\n", 'search = "nsga2"\npopulation = 12\nevaluations = 44\n')
+SEARCH = TASK.replace("samples = 64\n", 'search = "nsga2"\npopulation = 8\nevaluations = 32\n')
 
 
 def lengths(rows):
@@ -201,18 +201,18 @@ def search2(tmp_path_factory, scheduler):
 def test_the_search_writes_its_rows_front_and_curve(search2):
     task, out = search2
     rows = rows_of(out)
-    assert [r["design"] for r in rows] == list(range(44))
+    assert [r["design"] for r in rows] == list(range(32))
     s = json.loads((out / "summary.json").read_text())
-    assert s["search"] == "nsga2" and s["population"] == 12 and s["designs"] == 44
-    assert s["batch"] == 4 and s["batches_in_flight"] == 3
+    assert s["search"] == "nsga2" and s["population"] == 8 and s["designs"] == 32
+    assert s["batch"] == 4 and s["batches_in_flight"] == 2
     hv = s["hypervolume"]
-    assert hv["evaluations"][-1] == 44 and s["final_hypervolume"] == hv["value"][-1] > 0
+    assert hv["evaluations"][-1] == 32 and s["final_hypervolume"] == hv["value"][-1] > 0
     assert (np.diff(hv["value"]) >= 0).all()
     for name in ("hypervolume", "pareto"):
         assert (out / f"{name}.png").stat().st_size > 1000
-    # the first population is the space's Sobol sample of 12
+    # the first population is the space's Sobol sample of 8
     _, space = load_scenario(task).design_task()
-    assert np.array_equal(lengths(rows[:12]), replace(space, samples=12).designs())
+    assert np.array_equal(lengths(rows[:8]), replace(space, samples=8).designs())
     assert "design search of task.toml" in (out / "report.html").read_text().lower()
 
 
@@ -232,8 +232,8 @@ def test_a_killed_search_resumes_to_the_same_front(search2, tmp_path, scheduler)
                             start_new_session=True)
     csv_path = out / "designs.csv"
     deadline = time.monotonic() + 120
-    while time.monotonic() < deadline:  # past the first population (12 designs)
-        if csv_path.exists() and len(csv_path.read_text().splitlines()) > 21:
+    while time.monotonic() < deadline:  # past the first population (8 designs)
+        if csv_path.exists() and len(csv_path.read_text().splitlines()) > 15:
             break
         if proc.poll() is not None:
             break
@@ -242,14 +242,14 @@ def test_a_killed_search_resumes_to_the_same_front(search2, tmp_path, scheduler)
     proc.wait()
     partial = csv_path.read_text()
     done = len(partial.splitlines()) - 1
-    assert 12 < done < 44, done  # killed part-way
-    csv_path.write_text(partial + "44,1.0,2.")  # a line cut short by the kill
+    assert 8 < done < 32, done  # killed part-way, past the first population
+    csv_path.write_text(partial + "32,1.0,2.")  # a line cut short by the kill
     assert main(["design", str(task), "--out", str(out), "--resume", "--scheduler", scheduler,
                  "--quiet"]) == 0
     assert (out / "pareto.csv").read_bytes() == (out2 / "pareto.csv").read_bytes()
     assert csv_path.read_bytes() == (out2 / "designs.csv").read_bytes()
     s = json.loads((out / "summary.json").read_text())
-    assert s["resumed"] == done and s["evaluated"] == 44 - done
+    assert s["resumed"] == done and s["evaluated"] == 32 - done
 
 
 def test_resume_refuses_another_search(search2, tmp_path, capsys):
