@@ -101,6 +101,9 @@ class SearchSettings:
     lag : int, optional
         Batches in flight after the first population; default ``population // batch`` (at
         least 1): a generation's worth.
+    chunk : int, optional
+        Designs per unit of work (default ``batch``: one per batch; the first population
+        in as many as it takes). It does not change the designs proposed.
     """
 
     kind: str = "nsga2"
@@ -109,6 +112,7 @@ class SearchSettings:
     seed: int = 0
     batch: int = 8
     lag: int | None = None
+    chunk: int | None = None
 
     def __post_init__(self) -> None:
         if self.kind not in SEARCHES:
@@ -125,6 +129,8 @@ class SearchSettings:
             raise ConfigError(f"config key [design].chunk = {self.batch!r} must be at least 1")
         if self.lag is not None and self.lag < 1:
             raise ConfigError(f"a search's lag = {self.lag} must be at least 1")
+        if self.chunk is not None and self.chunk < 1:
+            raise ConfigError(f"a search's chunk = {self.chunk} must be at least 1")
 
     @property
     def in_flight(self) -> int:
@@ -206,10 +212,13 @@ class SearchRun:
     designs : int
         Designs proposed in all (``evaluations``, fewer when the algorithm ran out of new
         designs).
+    algorithm_s : float
+        Time spent in this process proposing and telling (pymoo), of ``stats.wall_s``.
     """
 
     stats: SweepStats
     designs: int
+    algorithm_s: float = 0.0
 
 
 @dataclass
@@ -258,11 +267,15 @@ def run_search(cluster: Cluster, task: Task, space: DesignSpace, settings: Searc
     queue = distributed.as_completed()
     evaluated = 0
     pending = 0
+    algorithm_s = 0.0
 
     def propose() -> bool:
         nonlocal pending
         first = batches[-1].first + len(batches[-1].designs) if batches else 0
+        nonlocal algorithm_s
+        ta = time.perf_counter()
         U = proposer.ask(settings.evaluations - first)
+        algorithm_s += time.perf_counter() - ta
         if not len(U):
             return False
         designs = space.at(U)
@@ -277,7 +290,7 @@ def run_search(cluster: Cluster, task: Task, space: DesignSpace, settings: Searc
                                   "task, [design], seed or pymoo version)")
             else:
                 rows[first + j] = r
-        for part in chunks_of(sorted(batch.left), settings.batch):
+        for part in chunks_of(sorted(batch.left), settings.chunk or settings.batch):
             queue.add(chunks.submit(designs[part[0] - first:part[-1] - first + 1], part[0]))
             pending += 1
         batches.append(batch)
@@ -288,7 +301,9 @@ def run_search(cluster: Cluster, task: Task, space: DesignSpace, settings: Searc
     while told < len(batches):
         while told < len(batches) and not batches[told].left:
             b = batches[told]
+            ta = time.perf_counter()
             proposer.tell([rows[i] for i in range(b.first, b.first + len(b.designs))])
+            algorithm_s += time.perf_counter() - ta
             told += 1
             for _ in range(settings.in_flight if told == 1 else 1):
                 if not propose():
@@ -306,7 +321,8 @@ def run_search(cluster: Cluster, task: Task, space: DesignSpace, settings: Searc
         on_chunk(got)
     assert pending == 0
     n = batches[-1].first + len(batches[-1].designs)
-    return SearchRun(SweepStats(evaluated, time.perf_counter() - t0, cluster.workers), n)
+    return SearchRun(SweepStats(evaluated, time.perf_counter() - t0, cluster.workers), n,
+                     algorithm_s)
 
 
 # ------------------------------------------------------------------ hypervolume and progress
