@@ -65,7 +65,8 @@ Row = dict[str, Any]
 SEARCHES = ("nsga2",)
 #: The reference point of a hypervolume, each objective scaled to [0, 1] between the ideal
 #: and the nadir point of the front it is measured against (a usual choice, e.g. Ishibuchi
-#: et al., EMO 2017: a little beyond the nadir, so that the front's extreme points count).
+#: et al., Evol. Comput. 26(3), 2018: a little beyond the nadir, so that the front's extreme
+#: points count).
 REFERENCE_POINT = 1.1
 #: Constraint violation of a design planned but beyond a limit, and of one never planned.
 VIOLATION_LIMIT, VIOLATION_UNPLANNED = 1.0, 2.0
