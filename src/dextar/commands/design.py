@@ -116,13 +116,11 @@ def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
                                     sweep.space.varied_axes, res.best_toml, best_fig,
                                     with_figures=figures, hypervolume=res.hypervolume)
     stats, best, n = res.stats, res.best, len(res.rows)
-    hv = (f", front hypervolume {res.hypervolume.hypervolume[-1]:.4g}"
-          if res.hypervolume is not None and res.choice.feasible else "")
     text = (f"design {what} ({sweep.kind}): {n} designs ({stats.evaluated} evaluated, "
             f"{n - stats.evaluated} "
             f"resumed) on {stats.workers} workers in {stats.wall_s:.1f} s "
             f"({summary['designs_per_second']:.3g} designs/s); {len(res.choice.feasible)} "
-            f"feasible, {len(res.choice.pareto_rows)} on the Pareto front{hv}"
+            f"feasible, {len(res.choice.pareto_rows)} on the Pareto front"
             + (f"; chosen design {best['design']}: l1 = {best['l1']:.4g}, l2 = "
                f"{best['l2']:.4g}, L1 = {best['L1']:.4g}, L2 = {best['L2']:.4g}, d = "
                f"{best['d']:.4g} mm -> {shown(args.out, 'best.toml')}" if best
