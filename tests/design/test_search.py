@@ -345,3 +345,47 @@ def test_no_warning_where_the_time_optimal_law_names_an_unreachable_stage():
         row = evaluate_design(task, [53.501671366393566, 133.4673346579075, 93.27383426949382,
                                      62.73520674556494, 21.362981339916587])
     assert not row["feasible"] and "no motion within the limits passes" in row["reason"]
+
+
+def _search_tables():
+    from hypothesis import strategies as st
+
+    value = st.one_of(st.sampled_from(["nsga2", "sobol", "grid", "random", "nsga3", ""]),
+                      st.integers(-3, 5000), st.floats(allow_nan=True, width=32),
+                      st.booleans())
+    keys = st.sampled_from(["search", "sampling", "population", "evaluations", "samples",
+                            "seed", "chunk"])
+    return st.dictionaries(keys, value, max_size=5)
+
+
+def test_random_search_tables_are_read_or_refused_by_name():
+    """Any [design] table of search keys either gives a space (and, for nsga2, settings whose
+    first population is the space's sample) or is refused with a ConfigError naming the key."""
+    from hypothesis import HealthCheck, given, settings
+
+    from dextar.config.design import DesignTable
+    from dextar.errors import ConfigError
+    from dextar.geometry import FiveBar
+
+    robot = FiveBar(72.0, 72.0, 87.0, 87.0, 60.0)
+
+    @settings(max_examples=40, deadline=None, derandomize=True,
+              suppress_health_check=list(HealthCheck))
+    @given(table=_search_tables())
+    def check(table):
+        try:
+            t = DesignTable.from_toml({"l": [50.0, 120.0], **table})
+            space, found = t.space(robot), t.search()
+        except ConfigError as exc:
+            assert re.search(r"design|samples|seed|evaluations", str(exc)), exc
+            return
+        kind = table.get("search") or table.get("sampling") or "sobol"
+        assert (found is not None) == (kind == "nsga2")
+        if found is not None:
+            assert space.samples == found.population <= found.evaluations
+            assert found.batch == t.chunk and found.in_flight >= 1
+            assert "samples" not in table
+        else:
+            assert space.sampling == kind and "population" not in table
+
+    check()
