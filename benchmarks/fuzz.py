@@ -28,6 +28,7 @@ from tests.robustness.harness import (  # noqa: E402
     run_config_case,
     run_identify_case,
     run_program_case,
+    run_robot_config_case,
     run_run_case,
     toml_text,
 )
@@ -37,9 +38,11 @@ from tests.robustness.strategies import (  # noqa: E402
     dry_friction_runs,
     falling_simulations,
     kinematics_argv,
+    long_animated_runs,
     metre_configs,
     motion_files,
     programs,
+    time_scaled_motion_files,
 )
 
 PICK_PLACE = ROOT / "examples" / "pick_place.toml"
@@ -74,7 +77,9 @@ def main() -> int:
     n_metres = int(args.cases * 0.03)
     n_falling = int(args.cases * 0.03)
     n_dry = int(args.cases * 0.01)
-    n_cfg = int(args.cases * 0.65) - n_metres - n_falling - n_dry
+    n_long = int(args.cases * 0.01)  # review 28: long motions with the animation drawn
+    n_time = int(args.cases * 0.02)  # issue 28's time scales
+    n_cfg = int(args.cases * 0.65) - n_metres - n_falling - n_dry - n_long - n_time
 
     @settings(max_examples=n_cfg, deadline=None, database=None, derandomize=False,
               suppress_health_check=list(HealthCheck))
@@ -112,10 +117,14 @@ def main() -> int:
     @settings(max_examples=n_metres, deadline=None, database=None,
               suppress_health_check=list(HealthCheck))
     @given(doc=metre_configs(),
-           command=st.sampled_from(["plan", "torques", "simulate", "export"]))
+           command=st.sampled_from(["plan", "torques", "simulate", "export", "ik", "fk",
+                                    "workspace", "poses", "excite"]))
     def fuzz_metres(doc: dict, command: str) -> None:
         t0 = time.perf_counter()
-        outcome, detail = run_config_case(doc, command)
+        if command in ("ik", "fk", "workspace", "poses", "excite"):
+            outcome, detail = run_robot_config_case(doc, command)
+        else:
+            outcome, detail = run_config_case(doc, command)
         record(outcome, detail, f"{command} with\n{toml_text(doc)}", time.perf_counter() - t0)
 
     @settings(max_examples=n_falling, deadline=None, database=None,
@@ -134,6 +143,28 @@ def main() -> int:
         outcome, detail = run_run_case(doc)
         record(outcome, detail, f"run with\n{toml_text(doc)}", time.perf_counter() - t0)
 
+    @settings(max_examples=n_long, deadline=None, database=None,
+              suppress_health_check=list(HealthCheck))
+    @given(doc=long_animated_runs())
+    def fuzz_long_runs(doc: dict) -> None:
+        t0 = time.perf_counter()
+        outcome, detail = run_run_case(doc)
+        record(outcome, detail, f"run with\n{toml_text(doc)}", time.perf_counter() - t0)
+
+    @settings(max_examples=n_time, deadline=None, database=None,
+              suppress_health_check=list(HealthCheck))
+    @given(case=time_scaled_motion_files(), config=st.sampled_from([None, str(PICK_PLACE)]))
+    def fuzz_time_scales(case: tuple[str, list[str], float], config: str | None) -> None:
+        text, options, factor = case
+        t0 = time.perf_counter()
+        outcome, detail = run_identify_case(text, options, config)
+        unit = {1e3: "milliseconds", 1e6: "microseconds"}.get(factor)
+        if unit is not None and outcome not in DEFECTS and (
+                outcome != "refused" or f"Is the time in {unit}?" not in detail):
+            outcome, detail = "bad-exit", f"time in {unit} not named: {outcome}: {detail}"
+        record(outcome, detail, f"identify {options} config {config}, t_s x {factor:g}, on\n"
+               f"{text[:300]}", time.perf_counter() - t0)
+
     import random
 
     random.seed(args.seed)
@@ -144,6 +175,8 @@ def main() -> int:
     fuzz_metres()
     fuzz_falling()
     fuzz_dry_runs()
+    fuzz_long_runs()
+    fuzz_time_scales()
     fuzz_argv()
     total = sum(counts.values())
     print(f"{total} cases in {time.perf_counter() - t_start:.0f} s: " + ", ".join(

@@ -1,26 +1,22 @@
-"""The suite's order for two xdist workers: ``--dist loadfile`` (pyproject) sends whole files
-to the workers in collection order, and pytest-randomly shuffles that order; the longest
-files go first (longest-processing-time scheduling), so that no long file starts last while
-the other worker idles. Within each rank the random order stands."""
+"""The suite's order for the xdist workers: ``--dist loadfile`` (pyproject) sends whole files
+to the workers in collection order (``--no-loadscope-reorder`` keeps that order), and
+pytest-randomly shuffles it. The files go out by their share of tests marked ``slow``, the
+largest first (a file of slow tests only, then one with some, the files without any last):
+longest-processing-time scheduling with the lengths read from the marks, so that no long
+file starts last while the other worker idles. Nothing here is kept by hand: marking a test
+slow moves its file. Within a rank the random order stands."""
+
+from collections import Counter
 
 import pytest
 
-#: The longest files, longest first (seconds on a 2-core machine, 2026-12-02: design 45,
-#: identification CLI 20, robustness 18, traps 11, run 9, examples 6, MuJoCo 6, calibration
-#: CLI 5, program 5, identify 5).
-LONGEST = ("tests/design/test_design.py", "tests/cli/test_cli_identification.py",
-           "tests/robustness/test_robustness.py", "tests/cli/test_traps.py",
-           "tests/test_run.py", "tests/test_examples.py",
-           "tests/identification/test_mujoco_identification.py",
-           "tests/cli/test_cli_calibration.py", "tests/program/test_program.py",
-           "tests/identification/test_identify.py")
+
+def _file(item: pytest.Item) -> str:
+    return item.nodeid.split("::")[0]
 
 
-@pytest.hookimpl(trylast=True)  # after pytest-randomly's shuffle
+@pytest.hookimpl(trylast=True)  # after pytest-randomly's shuffle and -m's deselection
 def pytest_collection_modifyitems(items):
-    rank = {name: i for i, name in enumerate(LONGEST)}
-
-    def key(item):
-        return rank.get(item.nodeid.split("::")[0], len(LONGEST))
-
-    items.sort(key=key)  # stable: the shuffle stands within a rank
+    tests = Counter(_file(item) for item in items)
+    slow = Counter(_file(item) for item in items if item.get_closest_marker("slow"))
+    items.sort(key=lambda item: -slow[_file(item)] / tests[_file(item)])  # stable

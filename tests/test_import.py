@@ -1,17 +1,39 @@
 """Importing dextar is light and leaves no state behind (benchmarks/bench_import.py times it)."""
 
 import ast
+import os
 import subprocess
 import sys
 
+import pytest
 
+
+def _backend_after(code: str, mplbackend: str | None = None) -> list[str]:
+    """What ``code`` prints in a fresh interpreter, then matplotlib's backend setting ("auto"
+    while nothing has chosen one: matplotlib picks one at the first figure shown), with the
+    environment's MPLBACKEND replaced by ``mplbackend``. (``rcParams._get`` reads the setting
+    without resolving it: ``get_backend()`` would choose "agg" on a machine without a
+    display, whoever asked.)"""
+    probe = (f"{code}; import matplotlib; b = matplotlib.rcParams._get('backend'); "
+             "print('auto' if b is matplotlib.rcsetup._auto_backend_sentinel else b)")
+    env = {k: v for k, v in os.environ.items() if k != "MPLBACKEND"}
+    if mplbackend is not None:
+        env["MPLBACKEND"] = mplbackend
+    r = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                       check=True, env=env)
+    return r.stdout.splitlines()
+
+
+@pytest.mark.slow
 def test_import_loads_no_plotting_or_solvers_and_sets_no_backend():
-    code = ("import sys, dextar; import matplotlib; "
+    # the figures' module draws on its own canvas: the backend stays the user's to choose
+    code = ("import sys, dextar; "
             "print(sorted(m for m in ('matplotlib.pyplot', 'scipy') if m in sys.modules)); "
-            "print(matplotlib.get_backend() != 'agg' or 'MPLBACKEND' in __import__('os').environ)")
-    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    mods, _ = r.stdout.splitlines()
+            "import dextar.output.figures")
+    mods, backend = _backend_after(code)
     assert mods == "[]"
+    assert [backend] == _backend_after("pass")           # matplotlib's own default
+    assert _backend_after(code, "svg") == ["[]", "svg"]  # the user's MPLBACKEND stands
 
 
 def test_library_never_selects_a_matplotlib_backend():
@@ -34,6 +56,7 @@ def _loaded(code: str) -> list[str]:
     return ast.literal_eval(r.stdout.splitlines()[-1])  # (after what code printed)
 
 
+@pytest.mark.slow
 def test_the_command_line_and_its_parser_load_no_scipy_matplotlib_or_stages():
     # dextar --help lists the commands without importing their modules; a command's own
     # --help imports its module alone, whose job and writers load when it runs
@@ -53,6 +76,7 @@ def test_the_command_line_and_its_parser_load_no_scipy_matplotlib_or_stages():
                                     "load_scenario(None)")
 
 
+@pytest.mark.slow
 def test_reading_a_robot_table_loads_no_scipy_and_no_stage_above_the_config():
     # dextar ik / fk / workspace read [robot] only; a scenario's run objects import their
     # stages when they are built

@@ -137,6 +137,7 @@ def dextar(site, *argv, cwd):
                           capture_output=True, text=True, timeout=120)
 
 
+@pytest.mark.slow
 def test_a_plugin_command_runs_and_is_listed(site, tmp_path):
     r = dextar(site, "hello", "world", "--json", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
@@ -149,6 +150,7 @@ def test_a_plugin_command_runs_and_is_listed(site, tmp_path):
     assert r.returncode == 2 and "invalid choice: 'hello'" in r.stderr
 
 
+@pytest.mark.slow
 def test_a_plugin_move_type_and_law_plan_a_program(site, tmp_path):
     (tmp_path / "task.toml").write_text(PROGRAM)
     r = dextar(site, "program", "task.toml", "--out", "o", "--no-figures", "--json",
@@ -167,6 +169,7 @@ def test_a_plugin_move_type_and_law_plan_a_program(site, tmp_path):
     assert data["x_mm"][-1] == pytest.approx(30.0, abs=1e-9)
 
 
+@pytest.mark.slow
 def test_a_plugin_path_type_and_law_plan_a_run(site, tmp_path):
     (tmp_path / "run.toml").write_text(RUN)
     r = dextar(site, "plan", "run.toml", "--out", "plan.csv", "--json", cwd=tmp_path)

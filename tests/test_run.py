@@ -18,6 +18,8 @@ from dextar.geometry import DEXTAR_MM
 from dextar.laws import solve_optimal_law
 from dextar.paths import Arc
 
+pytestmark = pytest.mark.slow
+
 FIGS = [f"fig{k}" for k in range(3, 10)]
 #: The run's CSV columns in paper units (names carry the unit, see dextar.output.tables).
 RUN_COLUMNS = ["t_T", "p", "dp_per_T", "ddp_per_T2", "x_L", "y_L", "dx_L_T", "dy_L_T",
@@ -204,3 +206,40 @@ def test_run_general_robot_without_paper_model(tmp_path, capsys):
     report = (out / "report.html").read_text()
     assert "not applicable" in report and "paper's claims" not in report
     assert "Five-bar l1 = 70, l2 = 75, L1 = 90, L2 = 85, d = 50 mm" in report
+
+
+def _gif_delays(path):
+    from PIL import Image
+
+    im, delays = Image.open(path), []
+    try:
+        while True:
+            delays.append(im.info["duration"])
+            im.seek(im.tell() + 1)
+    except EOFError:
+        return delays
+
+
+def test_a_very_long_motion_is_animated_sped_up_and_says_so(tmp_path):
+    """Review 28 finding 2: a 1e9 s motion asked the animation for 1.7e7 frames of 60 s each
+    (the run hung). Now at most ``animation_frames`` frames, and the report (as the GIF's
+    title) says the animation is sped up, not real time; the paper's 1 s motion plays in real
+    time (test_the_paper_runs_animation_is_real_time)."""
+    cfg = tmp_path / "long.toml"
+    cfg.write_text('[law]\ntype = "min-jerk"\nduration = 1e9\n'
+                   '[output]\nsamples = 101\nfigures = ["animation"]\n')
+    out = tmp_path / "o"
+    t0 = time.perf_counter()
+    assert main(["run", str(cfg), "--out", str(out), "--quiet"]) == 0
+    assert time.perf_counter() - t0 < 60.0  # (about 2 s; it did not end in 10 minutes)
+    delays = _gif_delays(out / "animation.gif")
+    assert len(delays) == 41 and set(delays[:-1]) == {60_000}
+    report = (out / "report.html").read_text()
+    assert "sped up 4.17e+05 times (not real time" in report and "in real time" not in report
+
+
+def test_the_paper_runs_animation_is_real_time(run_dir):
+    delays = _gif_delays(run_dir / "animation.gif")
+    assert len(delays) <= 41 and sum(delays[:-1]) == pytest.approx(1000.0, abs=5.0)
+    report = (run_dir / "report.html").read_text()
+    assert "optimal law), in real time." in report and "sped up" not in report

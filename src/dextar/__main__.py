@@ -2,4 +2,5 @@
 
 from .cli import entry
 
-entry()
+if __name__ == "__main__":  # (importing the module, as the API docs do, runs nothing)
+    entry()

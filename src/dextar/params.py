@@ -96,6 +96,14 @@ def _where(table: str, key: str) -> str:
     return f"config key {table}.{key}" if table.startswith("[") else f"config key [{table}].{key}"
 
 
+def number_words(x: float) -> str:
+    """A number as a message shows it: NaN called NaN, an infinity ``inf`` or ``-inf``, any
+    other in six significant digits."""
+    if math.isnan(x):
+        return "NaN"
+    return f"{x:.6g}"
+
+
 def _check_number(table: str, key: str, p: Param, v: object) -> float:
     where = _where(table, key)
     if not _is_number(v):

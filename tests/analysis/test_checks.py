@@ -122,6 +122,7 @@ def _plan(an, gain=1.0):
     return plan
 
 
+@pytest.mark.slow
 def test_a_window_that_leaves_the_domain_is_reported_with_its_time(line_si):
     """Torques a thousand times too large throw the robot out of its domain within a
     window: its drift is infinite, the time and the cause named (no exception)."""
@@ -135,6 +136,7 @@ def test_a_window_that_leaves_the_domain_is_reported_with_its_time(line_si):
     assert "singularity" in why or "meet" in why, why
 
 
+@pytest.mark.slow
 def test_a_window_far_off_is_given_up_with_the_drift_it_reached(line_si):
     an = line_si
     r = replay(an.model, _plan(an, 1.5), replay_windows(an),

@@ -14,6 +14,7 @@ from dextar.kinematics import assembly_mode, singularity_distances
 from .conftest import COUNT, NOMINAL
 
 
+@pytest.mark.slow
 def test_linearised_covariance_matches_monte_carlo():
     """1500 parameter sets drawn from a covariance (0.01 mm, 0.005 deg, correlated), each
     commanded to the same targets by the readings of the mean model: the sample covariance

@@ -72,6 +72,7 @@ def runs(four_modes, one_mode, held_out):
     return out
 
 
+@pytest.mark.slow
 def test_the_truth_lies_within_the_standard_deviations(runs):
     """16 data sets, 160 estimates. Measured: sum of the Mahalanobis distances 182.9 against
     the chi-square(160) bounds [104, 233] at 1e-4 each side; the largest |error| / std
@@ -95,6 +96,7 @@ def test_the_truth_lies_within_the_standard_deviations(runs):
     assert 4 * d2 > chi2.ppf(1 - 1e-4, dof)
 
 
+@pytest.mark.slow
 def test_held_out_error_reaches_the_noise_floor(runs):
     """Held-out RMS error after / noise floor: measured 0.97 ... 1.05 (bound 1.3; 300 seeds
     of uniform errors reached 1.15 at most); before / floor: 10.4 ... 191 (bound 10, the
@@ -108,6 +110,7 @@ def test_held_out_error_reaches_the_noise_floor(runs):
     assert max(ratios) < 1.1
 
 
+@pytest.mark.slow
 def test_calibrated_readings_reach_the_targets_on_the_true_robot(runs):
     """Targets in the instrument's frame, readings of the calibrated model rounded to the
     encoder's counts, on the true robot: RMS miss 0.14 ... 0.36 of the noise floor (bound
@@ -119,6 +122,7 @@ def test_calibrated_readings_reach_the_targets_on_the_true_robot(runs):
             assert miss < 0.6 * r["floor"]
 
 
+@pytest.mark.slow
 def test_four_working_modes_against_one(runs, four_modes, one_mode):
     """Same number of poses (60), same robots, same held-out poses of all four modes: O1
     0.432 against 0.260; held-out error after calibration 1.01 against 1.13 times the
@@ -131,6 +135,7 @@ def test_four_working_modes_against_one(runs, four_modes, one_mode):
                for r in runs)
 
 
+@pytest.mark.slow
 def test_the_wrong_model_is_caught(runs):
     """Encoder offsets frozen at zero (the wrong model): residuals 15 ... 250 times the
     floor, and the chi-square test of the stated noise says so (status 2)."""
@@ -356,6 +361,7 @@ def test_a_solver_stopped_early_is_a_status_not_an_error(case):
     assert res.status == 1 and not res.success and "stopped" in res.message
 
 
+@pytest.mark.slow
 def test_the_predicted_accuracy_matches_the_misses_on_the_true_robot(runs):
     """The end-to-end misses against the covariance predicted from each fit's covariance
     and the encoders' rounding (s = count / sqrt(12)): e^T S^-1 e averages 2 (chi-square,

@@ -87,6 +87,7 @@ def test_calibrated_config_parses_and_round_trips(result):
     assert "instrument" not in no_frame
 
 
+@pytest.mark.slow
 def test_figures_are_drawn(result, four_modes):
     """The figures calibration_files does not draw (it draws the residuals with held-out
     poses and the accuracy maps with the poses)."""
@@ -106,6 +107,7 @@ def test_poses_csv_and_summary(four_modes):
     assert sum(s["modes"].values()) == 60
 
 
+@pytest.mark.slow
 def test_every_file_of_the_command(result, tmp_path):
     res, held = result
     files = out.calibration_files(res, data="measured.csv", working_mode="+-",

@@ -90,13 +90,24 @@ def test_every_working_mode_asked_for_gets_its_share():
     assert s.observability.o1 > 0.95 * 0.513
 
 
-def test_dextar_design_unchanged_by_the_share(four_modes):
-    """The DexTAR's rarest mode already has 3 of 60 poses, the share 60 // 16 = 3: the
-    design is the determinant's own, as before the share."""
+#: O1 of the DexTAR's 60-pose design in four modes: 0.432 (seeds 1-3 of the candidate grid:
+#: 0.436, 0.430, 0.432); one mode's 0.260.
+DEXTAR_O1 = 0.432
+
+
+def test_the_share_costs_the_dextar_design_nothing(four_modes, one_mode):
+    """Every mode gets at least its share, 60 // 16 = 3 poses, and the design keeps the
+    determinant's observability: O1 within 5 % of the measured 0.432 (the four seeds
+    measured within 1 %). Which poses the greedy exchange takes is the optimiser's: the
+    per-mode counts (20, 18, 3, 19 at seed 0) are not asserted (review 28 finding 15). The
+    bound can fail: one mode's design reaches 0.260."""
     counts = {m: four_modes.modes.count(m) for m in MODES}
-    assert counts == {"++": 20, "+-": 18, "-+": 3, "--": 19}
+    assert min(counts.values()) >= 60 // 16 and sum(counts.values()) == 60, counts
+    assert four_modes.observability.o1 > 0.95 * DEXTAR_O1
+    assert one_mode.observability.o1 < 0.95 * DEXTAR_O1
 
 
+@pytest.mark.slow
 def test_every_pose_inside_the_region_and_the_modes_missing_named():
     # above the motor axis, where a tracker beside the robot sees it: every pose inside and
     # the 4 modes (-+ has its 4 candidates at y = 21-29 mm)

@@ -97,6 +97,7 @@ def test_plan_prints_the_motion_time_and_cost_only_for_the_optimal_law(tmp_path,
     assert d["duration"] == d["duration_s"]
 
 
+@pytest.mark.slow
 def test_workspace_and_run_json_print_the_whole_summary(tmp_path, capsys):
     code, out, _ = run(["workspace", "--out", str(tmp_path / "w.png"), "--resolution", "40",
                         "--json"], capsys)
@@ -110,6 +111,7 @@ def test_workspace_and_run_json_print_the_whole_summary(tmp_path, capsys):
     assert code == 0 and s["law"]["type"] == "optimal" and "validation" in s and "files" in s
 
 
+@pytest.mark.slow
 def test_printed_paths_have_no_double_slash(tmp_path, capsys):
     code, out, _ = run(["simulate", "--out", str(tmp_path / "sim") + "/"], capsys)
     assert code == 0 and "//" not in out and str(tmp_path / "sim" / "tracking.csv") in out
@@ -119,6 +121,7 @@ def test_printed_paths_have_no_double_slash(tmp_path, capsys):
     assert code == 0 and "//" not in out
 
 
+@pytest.mark.slow
 def test_simulate_reports_saturation(tmp_path, capsys):
     cfg = tmp_path / "c.toml"
     # the motion needs 0.3 N m at its peak; saturated, it is 7.2 mm off: within 10 mm

@@ -80,6 +80,7 @@ def test_workspace_writes_png(tmp_path, capsys):
     assert code == 0 and out.read_bytes()[:4] == b"\x89PNG"
 
 
+@pytest.mark.slow
 def test_real_process_no_traceback():
     r = subprocess.run([sys.executable, "-m", "dextar.cli", "fk", "0", "180"],
                        capture_output=True, text=True)
@@ -96,3 +97,36 @@ def test_every_example_config_serves_the_robot_option(capsys):
     for cfg in sorted((Path(__file__).resolve().parents[2] / "examples").glob("*.toml")):
         code, _, err = run(["ik", "0", "120", "--robot", str(cfg)], capsys)
         assert code == 0, (cfg.name, err)
+
+
+@pytest.mark.parametrize("phi, psi, said", [
+    ("nan", "30", "encoder reading phi = NaN deg is not a number"),
+    ("30", "-inf", "encoder reading psi = -inf deg is infinite"),
+    ("1e300", "30", "encoder reading phi = 1e+300 deg is beyond 10000 deg: not a reading in "
+     "degrees"),
+    ("30", "-12000", "encoder reading psi = -12000 deg is beyond 10000 deg: not a reading in "
+     "degrees")])
+def test_fk_names_readings_that_are_none_in_the_users_words(capsys, phi, psi, said):
+    """Review 28 finding 10. Before: `fk nan 30` said "q has a non-finite value at index 0"
+    (internal names, no NaN, no deg, no phi); `fk 1e300 30` answered a point, exit 0. The
+    bound is a measured-poses file's (calibration.data.MAX_DEG)."""
+    code, out, err = run(["fk", phi, psi], capsys)
+    assert code == 2 and out == "" and err == f"dextar fk: error: {said}\n"
+
+
+@pytest.mark.parametrize("phi, psi", [("9999", "-9999"), ("-180", "180"), ("400", "30")])
+def test_fk_takes_readings_of_several_turns(capsys, phi, psi):
+    code, out, err = run(["fk", phi, psi, "--json"], capsys)
+    assert code == 0 and err == "" and json.loads(out)["phi_deg"] == float(phi)
+
+
+@pytest.mark.parametrize("argv, said", [
+    (["poses", "--count", "30", "--margin", "nan"], "singularity margin NaN must be in [0, 1)"),
+    (["poses", "--count", "30", "--seed", "-1"], "seed -1 must be a whole number, 0 or more"),
+])
+def test_other_number_options_are_named_not_internal_errors(tmp_path, capsys, argv, said):
+    """Before: `poses --seed -1` was `internal error: ValueError: expected non-negative
+    integer`; `--margin nan` was called nan."""
+    code, out, err = run([*argv, "--out", str(tmp_path / "p.csv")], capsys)
+    assert code == 2 and err == f"dextar poses: error: {said}\n"
+    assert not (tmp_path / "p.csv").exists()

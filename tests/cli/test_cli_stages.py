@@ -68,6 +68,7 @@ def test_torques_columns(tmp_path, capsys):
     assert "paper model (42) error" in capsys.readouterr().out
 
 
+@pytest.mark.slow
 def test_simulate_and_export(tmp_path, capsys):
     out = tmp_path / "sim"
     assert main(["simulate", "--out", str(out), "--json"]) == 0
@@ -122,6 +123,7 @@ def test_missing_config_file(capsys):
     assert "does not exist" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_no_traceback_for_bad_out(tmp_path):
     r = subprocess.run([sys.executable, "-m", "dextar.cli", "plan", "--out",
                         str(tmp_path / "x.txt")], capture_output=True, text=True)

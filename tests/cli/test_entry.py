@@ -22,6 +22,7 @@ def _entry(argv, before="", **kw):
                           **({"capture_output": True} | kw))
 
 
+@pytest.mark.slow
 def test_the_exit_status_the_output_and_the_exit_handlers():
     r = _entry(["ik", "0", "120"], "import atexit; atexit.register(print, 'exit handler ran')")
     assert r.returncode == 0, r.stderr
@@ -31,6 +32,7 @@ def test_the_exit_status_the_output_and_the_exit_handlers():
     assert bad.returncode == 2 and "out of reach" in bad.stderr and bad.stdout == ""
 
 
+@pytest.mark.slow
 def test_a_large_output_is_written_whole():
     r = _entry(["plan", "--out", "-"])  # 0.3 MB: more than a pipe holds
     assert r.returncode == 0, r.stderr
@@ -38,6 +40,7 @@ def test_a_large_output_is_written_whole():
     assert len(r.stdout) > 2**18 and len(lines) == 1002 and lines[-1].startswith("1.0,")
 
 
+@pytest.mark.slow
 def test_a_thread_of_a_library_still_running_is_waited_for():
     r = _entry(["ik", "0", "120"], "import threading, time; threading.Thread(target=lambda: "
                "(time.sleep(0.5), print('thread done', flush=True))).start()")

@@ -20,6 +20,7 @@ def read_csv(path):
 
 
 # ---------------------------------------------------------------- wrong numbers that look right
+@pytest.mark.slow
 def test_a_users_run_draws_what_applies_and_names_what_42_leaves_out(tmp_path, capsys):
     """line_si.toml (gravity, friction, payload): no Fig. 3 (the paper's uniform law) or Fig.
     7 (the paper's masses); the paper model's error is measured against the exact torques
@@ -38,6 +39,7 @@ def test_a_users_run_draws_what_applies_and_names_what_42_leaves_out(tmp_path, c
     assert "without gravity and friction, which (42) leaves out" in capsys.readouterr().out
 
 
+@pytest.mark.slow
 def test_identify_without_config_says_what_it_assumed(tmp_path, capsys, excite_csv):
     main(["identify", str(excite_csv), "--out", str(tmp_path / "id"), "--quiet"])
     err = capsys.readouterr().err
@@ -96,6 +98,7 @@ def test_a_trapezoid_error_speaks_the_configs_units(tmp_path, capsys):
                      r"mm/s\^2", err), err
 
 
+@pytest.mark.slow
 def test_a_plant_that_meets_a_singularity_is_a_result(tmp_path, capsys):
     """line_si.toml with a 0.1 N m torque limit: the saturated plant runs into a parallel
     singularity; what was simulated up to then is written, exit 1, the time named."""
@@ -125,6 +128,7 @@ def test_control_settings_out_of_range_are_refused_by_key(tmp_path, capsys, key,
 
 
 # ---------------------------------------------------------------- files and messages
+@pytest.mark.slow
 def test_every_output_follows_the_umask(tmp_path, excite_csv):
     small = tmp_path / "small.toml"
     small.write_text('[output]\nfigures = ["fig4", "animation"]\nanimation_frames = 2\n'
@@ -144,6 +148,7 @@ def test_every_output_follows_the_umask(tmp_path, excite_csv):
     assert {stat.S_IMODE(p.stat().st_mode) for p in files} == {0o644}
 
 
+@pytest.mark.slow
 def test_a_forced_run_holds_this_runs_files_only(tmp_path):
     out = tmp_path / "d"
     a, b = tmp_path / "a.toml", tmp_path / "b.toml"
@@ -174,6 +179,7 @@ def test_csv_numbers_are_shortest_and_never_negative_zero(tmp_path):
     assert all(float(repr(float(c))) == float(c) and repr(float(c)) == c for c in cells[:2000])
 
 
+@pytest.mark.slow
 def test_program_figures_and_report_count_and_name_the_moves(tmp_path):
     from dextar.config import load_scenario
     from dextar.output.program import moves_figure

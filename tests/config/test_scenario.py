@@ -25,7 +25,7 @@ def test_typed_tables_of_the_example():
                                            "knee_speed_rpm": 1}}
 
 
-def test_program_request_is_in_si():
+def test_program_request_is_in_si(tmp_path):
     sc = load_scenario(EXAMPLES / "pick_place.toml")
     req = sc.program_request()
     assert isinstance(req, ProgramRequest)
@@ -35,11 +35,22 @@ def test_program_request_is_in_si():
     assert req.moves[2].blend == pytest.approx(0.005)
     assert req.motors is not None
     assert req.motors.max_speed[0] == pytest.approx(30 * 2 * math.pi / 60)
-    # a joint move's target angles go to radians under a name without the unit
-    sc = load_scenario(EXAMPLES / "mode_change.toml")
-    joints = [m for m in sc.moves if m.type == "joint" and m.get("to_q") is not None]
-    for m in joints:
-        assert "to_deg" not in m.values
+    # a joint move's target: a point (`to`, mm) goes to m; readings (`to_deg`) go to rad
+    # under a name without the unit (`to_q`). mode_change.toml's joint move says `to`; the
+    # same file with that move given as the readings of its point says `to_deg`.
+    text = (EXAMPLES / "mode_change.toml").read_text()
+    point = 'to = [-20.0, 120.0]\nworking_mode = "++"'
+    assert text.count(point) == 1
+    readings = tmp_path / "mode_change_deg.toml"
+    readings.write_text(text.replace(point, 'to_deg = [73.4588, 39.5574]\nworking_mode = "++"'))
+    [joint] = [m for m in load_scenario(EXAMPLES / "mode_change.toml").program_request().moves
+               if m.type == "joint"]
+    assert joint.get("to") == pytest.approx((-0.02, 0.12), abs=1e-15)
+    assert "to_q" not in joint.values and "to_deg" not in joint.values
+    [joint] = [m for m in load_scenario(readings).program_request().moves if m.type == "joint"]
+    assert joint.get("to_q") == pytest.approx((math.radians(73.4588), math.radians(39.5574)),
+                                              abs=1e-15)
+    assert "to_deg" not in joint.values and "to" not in joint.values
 
 
 def test_program_start_is_required_by_key():

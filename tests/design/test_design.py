@@ -17,6 +17,7 @@ from dextar.cli import main
 from dextar.config import load_scenario
 from dextar.design.evaluate import Task, evaluate_design
 from dextar.design.pareto import closest_to_ideal, pareto_mask
+from dextar.design.space import METRICS
 from dextar.output.design import parse_line
 
 pytest.importorskip("distributed")
@@ -78,6 +79,7 @@ def sweep2(tmp_path_factory, scheduler):
     return task, out
 
 
+@pytest.mark.slow
 def test_rows_are_the_single_design_function(sweep2):
     task_path, out = sweep2
     rows = rows_of(out)
@@ -98,6 +100,7 @@ def test_rows_are_the_single_design_function(sweep2):
     assert all(r["reason"] for r in rows if not r["feasible"])
 
 
+@pytest.mark.slow
 def test_pareto_set_by_brute_force(sweep2):
     _, out = sweep2
     rows = [r for r in rows_of(out) if r["feasible"]]
@@ -122,6 +125,20 @@ def test_pareto_helpers_on_a_known_front():
     assert closest_to_ideal(F[[0, 1, 2]]) == 1
 
 
+def test_one_design_is_a_row_without_a_cluster(tmp_path):
+    """What each worker runs, on its own: the DexTAR plans the task within its motors (its
+    metrics finite); rods too short for the start are a row with the reason and no metric."""
+    task, _ = load_scenario(write_task(tmp_path)).design_task()
+    row = evaluate_design(task, (72.0, 72.0, 87.0, 87.0, 60.0))
+    assert row["feasible"] and row["reason"] == "" and row["footprint_mm"] == 72 + 87 + 30
+    assert all(np.isfinite(row[k]) for k in METRICS) and row["cycle_time_s"] > 0
+    assert max(row["peak_torque_A_Nm"], row["peak_torque_D_Nm"]) <= 3.4  # [motors]
+    short = evaluate_design(task, (20.0, 20.0, 30.0, 30.0, 60.0))  # reach 50 mm: start at 130
+    assert not short["feasible"] and "out of reach of leg 1" in short["reason"]
+    assert short["cycle_time_s"] is None and short["footprint_mm"] == 80.0
+
+
+@pytest.mark.slow
 def test_one_worker_gives_the_same_file(sweep2, tmp_path):
     task, out2 = sweep2
     out1 = tmp_path / "one"
@@ -130,6 +147,7 @@ def test_one_worker_gives_the_same_file(sweep2, tmp_path):
     assert (out1 / "pareto.csv").read_bytes() == (out2 / "pareto.csv").read_bytes()
 
 
+@pytest.mark.slow
 def test_a_killed_sweep_resumes_to_the_same_file(sweep2, tmp_path, scheduler):
     task, out2 = sweep2
     out = tmp_path / "killed"
@@ -173,6 +191,7 @@ def test_bad_design_tables_exit_2(tmp_path, capsys, design, message):
     assert not (tmp_path / "o").exists()
 
 
+@pytest.mark.slow
 def test_geometries_that_cannot_assemble_are_rows(tmp_path, scheduler):
     """Rods too short for the base: every design is a row with its reason, no crash."""
     task = write_task(tmp_path, design='[design]\nl = [5.0, 10.0]\nL = [5.0, 10.0]\n'
@@ -186,6 +205,7 @@ def test_geometries_that_cannot_assemble_are_rows(tmp_path, scheduler):
     assert s["feasible"] == 0 and s["best"] is None
 
 
+@pytest.mark.slow
 def test_unreachable_scheduler_is_named_within_10_s(tmp_path, capsys, monkeypatch):
     from dextar.design import sweep
 
@@ -208,6 +228,7 @@ def test_without_dask_the_extra_is_named(tmp_path, capsys, monkeypatch):
     assert "pip install -e '.[design]'" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_resume_refuses_another_sweep(sweep2, tmp_path, capsys):
     task, out2 = sweep2
     import shutil
@@ -220,6 +241,7 @@ def test_resume_refuses_another_sweep(sweep2, tmp_path, capsys):
     assert "--resume" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_a_run_task_sweeps_its_path_and_law(tmp_path, scheduler):
     """A dextar run config (one path, one law) is a task too: geometry and torque metrics
     along its path; its rows are the single-design function's."""
@@ -310,6 +332,7 @@ def test_random_design_tables_are_read_or_refused_by_name(tmp_path_factory):
     check()
 
 
+@pytest.mark.slow
 def test_a_running_cluster_by_address_gives_the_same_file(sweep2, tmp_path):
     """`dask scheduler` and `dask worker` started as the README shows; --scheduler uses them."""
     import shutil
@@ -344,6 +367,7 @@ def test_a_running_cluster_by_address_gives_the_same_file(sweep2, tmp_path):
             p.wait()
 
 
+@pytest.mark.slow
 def test_a_worker_that_dies_is_replaced_and_the_rows_are_complete(sweep2):
     """One of two workers is killed after the first chunk: Dask reruns its chunks elsewhere
     and the sweep ends with every row, equal to the uninterrupted sweep's."""
@@ -371,6 +395,7 @@ def test_a_worker_that_dies_is_replaced_and_the_rows_are_complete(sweep2):
         assert got[i] == expected[i]
 
 
+@pytest.mark.slow
 def test_sweeps_one_after_another_on_one_cluster(tmp_path, scheduler):
     """Two sweeps in a row on the same two workers (as a script or the benchmark does): the
     second one's task is not lost while the first one's copy is being released."""

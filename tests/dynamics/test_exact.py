@@ -6,6 +6,7 @@ from dextar.dynamics import (
     Inertia,
     Model,
     Rod,
+    accelerations,
     bias_forces,
     gravity_torques,
     inverse_dynamics,
@@ -102,6 +103,37 @@ def test_decomposition_and_mass_matrix():
     # kinetic energy is (1/2) qdot^T M qdot
     np.testing.assert_allclose(kinetic_energy(model, q, dq),
                                0.5 * np.einsum("ni,nij,nj->n", dq, M, dq), rtol=1e-12)
+
+
+def test_accelerations_invert_the_inverse_dynamics(kernel):
+    """Review 28 finding 11: the replay's windows and the forward dynamics share one
+    vectorised ``accelerations`` (M from mass_matrix, h from one inverse_dynamics pass) where
+    the replay had rebuilt M and h from three inverse-dynamics calls. Against the inverse
+    dynamics with gravity, viscous and Coulomb friction and rotors (forward(inverse) =
+    identity), and M against state_dynamics, the scalar model the integrators call."""
+    from dextar.dynamics import state_dynamics
+
+    model = Model(ROBOT, general_inertia(gravity=(0.3, -2.0), viscous=(0.01, 0.02),
+                                         coulomb=(0.05, 0.03)))
+    q, dq, ddq = random_joint_motion(np.random.default_rng(7), np.linspace(0, 1, 60))
+    tau = inverse_dynamics(model, q, dq, ddq)
+    acc = accelerations(model, q, dq, tau)
+    np.testing.assert_allclose(acc, ddq, rtol=0, atol=1e-10 * np.abs(ddq).max())
+    assert accelerations(model, q[3], dq[3], tau[3]).shape == (2,)  # one state
+    M = mass_matrix(model, q)
+    for i in (0, 17, 59):
+        Mi, hi = state_dynamics(model, q[i], dq[i])
+        np.testing.assert_allclose(M[i], Mi, rtol=0, atol=1e-13 * np.abs(Mi).max())
+    # the torques of other accelerations are not these accelerations' (the check can fail)
+    assert np.abs(accelerations(model, q, dq, tau + 1e-3) - ddq).max() > 1e-3
+
+
+def test_accelerations_name_the_state_they_cannot_take():
+    """The replay gives up a window by this error (one state at a time, named)."""
+    model = Model(ROBOT, general_inertia())
+    q = np.radians([[60.5, 119.5], [0.0, 180.0]])  # the second: rods 2.3 L apart
+    with pytest.raises(dx.AssemblyError, match=r"cannot meet at sample 1: q = \(0, 180\) deg"):
+        accelerations(model, q, np.zeros((2, 2)), np.zeros((2, 2)))
 
 
 def test_gravity_is_potential_gradient():

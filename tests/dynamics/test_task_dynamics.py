@@ -40,13 +40,13 @@ def motion(robot, mode, n, seed):
     rng = np.random.default_rng(seed)
     reach = robot.l1 + robot.L1
     P = np.stack([rng.uniform(-0.6, 0.6, 20 * n), rng.uniform(0.2, 1.0, 20 * n)], -1) * reach
-    ok = np.zeros(len(P), bool)
-    for k, p in enumerate(P):  # (a test's setup: a few thousand points)
-        try:
-            inverse_kinematics(robot, p[None], mode)
-            ok[k] = True
-        except ReachError:
-            pass
+    # within both legs' annuli (a point within 1e-9 of an annulus' edge is a stretched or
+    # folded leg, which the serial-singularity distance below leaves out anyway)
+    ok = np.ones(len(P), bool)
+    for leg, pivot in ((1, robot.A), (2, robot.D)):
+        rin, rout = robot.reach(leg)
+        r = np.hypot(P[:, 0] - pivot[0], P[:, 1] - pivot[1])
+        ok &= (r > rin + 1e-9 * rout) & (r < rout * (1 - 1e-9))
     P = P[ok]
     q = inverse_kinematics(robot, P, mode)
     t1, t2 = singularity_distances(robot, q, P)

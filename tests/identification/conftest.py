@@ -40,3 +40,14 @@ def synthetic(model, trajectory, seconds, *, seed, noise=0.005, rate=1000.0):
     tau = inverse_dynamics(model, q, dq, ddq)
     return MotionData(t, np.round(q / COUNT) * COUNT, tau + rng.normal(scale=noise,
                                                                       size=tau.shape))
+
+
+@pytest.fixture(scope="session")
+def issue28():
+    """Issue 28's robot (SI) and its working mode (tests/identification/excitations.py)."""
+    from dextar.config.scenario import scenario_from_dict
+
+    from .excitations import ISSUE28_CONFIG
+
+    sc = scenario_from_dict(ISSUE28_CONFIG)
+    return sc.si_model, sc.mode

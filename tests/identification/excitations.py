@@ -29,3 +29,22 @@ _COEFFICIENTS = {
 
 #: The stored excitations.
 EXCITATIONS = {k: FourierTrajectory(q0, a, b, 0.2) for k, (q0, a, b) in _COEFFICIENTS.items()}
+
+#: Issue 28's robot (:data:`ISSUE28_CONFIG`): ``design_excitation(model, "+-", duration=15.0,
+#: motors=...)`` at seed 0 (condition number 6.06, 5 harmonics of 0.2 Hz), the excitation of
+#: benchmarks/bench_identify_verdicts.py's seed 0.
+ISSUE28 = FourierTrajectory(
+    np.array([1.2342010043941911, 2.404103594631578]),
+    np.array([[0.028236598762825332, 0.19964314254887286, 0.14894915777875795, 0.16800601368561677, -0.5448349127760729], [-0.22921631883958143, -0.04866265949845323, 0.24015662772886898, 0.4567718235168448, -0.41904947290767913]]),
+    np.array([[-0.43259092553920614, 0.4660381965212067, 0.4347991625451842, 0.22311344013964168, -0.5392673431394653], [0.08879698371691555, -0.07881685888998356, 0.469847582553372, 0.6543243010405438, -0.7916006435518479]]),
+    0.2)
+
+#: Issue 28's robot (config units): 80/75/95/92/58 mm, a 0.28 kg effector, gravity tilted by
+#: 9.4 deg, dry and viscous friction, 1.5 N m motors of 30 rad/s.
+ISSUE28_CONFIG = {
+    "robot": {"l1": 80.0, "l2": 75.0, "L1": 95.0, "L2": 92.0, "d": 58.0, "working_mode": "+-"},
+    "inertia": {"effector_mass": 0.28, "proximal_mass": 0.095, "distal_mass": 0.06},
+    "friction": {"coulomb": 0.02, "viscous": 0.005},
+    "gravity": {"vector": [9810.0 * 0.16332596224162227, -9810.0 * 0.9865721616069694]},
+    "motors": {"peak_torque": 1.5, "max_speed_rpm": 286.0},
+}

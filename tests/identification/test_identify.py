@@ -52,6 +52,7 @@ def _scatter(model, base, tr, draws, seed, truth):
     return np.array(zs), np.array(logs)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("which", [0, 2])
 def test_estimates_scatter_as_their_deviations_and_shrink_as_root_n(prior, base, which):
     """4 noise draws of 5 s and 20 s (5 mN m, 17-bit angles): 88 z-scores and 44 std ratios.
@@ -86,6 +87,7 @@ def test_physical_set_reproduces_the_base_parameters(prior, excitation, base):
         assert rod.mass >= 0 and rod.inertia >= 0
 
 
+@pytest.mark.slow
 def test_an_unphysical_solution_is_constrained(prior, base):
     """Base parameters no physical set can have (a negative friction) are refused by
     physical_set; realise never writes a negative mass or inertia."""
@@ -126,6 +128,7 @@ def test_a_good_fit_has_a_small_fit_quality_and_flags_what_it_cannot_pin(prior, 
     assert res.status_text == "identified"
 
 
+@pytest.mark.slow
 def test_gravity_left_out_is_a_poor_fit_with_outputs(prior, excitation, base):
     """The data have gravity, the prior not: fit quality 61-96 % over 20 MuJoCo excitations
     (measured), 3x the limit; the estimates are still there for the summary."""
@@ -142,6 +145,7 @@ def test_gravity_left_out_is_a_poor_fit_with_outputs(prior, excitation, base):
     assert res.inertia is not None and res.conditioned is not None
 
 
+@pytest.mark.slow
 def test_torques_in_another_unit_are_a_poor_fit(prior, excitation, base):
     """mN m fit exactly as well by least squares, but 1000x the prior's torques (good fits:
     1.05-1.10), and with masses no physical robot of this size has (beyond 10x the prior's

@@ -17,6 +17,8 @@ from dextar.identification.fit import identify, validate
 from ..program.test_program import EXAMPLES
 from .excitations import EXCITATIONS
 
+pytestmark = pytest.mark.slow
+
 mujoco = pytest.importorskip("mujoco")
 H = pytest.importorskip("tests.identification.mujoco_harness")
 

@@ -1,3 +1,5 @@
+import math
+
 import numpy as np
 import pytest
 
@@ -19,7 +21,8 @@ def paper_law(eta=0.1):
     return solve_optimal_law(SEMI, duration=1.0, eta=eta, mass=1.0)
 
 
-@pytest.mark.parametrize("eta", [1e-5, 1e-3, 0.1, 10.0, 1e3, 1e5])
+@pytest.mark.parametrize("eta", [pytest.param(1e-5, marks=pytest.mark.slow), 1e-3, 0.1, 10.0,
+                                 1e3, 1e5])
 def test_semicircle_satisfies_paper_ode_15(eta):
     law = paper_law(eta)
     R = SEMI.radius
@@ -129,6 +132,22 @@ def test_simple_laws():
     assert np.abs(tz.evaluate(np.linspace(0, tz.duration, 999))[1]).max() <= 1.0 + 1e-12
 
 
+@pytest.mark.parametrize("S, a, T", [(1.39, 1.15e19, 1.0), (0.123, 1.0, 1e9), (2.0, 4.0, 1.5),
+                                     (1.0, 1.0, 2.0)])
+def test_a_trapezoid_of_a_long_duration_moves_at_its_cruise_speed(S, a, T):
+    """Found by the long-motion fuzz shape (review 28): a 1e9 s trapezoid over 123 mm had a
+    cruise speed of exactly 0 (the cancellation of (a T - sqrt(a^2 T^2 - 4 a S)) / 2): the
+    law never moved, and the run's summary divided by its zero energy. The cruise speed is
+    the root of v^2 - a T v + a S = 0 (the distance covered in T), to rounding; the law
+    arrives."""
+    law = TrapezoidalLaw(S, math.inf, a, T)
+    v = law.cruise
+    assert v > 0 and v * v - a * T * v + a * S == pytest.approx(0.0, abs=1e-12 * a * S)
+    assert v * (T - v / a) == pytest.approx(S, rel=1e-12)  # cruise + the two ramps
+    s = law.evaluate(np.array([0.0, 0.5 * T, T]))[0]
+    assert s[0] == 0.0 and s[1] == pytest.approx(0.5 * S, rel=1e-9) and s[2] == pytest.approx(S)
+
+
 def test_law_errors():
     with pytest.raises(ParameterError, match="cannot be covered"):
         TrapezoidalLaw(10.0, vmax=100.0, amax=1.0, duration=1.0)
@@ -178,6 +197,7 @@ def euler_lagrange_residual(path, law, n=1001):
     return np.abs(s4 - rhs).max() / (1 + np.abs(s4).max())
 
 
+@pytest.mark.slow
 def test_spline_law_by_pieces_is_spectrally_accurate():
     """A spline's law comes from one Chebyshev element per spline piece: the Euler-Lagrange
     residual on 1001 times reaches 5e-12 (bound 1e-9), the law agrees with solve_bvp's at tol

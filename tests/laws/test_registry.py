@@ -60,9 +60,17 @@ def test_the_command_line_plans_with_it_and_its_help_lists_it(toy_law, tmp_path,
     assert "const-accel" in helptext
 
 
-def test_readme_lists_every_registered_path_and_law():
+def test_the_docs_list_every_registered_path_and_law_a_new_one_too(toy_law):
+    """The docs' config reference (generated from the registries when the docs are built)
+    names every path type and law, the one registered from outside included."""
+    import importlib.util
     from pathlib import Path
 
-    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
-    for name in [*PATH_TYPES, *(k for k in LAW_TYPES if k != "const-accel")]:
-        assert f'`"{name}"`' in readme, name
+    source = Path(__file__).resolve().parents[2] / "docs" / "_ext" / "dextar_reference.py"
+    spec = importlib.util.spec_from_file_location("dextar_reference_for_laws", source)
+    reference = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(reference)
+    text = reference.config_reference()
+    for name in [*PATH_TYPES, *LAW_TYPES]:
+        assert f'type = "{name}"' in text and f'``"{name}"``' in text, name
+    assert "const-accel" in LAW_TYPES and "constant acceleration from rest" in text

@@ -69,12 +69,15 @@ def test_a_laid_out_figure_saves_the_same_bytes_without_its_layout_engine():
 
 
 @pytest.mark.parametrize("total_s, frames", [(1.0, 41), (0.768, 41), (0.001, 41), (0.0, 41),
-                                             (60.0, 500), (60.0, 2), (8 * 3600.0, 2)])
+                                             (60.0, 500), (60.0, 2), (8 * 3600.0, 2),
+                                             (40 * 60.0, 41), (41 * 60.0, 41), (1e9, 41)])
 def test_the_animation_plays_in_real_time_within_a_gifs_delays(total_s, frames):
-    """Frames every whole number of centiseconds from 20 ms (browsers play shorter delays
-    slowly) to 60 s (a GIF's delay field ends at 655 s), the first and last samples shown,
-    the motion's time played within 5 ms (20 ms for a motion shorter than that)."""
-    from dextar.output.figures import ANIMATION_PAUSE_MS, _real_time_frames
+    """Never more frames than asked; frames every whole number of centiseconds from 20 ms
+    (browsers play shorter delays slowly) to 60 s (a GIF's delay field ends at 655 s), the
+    first and last samples shown, the motion's time played within 5 ms (20 ms for a motion
+    shorter than that) up to ``frames - 1`` delays of 60 s, sped up past them (a 1e9 s
+    motion had asked for 1.7e7 frames of 60 s: the run hung)."""
+    from dextar.output.figures import ANIMATION_PAUSE_MS, _real_time_frames, _speedup
 
     t = np.linspace(0.0, total_s, 2001)
     index, delays = _real_time_frames(t, frames)
@@ -82,9 +85,16 @@ def test_the_animation_plays_in_real_time_within_a_gifs_delays(total_s, frames):
         assert list(index) == [0] and delays == [ANIMATION_PAUSE_MS]
         return
     assert index[0] == 0 and index[-1] == len(t) - 1 and len(index) == len(delays)
+    assert len(index) <= frames
     assert delays[-1] == ANIMATION_PAUSE_MS
     inner = delays[:-1]
     assert all(20 <= d <= 60_000 and d % 10 == 0 for d in inner)
-    if total_s >= 0.02:
-        assert abs(sum(inner) - 1e3 * total_s) <= 5.0
-        assert len(index) <= frames or max(inner) == 60_000
+    speedup = _speedup(1e3 * total_s, frames)
+    if total_s <= (frames - 1) * 60.0:
+        assert speedup == 1.0
+        if total_s >= 0.02:
+            assert abs(sum(inner) - 1e3 * total_s) <= 5.0
+    else:  # sped up: every frame the longest delay, the motion in that many times less
+        assert speedup > 1.0 and inner == [60_000] * (frames - 1)
+        assert sum(inner) * speedup == pytest.approx(1e3 * total_s, rel=1e-12)
+        assert list(index) == sorted(set(index))  # evenly spread, each sample once

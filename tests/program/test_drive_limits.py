@@ -90,6 +90,7 @@ def test_jerk_limits_on_another_geometry(tmp_path):
                  30 * 2 * np.pi / 60, s["moves"])
 
 
+@pytest.mark.slow
 def test_csp_and_pvt_reconstruct_the_setpoints(smooth):
     from dextar.program.drive import hermite
 
@@ -128,6 +129,7 @@ FIT = ('[robot]\npreset = "dextar"\n[inertia]\neffector_mass = 0.08\npayload = 0
        '[[move]]\ntype = "dwell"\ntime = 0.05\n[[move]]\ntype = "line"\nto = [-40.0, 110.0]\n')
 
 
+@pytest.mark.slow
 def test_fit_rms_plans_at_the_rating_and_stronger_motors_never_lose(tmp_path):
     """With 4 N m peaks the task as planned exceeds its 1 N m RMS rating; fitted, it is
     within it, bound by a rating, and faster than with 2 N m motors (which fit as

@@ -112,6 +112,27 @@ def test_whole_numbers_are_written_as_whole_numbers(tmp_path, capsys):
     assert moves[0] == 0 and moves[-1] == 7 and np.all(np.diff(moves) >= 0)
 
 
+@pytest.mark.parametrize("period_ms", [7, 3, 10])
+def test_pvt_times_are_whole_periods_as_written(tmp_path, capsys, period_ms):
+    """Review 28 finding 14: the last PVT time was the sum of rounded times (1.7080000000000002
+    s at a 7 ms period, 1.7069999999999999 at 3 ms); every time is now its whole number of
+    servo ticks over the servo rate, as the setpoints' are: each written time, read as a
+    decimal, is a whole number of periods, the points one period apart, the last at or after
+    the cycle's last tick."""
+    from decimal import Decimal
+
+    code, err, out = _run(tmp_path, capsys,
+                          DRIVE.replace("pvt_period_ms = 10", f"pvt_period_ms = {period_ms}"))
+    assert code == 0, err
+    lines = (out / "pvt.csv").read_text().splitlines()
+    i = lines[0].split(",").index("t_s")
+    written = [Decimal(line.split(",")[i]) for line in lines[1:]]
+    period = Decimal(period_ms) / 1000
+    assert [t / period for t in written] == list(range(len(written)))
+    last = Decimal(repr(float(columns(out / "setpoints.csv")["t_s"][-1])))
+    assert written[-1] >= last > written[-1] - period
+
+
 @pytest.mark.parametrize("drive, words", [
     (DRIVE.replace("rated_torque_Nm = 0.0115\n", "") + "max_torque_permille = 1200\n",
      "[drive].max_torque_permille needs [drive].rated_torque_Nm"),

@@ -32,6 +32,7 @@ def pick_place(tmp_path_factory):
     return dict(zip(head, data.T, strict=True)), json.loads((out / "summary.json").read_text())
 
 
+@pytest.mark.slow
 def test_figures_and_report_are_written(tmp_path):
     from html.parser import HTMLParser
 
@@ -102,6 +103,7 @@ def test_dwell_holds_still_against_gravity(pick_place):
     assert np.ptp(cols["tau1_Nm"][sel]) < 1e-12 and abs(cols["tau1_Nm"][sel][0]) > 1e-3
 
 
+@pytest.mark.slow
 def test_pd_loop_on_our_forward_dynamics_tracks_the_setpoints(tmp_path):
     """A drive with the setpoints' feedforward torques and a soft PD loop (which cannot hide
     a wrong feedforward) tracks the mode-change program on our forward dynamics; the same
@@ -265,17 +267,16 @@ def test_a_chain_takes_the_law_of_its_first_move(tmp_path, capsys):
     assert "blend makes it one motion" in capsys.readouterr().err
 
 
-def test_the_readme_program_plans_within_the_motors(tmp_path):
-    """The README's task file (a tight blended turn, time-optimal under a steep torque-speed
-    envelope) plans, and its setpoints stay within the motors (a missed torque peak between
-    the law's check samples once made it exceed by 16 %)."""
-    import re
-
-    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
-    cfg = tmp_path / "readme.toml"
-    cfg.write_text(re.search(r"```toml\n(\[motors\].*?)```", readme, re.S).group(1))
+def test_the_docs_program_plans_within_the_motors(tmp_path):
+    """The task file the docs' programs guide shows (examples/program_tour.toml: a tight
+    blended turn, time-optimal under a steep torque-speed envelope) plans, and its setpoints
+    stay within the motors (a missed torque peak between the law's check samples once made it
+    exceed by 16 %)."""
+    guide = (EXAMPLES.parent / "docs" / "guides" / "programs.rst").read_text()
+    assert "examples/program_tour.toml" in guide  # the file the guide shows
     out = tmp_path / "o"
-    assert main(["program", "--no-figures", str(cfg), "--out", str(out), "--quiet"]) == 0
+    assert main(["program", "--no-figures", str(EXAMPLES / "program_tour.toml"), "--out",
+                 str(out), "--quiet"]) == 0
     s = json.loads((out / "summary.json").read_text())
     assert s["status"] == "fits" and s["moves"][0]["blended_with_next"]
     assert all(m["peak_torque_ratio"] <= 1 + 1e-3 for m in s["motors"])

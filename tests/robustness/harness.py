@@ -213,3 +213,37 @@ def run_run_case(doc: dict[str, Any]) -> tuple[str, str]:
         out = work / "out"
         return run_case(["run", str(cfg), "--out", str(out), "--quiet"], work,
                         out / "summary.json", allow_exceeds=True)
+
+
+def run_robot_config_case(doc: dict[str, Any], command: str) -> tuple[str, str]:
+    """Write ``doc`` as a config and run a command that reads its robot only (``ik``, ``fk``,
+    ``workspace``, ``poses``) or ``excite`` on it, with arguments of the DexTAR's size."""
+    with tempfile.TemporaryDirectory() as tmp:
+        work = Path(tmp)
+        cfg = work / "case.toml"
+        cfg.write_text(toml_text(doc))
+        out: Path | None = None
+        if command == "ik":
+            argv = ["ik", "0", "120", "--robot", str(cfg)]
+        elif command == "fk":
+            argv = ["fk", "60", "120", "--robot", str(cfg)]
+        elif command == "workspace":
+            out = work / "ws.png"
+            argv = ["workspace", "--robot", str(cfg), "--resolution", "41", "--out", str(out)]
+        elif command == "poses":  # (text columns: the file is checked here, not as numbers)
+            poses = work / "poses.csv"
+            outcome, detail = run_case(["poses", str(cfg), "--count", "20", "--out", str(poses),
+                                        "--quiet"], work, None)
+            written = poses.exists() and len(poses.read_text().splitlines()) == 21
+            if outcome == "bad-exit" and detail.startswith("exit 1") and written:
+                return "exceeds", detail  # a working mode with no pose: exit 1, named
+            if outcome == "ok" and not written:
+                return "bad-exit", "exit 0 without the 20 poses"
+            return outcome, detail
+        elif command == "excite":  # below its coverage floors is a result: exit 1, written
+            out = work / "excite.csv"
+            return run_case(["excite", str(cfg), "--duration", "5", "--harmonics", "2", "--out",
+                             str(out), "--quiet"], work, out, allow_exceeds=True)
+        else:
+            raise ValueError(f"not a robot-config command: {command}")
+        return run_case(argv, work, out)

@@ -336,3 +336,66 @@ def dry_friction_runs(draw: st.DrawFn) -> dict[str, Any]:
         "output": {"units": draw(st.sampled_from(["si", "paper"])), "samples": 201,
                    "figures": []},
     }
+
+
+# --- review 28 finding 2: long motions with the figures and the animation on --------------
+
+@st.composite
+def long_animated_runs(draw: st.DrawFn) -> dict[str, Any]:
+    """A `dextar run` of a motion from a minute to 1e9 s (about the 40-frame, 60 s-a-frame
+    limit of a real-time animation, and far past it) with the animation and figures drawn:
+    the animation must stay within its frames (a 1e9 s motion had asked for 1.7e7)."""
+    law = draw(st.sampled_from(["min-jerk", "uniform", "optimal", "trapezoid"]))
+    doc: dict[str, Any] = {
+        "law": {"type": law,
+                "duration": draw(st.sampled_from([60.0, 2400.0, 2460.0, 2461.0, 3600.0, 1e5,
+                                                  1e7, 1e9]))},
+        "output": {"units": draw(st.sampled_from(["si", "paper"])),
+                   "samples": draw(st.sampled_from([101, 201, 1001])),
+                   "animation_frames": draw(st.sampled_from([2, 41, 200]))},
+    }
+    figures = draw(st.sampled_from([None, ["animation"], ["animation", "fig4", "fig9"]]))
+    if figures is not None:
+        doc["output"]["figures"] = figures
+    if draw(st.booleans()):
+        doc["path"] = draw(st.sampled_from([
+            {"type": "line", "start": [-60.0, 90.0], "end": [60.0, 115.0]},
+            {"type": "arc", "radius": 30.0, "center": [0.0, 110.0], "start_deg": 0.0,
+             "end_deg": 360.0 * draw(st.sampled_from([1, 20]))}]))
+    if law == "trapezoid":
+        doc["law"]["vmax"] = draw(st.sampled_from([1e-3, 1.0, 1000.0]))
+        doc["law"]["amax"] = draw(st.sampled_from([1e-3, 1000.0]))
+    if draw(st.booleans()):
+        doc["friction"] = {"coulomb": 0.002}
+        doc["gravity"] = {"vector": [0.0, -9810.0]}
+    return doc
+
+
+# --- issue 28: time scales ---------------------------------------------------------------
+
+#: Factors a time column is multiplied by: seconds written as milliseconds, microseconds, or
+#: as kiloseconds (the motion 1000 times faster).
+TIME_SCALES = (1e-3, 1.0, 1e3, 1e6)
+
+
+@st.composite
+def time_scaled_motion_files(draw: st.DrawFn) -> tuple[str, list[str], float]:
+    """A clean measured-motion CSV (a small motion of the DexTAR in working mode +-, 1000
+    or 500 Hz) whose time column is multiplied by a factor of :data:`TIME_SCALES`; returns
+    the text, extra ``dextar identify`` options and the factor."""
+    import numpy as np
+
+    n = draw(st.sampled_from([4000, 2000, 600]))
+    rate = draw(st.sampled_from([1000.0, 500.0]))
+    t = np.arange(n) / rate
+    w = 2 * np.pi * draw(st.sampled_from([0.3, 1.0, 2.0]))
+    amp = draw(st.sampled_from([0.2, 0.05, 0.0]))
+    # (0, 100) mm in working mode +- is phi = 54.7, psi = 125.3 deg for the DexTAR
+    q = np.stack([0.955 + amp * np.sin(w * t), 2.187 + amp * np.sin(1.7 * w * t + 1)], -1)
+    tau = np.stack([0.1 * np.sin(w * t) + 0.05, 0.08 * np.cos(w * t)], -1)
+    factor = draw(st.sampled_from(TIME_SCALES))
+    rows = np.column_stack([factor * t, q, tau])
+    text = "\n".join(["t_s,phi_rad,psi_rad,tau1_Nm,tau2_Nm",
+                      *(",".join(repr(float(v)) for v in r) for r in rows)]) + "\n"
+    opts = ["--cutoff-hz", "5"] if draw(st.integers(0, 3)) == 1 else []
+    return text, opts, factor

@@ -9,6 +9,7 @@ import re
 import tempfile
 from pathlib import Path
 
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -28,10 +29,16 @@ from .strategies import (
     dry_friction_runs,
     falling_simulations,
     kinematics_argv,
+    long_animated_runs,
     metre_configs,
     motion_files,
     programs,
+    time_scaled_motion_files,
 )
+
+pytestmark = pytest.mark.slow
+
+PICK_PLACE = str(Path(__file__).resolve().parents[2] / "examples" / "pick_place.toml")
 
 SETTINGS = settings(max_examples=100, deadline=None, derandomize=True,
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
@@ -144,3 +151,24 @@ def test_falling_simulations_never_crash(doc):
 def test_long_runs_with_dry_friction_never_crash(doc):
     outcome, detail = run_run_case(doc)
     assert outcome not in DEFECTS, f"{outcome}: {detail}\nconfig:\n{toml_text(doc)}"
+
+
+@settings(max_examples=2, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@given(doc=long_animated_runs())
+def test_long_runs_with_the_animation_never_hang(doc):
+    outcome, detail = run_run_case(doc)
+    assert outcome not in DEFECTS, f"{outcome}: {detail}\nconfig:\n{toml_text(doc)}"
+
+
+@SHAPES
+@given(case=time_scaled_motion_files(), config=st.sampled_from([None, PICK_PLACE]))
+def test_time_columns_in_other_units_never_crash(case, config):
+    """A time column in milliseconds or microseconds is refused naming that unit (issue 28,
+    time scales); seconds, or a motion 1000 times faster, end in a result or a refusal."""
+    text, options, factor = case
+    outcome, detail = run_identify_case(text, options, config)
+    assert outcome not in DEFECTS, f"{outcome}: {detail}\nfactor {factor}\n{text[:300]}"
+    unit = {1e3: "milliseconds", 1e6: "microseconds"}.get(factor)
+    if unit is not None:
+        assert outcome == "refused" and f"Is the time in {unit}?" in detail, detail

@@ -48,6 +48,7 @@ def test_underdamped_closed_form(traj):
     assert np.abs(res.joint_error - closed).max() < 1e-5
 
 
+@pytest.mark.slow
 def test_a_wrong_model_leaves_an_error_and_saturation_clips(traj):
     plant = Model(ROBOT, MODEL.inertia.scaled_masses(1.3))
     res = simulate_computed_torque(traj, MODEL, plant, natural_frequency=20.0)

@@ -12,6 +12,7 @@ Rows are numbered as lines of the file, the header being row 1.
 from __future__ import annotations
 
 import csv
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -30,6 +31,21 @@ OPTIONAL = ("mode", "assembly", "sigma_mm")
 #: is not in those units.
 MAX_DEG = 1e4
 MAX_MM = 1e6
+
+
+def check_readings_deg(readings_deg: tuple[float, float]) -> None:
+    """Raise :class:`ParameterError` for encoder readings ``(phi, psi)`` (deg) that are no
+    readings: NaN, infinite, or beyond :data:`MAX_DEG` (the bound of a measured-poses file:
+    a value past it is not an angle in degrees; ``dextar fk 1e300 30`` had answered a
+    point)."""
+    for name, v in zip(("phi", "psi"), readings_deg, strict=True):
+        if math.isnan(v):
+            raise ParameterError(f"encoder reading {name} = NaN deg is not a number")
+        if not math.isfinite(v):
+            raise ParameterError(f"encoder reading {name} = {v:g} deg is infinite")
+        if abs(v) > MAX_DEG:
+            raise ParameterError(f"encoder reading {name} = {v:.6g} deg is beyond "
+                                 f"{MAX_DEG:g} deg: not a reading in degrees")
 
 
 def rows_text(rows: Array, limit: int = 5) -> str:

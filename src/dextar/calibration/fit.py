@@ -46,6 +46,7 @@ from .._arrays import Array
 from .._lazy import lazy_module
 from ..errors import AssemblyError, DextarError, ParameterError, ReachError
 from ..geometry import parse_working_mode
+from ..params import number_words
 from .data import PoseData, rows_text
 from .errors import CouplingError, OutlierError, OutOfReachError
 from .model import (
@@ -616,7 +617,8 @@ def _options(frame: str, fit: Sequence[str] | None, robust: str | None,
     if robust is not None and robust not in ROBUST_LOSSES:
         raise ParameterError(f"robust loss {robust!r} is not one of {', '.join(ROBUST_LOSSES)}")
     if not (math.isfinite(outlier_factor) and outlier_factor > 1.0):
-        raise ParameterError(f"outlier factor {outlier_factor!r} must be a number above 1")
+        raise ParameterError(f"outlier factor {number_words(outlier_factor)} must be a number "
+                             "above 1")
     for name, v in (("point_std", point_std), ("reading_std", reading_std)):
         if v is not None and not (math.isfinite(v) and v > 0):
             raise ParameterError(f"{name} = {v!r} must be positive and finite")
@@ -708,12 +710,25 @@ def _blame(p: Array, p_nom: Array, data: PoseData, assembly: Array, sigma: Array
              for i in out[:5]]
     more = f" and {len(out) - 5} more" if len(out) > 5 else ""
     them = "it" if len(out) == 1 else "them"
+    # the rows the robust solves set aside too, which the fit of the others predicts within
+    # the bound: named, so that the rows counted add up (row 21 named alone beside a fit over
+    # 37 rows of 40)
+    named = {int(i) for i in out}
+    aside = [int(i) for i in np.flatnonzero(~g.kept_rows(data)) if int(i) not in named]
+    also = ""
+    if aside:
+        near = [f"{int(data.rows[i])} ({_mm(_row_distance(q, data, i, int(g.data.assembly[i])))} "
+                "from its prediction)" for i in aside[:5]]
+        listed = (", ".join(near) + f" and {len(aside) - 5} more" if len(aside) > 5 else
+                  " and ".join([", ".join(near[:-1]), near[-1]] if len(near) > 1 else near))
+        also = (f"; that fit also left out row{'s' if len(aside) > 1 else ''} {listed}, within "
+                "the bound")
     raise OutlierError(
         f"{data.source}: row{'s' if len(out) > 1 else ''} {', '.join(words)}{more} "
         f"disagree{'s' if len(out) == 1 else ''} with the others, which calibrate without "
         f"{them} (RMS error {_mm(_rms(np.hypot(*r.e.T)))} over {len(r.d)} rows, outlier "
-        f"bound {_mm(bound)}): correct or remove {them}, or calibrate with a robust loss",
-        tuple(int(data.rows[i]) for i in out))
+        f"bound {_mm(bound)}{also}): correct or remove {them}, or calibrate with a robust "
+        "loss", tuple(int(data.rows[i]) for i in out))
 
 
 def _row_distance(p: Array, data: PoseData, i: int, a: int) -> float:

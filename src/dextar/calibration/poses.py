@@ -50,6 +50,7 @@ from ..geometry import (
 )
 from ..kinematics import assembly_mode, inverse_kinematics
 from ..kinematics.checker import pose_distances, reach_violation
+from ..params import number_words
 from .model import NAMES, ROBOT, KinematicModel, characteristic_scales, closure, jacobian
 from .observability import Observability, identifiability, observability
 
@@ -384,6 +385,8 @@ def select_poses(nominal: KinematicModel, count: int, *,
         lies outside the legs' reach.
     """
     names = _checked_parameters(frame, count, margin, resolution, modes)
+    if not (isinstance(seed, (int, np.integer)) and seed >= 0):
+        raise ParameterError(f"seed {seed!r} must be a whole number, 0 or more")
     box = None if region is None else checked_region(region)
     sign = parse_assembly_mode(assembly)
     r = nominal.robot
@@ -442,7 +445,7 @@ def _checked_parameters(frame: str, count: int, margin: float, resolution: int,
         raise ParameterError(f"{count!r} poses: a calibration of {len(names)} parameters "
                              f"needs at least {2 * len(names)}")
     if not (math.isfinite(margin) and 0.0 <= margin < 1.0):
-        raise ParameterError(f"singularity margin {margin!r} must be in [0, 1)")
+        raise ParameterError(f"singularity margin {number_words(margin)} must be in [0, 1)")
     if not 10 <= resolution <= 1001:
         raise ParameterError(f"pose grid resolution {resolution} must be in 10 ... 1001")
     if not modes:

@@ -15,7 +15,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 from .. import config
 from ..errors import ConfigError, DextarError
@@ -160,18 +160,29 @@ def load(args: argparse.Namespace, units: str | None = None) -> Scenario:
     return sc.in_units(units)
 
 
+class Noted(Protocol):
+    """A config read by a command (:class:`~dextar.config.Scenario`,
+    :class:`~dextar.config.KinematicConfig`): its notes, what the user may not have meant
+    (:func:`dextar.config.kinematic.config_notes`)."""
+
+    @property
+    def notes(self) -> tuple[str, ...]:
+        """What the user may not have meant, in words."""
+
+
 @contextmanager
-def noted(sc: Scenario) -> Iterator[None]:
+def noted(cfg: Noted) -> Iterator[None]:
     """An error raised inside the block carries the config's notes (a robot in metres, an
-    empty file: :attr:`dextar.config.Scenario.notes`), where they are the likely cause."""
+    empty file), where they are the likely cause."""
     try:
         yield
     except DextarError as exc:
-        if sc.notes and exc.args:
-            exc.args = (f"{exc.args[0]} (note: {'; '.join(sc.notes)})", *exc.args[1:])
+        if cfg.notes and exc.args:
+            exc.args = (f"{exc.args[0]} (note: {'; '.join(cfg.notes)})", *exc.args[1:])
         raise
 
 
-def note_lines(command: str, sc: Scenario) -> list[str]:
-    """The config's notes as stderr lines, first among a command's warnings."""
-    return [f"dextar {command}: note: {n}" for n in sc.notes]
+def note_lines(command: str, cfg: Noted) -> list[str]:
+    """The config's notes as stderr lines, first among a command's warnings: every command
+    that reads a config says them."""
+    return [f"dextar {command}: note: {n}" for n in cfg.notes]

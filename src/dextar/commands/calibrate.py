@@ -16,7 +16,7 @@ from .. import jobs
 from .._lazy import lazy_module
 from ..config.kinematic import load_kinematic_config
 from ..output.files import OutputDir
-from .base import Result, into_directory, shown
+from .base import Result, into_directory, note_lines, noted, shown
 
 if TYPE_CHECKING:  # the writers, imported when the command runs (start-up: dextar._lazy)
     from ..output import calibration as written
@@ -50,8 +50,9 @@ def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
     od = OutputDir(args.out, force=args.force, produces=written.CALIBRATION_FILES)  # checked
     kc = load_kinematic_config(args.config)
     rt, inst = kc.robot, kc.instrument
-    job = jobs.calibrate(args.data, kc, validate=args.validate, frame=args.frame,
-                         robust=args.robust, outlier_factor=args.outlier_factor)
+    with noted(kc):
+        job = jobs.calibrate(args.data, kc, validate=args.validate, frame=args.frame,
+                             robust=args.robust, outlier_factor=args.outlier_factor)
     d = job.diagnosis
     files = written.calibration_files(
         d.result, data=args.data, config=args.config or "", working_mode=rt.working_mode,
@@ -63,4 +64,5 @@ def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
                                   problem=d.message, robust=args.robust,
                                   sigma_mm=inst.sigma_mm, working_mode=rt.working_mode,
                                   default_robot=rt.geometry_mm if args.config is None else None)
-    return Result(said.payload(files), said.text(), said.warnings(), code=said.code)
+    return Result(said.payload(files), said.text(),
+                  note_lines("calibrate", kc) + said.warnings(), code=said.code)

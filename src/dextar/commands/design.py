@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 from .. import jobs
 from .._lazy import lazy_module
 from ..output.files import OutputDir
-from .base import Result, config_argument, into_directory, load, shown
+from .base import Result, config_argument, into_directory, load, note_lines, noted, shown
 
 if TYPE_CHECKING:  # the writers, imported when the command runs (start-up: dextar._lazy)
     from ..design.search import Progress
@@ -97,7 +97,9 @@ def _dashboard(args: argparse.Namespace) -> Callable[[str], None] | None:
 
 def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
     """Sweep and choose (:func:`dextar.jobs.design`), write, word."""
-    sweep = jobs.design_sweep(load(args), samples=args.samples, seed=args.seed)
+    sc = load(args)
+    with noted(sc):
+        sweep = jobs.design_sweep(sc, samples=args.samples, seed=args.seed)
     what = "sweep" if sweep.search is None else "search"
     with OutputDir(args.out, force=args.force, keep=args.resume, produces=written.DESIGN_FILES,
                    hint=f"use --force to overwrite it or --resume to complete its {what}") as od:
@@ -125,4 +127,4 @@ def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
                f"{best['l2']:.4g}, L1 = {best['L1']:.4g}, L2 = {best['L2']:.4g}, d = "
                f"{best['d']:.4g} mm -> {shown(args.out, 'best.toml')}" if best
                else "; no feasible design"))
-    return Result(summary, text)
+    return Result(summary, text, note_lines("design", sc))

@@ -9,9 +9,8 @@ from typing import TYPE_CHECKING
 
 from .. import jobs
 from .._lazy import lazy_module
-from ..identification.excite import ACCELERATION_FLOOR, RANGE_FLOOR, SPEED_FLOOR
 from ..output.tables import csv_text
-from .base import Result, config_argument, json_flag, load, out_file, write_or_hand_back
+from .base import Result, config_argument, json_flag, load, note_lines, out_file, write_or_hand_back
 
 if TYPE_CHECKING:  # the writers, imported when the command runs (start-up: dextar._lazy)
     from ..output import identification as written
@@ -57,19 +56,10 @@ def run(args: argparse.Namespace) -> Result:
             f"distances type 1 {res.min_type1_distance:.3g}, type 2 "
             f"{res.min_type2_distance:.3g}; wrote {where} ({payload['samples']} samples at "
             f"{rate:g} Hz)")
-    cov = res.coverage
-    if cov is not None:
-        fr = cov.fractions
-        text += (f"; coverage of what the {'task' if region is not None else 'free range'} "
-                 f"and motors allow, motor A / D: range {fr['range'][0]:.0%} / "
-                 f"{fr['range'][1]:.0%}, speed {fr['speed'][0]:.0%} / {fr['speed'][1]:.0%}, "
-                 f"acceleration {fr['acceleration'][0]:.0%} / {fr['acceleration'][1]:.0%} "
-                 f"(floors {RANGE_FLOOR:.0%}, {SPEED_FLOOR:.0%}, {ACCELERATION_FLOOR:.0%}; "
-                 f"{res.attempts} design{'s' if res.attempts > 1 else ''})")
-    code = 1 if res.status == 2 else 0  # written, but short of its floors
-    warnings = ([] if res.status == 0 else
-                [f"dextar excite: {res.message}" if code else
-                 f"dextar excite: warning: {res.message}"])
+    if res.coverage is not None:
+        text += "; " + written.coverage_text(res, region is not None)
+    # below the advisory floors: written, exit 0, a warning (see identification.excite)
+    warnings = [] if res.status == 0 else [f"dextar excite: warning: {res.message}"]
     if region is not None:
         text += (f"; covers {res.region_coverage:.1%} of the task's poses, at "
                  f"{res.region_speed_ratio[0]:.2f} and {res.region_speed_ratio[1]:.2f} of its "
@@ -79,5 +69,6 @@ def run(args: argparse.Namespace) -> Result:
                             f"{res.region_coverage:.1%} of the task's poses and reaches "
                             f"{res.region_speed_ratio.min():.2f} of its peak speed: an "
                             "identification from it extrapolates on the rest")
-    return Result(payload, text, warnings, data=data, code=code)
+    warnings[:0] = note_lines("excite", sc)  # the config's notes (a robot in metres), first
+    return Result(payload, text, warnings, data=data)
 

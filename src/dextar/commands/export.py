@@ -12,6 +12,7 @@ from .base import (
     config_argument,
     json_flag,
     load,
+    note_lines,
     noted,
     out_file,
     units_note,
@@ -39,4 +40,4 @@ def run(args: argparse.Namespace) -> Result:
     where, data = write_or_hand_back(path, xml)
     return Result({"out": where, "units": sc.units.describe()},
                   f"wrote {where} (MuJoCo model in {units_note(sc)}; keyframe 'start' at the "
-                  "motion's start)", data=data)
+                  "motion's start)", note_lines("export", sc), data=data)

@@ -11,9 +11,9 @@ import argparse
 
 import numpy as np
 
-from ..config.kinematic import load_kinematics
+from ..config.kinematic import load_kinematic_config
 from ..kinematics import direct_kinematics
-from .base import Result, json_flag
+from .base import Result, json_flag, note_lines, noted
 from .kinematics_args import frame_argument, instrument_of, robot_argument
 
 
@@ -29,10 +29,12 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> Result:
     """Add the encoder offsets, solve and word the point."""
-    rc, inst = load_kinematics(args.robot)
+    kc = load_kinematic_config(args.robot)
+    rc, inst = kc.robot, (kc.instrument if kc.has_instrument else None)
     assembly = args.assembly or rc.assembly_mode
-    geo = rc.geometric_deg((args.phi, args.psi))
-    P = direct_kinematics(rc.geometry_mm, np.radians(geo), assembly)
+    with noted(kc):
+        geo = rc.geometric_deg((args.phi, args.psi))
+        P = direct_kinematics(rc.geometry_mm, np.radians(geo), assembly)
     x, y = float(P[0]), float(P[1])
     if args.frame == "instrument":
         x, y = instrument_of(inst, args.robot).to_instrument_mm((x, y))
@@ -46,4 +48,4 @@ def run(args: argparse.Namespace) -> Result:
         a, b = rc.encoder_offset_deg
         text += (f" for readings {args.phi:g}, {args.psi:g} deg (geometric angles "
                  f"{geo[0]:.6f}, {geo[1]:.6f} deg, offsets [{a:g}, {b:g}] deg)")
-    return Result(payload, text)
+    return Result(payload, text, note_lines("fk", kc))

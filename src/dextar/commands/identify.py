@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 
 from .. import jobs
 from .._lazy import lazy_module
-from .base import Result, into_directory, load, model_argument, shown
+from .base import Result, into_directory, load, model_argument, note_lines, shown
 
 if TYPE_CHECKING:  # the writers, imported when the command runs (start-up: dextar._lazy)
     from ..output import identification as written
@@ -25,7 +25,8 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
     sp.add_argument("--task", metavar="TASK.toml",
                     help="a program or run config the model is for (its robot must be the "
                     "config's): the predicted-torque uncertainty is measured along it "
-                    "(default: along the data's own envelope)")
+                    "(default: along the recorded motion: the verdict then covers motions "
+                    "like it)")
     sp.add_argument("--validate", metavar="DATA2.csv",
                     help="data not used in the fit: predicted against measured torques")
     sp.add_argument("--cutoff-hz", type=float, default=None,
@@ -53,4 +54,5 @@ def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
                         f"the DexTAR (l1 = {g.l1:g}, l2 = {g.l2:g}, L1 = {g.L1:g}, L2 = "
                         f"{g.L2:g}, d = {g.d:g} mm, working mode {sc.mode}) without gravity; "
                         "give the robot's config with --config")
+    warnings[:0] = note_lines("identify", sc)  # the config's notes (a robot in metres), first
     return Result(rep.summary, "\n".join(lines), warnings, code=0 if res.success else 1)

@@ -12,10 +12,10 @@ import argparse
 
 import numpy as np
 
-from ..config.kinematic import load_kinematics
+from ..config.kinematic import load_kinematic_config
 from ..kinematics import inverse_kinematics, singularity_distances
 from ..kinematics.checker import check_reach
-from .base import Result, json_flag
+from .base import Result, json_flag, note_lines, noted
 from .kinematics_args import frame_argument, instrument_of, mode_argument, robot_argument
 
 #: Normalised distance to a singularity below which the answer carries a warning.
@@ -34,7 +34,8 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> Result:
     """Solve, take the encoder offsets off and word the readings; warn near a singularity."""
-    rc, inst = load_kinematics(args.robot)
+    kc = load_kinematic_config(args.robot)
+    rc, inst = kc.robot, (kc.instrument if kc.has_instrument else None)
     mode = args.mode or rc.working_mode
     given = (args.x, args.y)
     frame = args.frame
@@ -42,19 +43,21 @@ def run(args: argparse.Namespace) -> Result:
     P = np.array(point, float)
     where = ("" if frame == "robot" else
              f" in the robot frame (({args.x:.6g}, {args.y:.6g}) mm in the instrument's)")
-    check_reach(rc.geometry_mm, P[None, :], lambda i: "the target",
-                lambda p: f"({p[0]:.6g}, {p[1]:.6g}) mm{where}", lambda v: f"{v:.6g} mm")
-    q = inverse_kinematics(rc.geometry_mm, P, mode)
+    with noted(kc):
+        check_reach(rc.geometry_mm, P[None, :], lambda i: "the target",
+                    lambda p: f"({p[0]:.6g}, {p[1]:.6g}) mm{where}", lambda v: f"{v:.6g} mm")
+        q = inverse_kinematics(rc.geometry_mm, P, mode)
     d1, d2 = (float(v) for v in singularity_distances(rc.geometry_mm, q, P))
     geo = np.degrees(q)
     # readings = geometric - offset, in (-180, 180] like the inverse kinematics' angles
     r = 180.0 - np.mod(180.0 - (geo - np.array(rc.encoder_offset_deg)), 360.0)
     phi, psi = (float(v) for v in r)
-    warnings = [f"dextar ik: warning: the pose is near a {kind} singularity (normalised "
-                f"distance {d:.3g} below {NEAR_SINGULARITY:g}): small errors in the angles "
-                "move the end-effector far" for kind, d in (("serial (type 1)", d1),
-                                                            ("parallel (type 2)", d2))
-                if d < NEAR_SINGULARITY]
+    warnings = note_lines("ik", kc)
+    warnings += [f"dextar ik: warning: the pose is near a {kind} singularity (normalised "
+                 f"distance {d:.3g} below {NEAR_SINGULARITY:g}): small errors in the angles "
+                 "move the end-effector far" for kind, d in (("serial (type 1)", d1),
+                                                             ("parallel (type 2)", d2))
+                 if d < NEAR_SINGULARITY]
     payload = {"phi_deg": phi, "psi_deg": psi, "angles": "readings", "mode": mode,
                "geometric_phi_deg": float(geo[0]), "geometric_psi_deg": float(geo[1]),
                "encoder_offset_deg": list(rc.encoder_offset_deg), "frame": frame,

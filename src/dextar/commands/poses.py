@@ -15,7 +15,15 @@ from ..calibration.poses import DEFAULT_MARGIN, checked_region
 from ..config.kinematic import load_kinematic_config
 from ..errors import DextarError
 from ..geometry import WORKING_MODES, canonical_working_mode
-from .base import Result, config_argument, json_flag, out_file, write_or_hand_back
+from .base import (
+    Result,
+    config_argument,
+    json_flag,
+    note_lines,
+    noted,
+    out_file,
+    write_or_hand_back,
+)
 
 if TYPE_CHECKING:  # the writers, imported when the command runs (start-up: dextar._lazy)
     from ..output import calibration as written
@@ -80,12 +88,15 @@ def run(args: argparse.Namespace) -> Result:
     """Choose the poses (:func:`dextar.jobs.poses`), write them, word the observability."""
     target = out_file(args.out, ".csv")
     kc = load_kinematic_config(args.config)
-    sel = jobs.poses(kc, args.count, modes=args.modes or WORKING_MODES, region_mm=args.region,
-                     margin=DEFAULT_MARGIN if args.margin is None else args.margin,
-                     seed=args.seed, frame=args.frame)
+    with noted(kc):
+        sel = jobs.poses(kc, args.count, modes=args.modes or WORKING_MODES,
+                         region_mm=args.region,
+                         margin=DEFAULT_MARGIN if args.margin is None else args.margin,
+                         seed=args.seed, frame=args.frame)
     where, data = write_or_hand_back(target, written.poses_csv(sel))
     payload = written.poses_payload(sel, where=where, config=args.config or "",
                                     frame=args.frame,
                                     encoder_offset_deg=kc.robot.encoder_offset_deg)
-    return Result(payload, written.poses_text(sel, where), written.poses_warnings(sel), data,
+    return Result(payload, written.poses_text(sel, where),
+                  note_lines("poses", kc) + written.poses_warnings(sel), data,
                   code=1 if sel.missing_modes else 0)

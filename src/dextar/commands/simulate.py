@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 
 from .. import jobs
 from .._lazy import lazy_module
+from ..simulation.control import FOLLOWED, INCOMPLETE, LEFT_TOLERANCE, SINGULARITY_MET
 from .base import Result, config_argument, into_directory, load, note_lines, noted, shown
 
 if TYPE_CHECKING:  # the writers, imported when the command runs (start-up: dextar._lazy)
@@ -32,21 +33,24 @@ def run(args: argparse.Namespace) -> Result:
     report = written.write_tracking(args.out, tr, res, sc.units, c, force=args.force)
     warnings = note_lines("simulate", sc)
     saturated = report["saturated_fraction"]
-    if res.status == 1:
+    why = (f"; the torque limit {c['torque_limit_nm']:g} N m saturated a motor during "
+           f"{saturated:.1%} of the motion simulated" if saturated > 0 else "")
+    if res.status == SINGULARITY_MET:
         warnings.append(f"dextar simulate: the controlled robot left the motion at "
                         f"{sc.units.time_text(res.t[-1])} of {tr.t[-1] * sc.units.time_s:.6g} "
-                        f"s ({res.message}) after the torque limit saturated a motor during "
-                        f"{saturated:.1%} of it; the files hold the motion up to there")
-    elif res.status == 2:
-        why = (f"; the torque limit {c['torque_limit_nm']:g} N m saturated a motor during "
-               f"{saturated:.1%} of the motion" if saturated > 0 else "")
+                        f"s ({res.message}){why}; the files hold the motion up to there")
+    elif res.status == LEFT_TOLERANCE:
         warnings.append(f"dextar simulate: not followed: {res.message}{why}")
+    elif res.status == INCOMPLETE:
+        warnings.append(f"dextar simulate: simulation incomplete: {res.message}{why}; the "
+                        "files hold the motion up to there")
     elif saturated > 0:
         warnings.append(f"dextar simulate: warning: the torque limit {c['torque_limit_nm']:g} "
                         f"N m saturates a motor during {saturated:.1%} of the motion; it was "
                         f"followed within {report['tolerance_mm']:.4g} mm all the same")
     files = ", ".join(shown(args.out, n) for n in written.TRACKING_FILES)
-    verdict = "followed" if res.status == 0 else "NOT FOLLOWED"
+    verdict = {FOLLOWED: "followed", INCOMPLETE: "INCOMPLETE (stopped by its step budget)"
+               }.get(res.status, "NOT FOLLOWED")
     return Result(report, f"wrote {files}: {verdict} (tolerance {report['tolerance_mm']:.4g} "
                   f"mm): max task error {report['max_task_error_mm']:.4g} mm, max joint error "
                   f"{report['max_joint_error_deg']:.4g} deg, torque saturated "

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 from pathlib import Path as FilePath
 from typing import Any, ClassVar
 
+from ..calibration.data import check_readings_deg
 from ..calibration.model import KinematicModel
 from ..calibration.poses import checked_region
 from ..errors import ConfigError, DextarError
@@ -18,6 +19,33 @@ from ..geometry import DEXTAR_MM, FiveBar, canonical_working_mode, parse_assembl
 from ..params import Param, read_params
 from .base import TABLES, Table
 from .toml import check_tables, read_config
+
+#: A robot whose longest length is below this (mm) looks written in metres: the DexTAR in
+#: metres is 0.087 at most, the smallest five-bars built are tens of millimetres.
+METRES_LIKE_MM = 1.0
+
+#: Where a robot-only config of no file comes from.
+KINEMATIC_DEFAULT_SOURCE = "defaults (the DexTAR)"
+
+
+def config_notes(source: str | None, doc: Mapping[str, Any], geometry_mm: FiveBar,
+                 defaults: str) -> tuple[str, ...]:
+    """What the user may not have meant in a config, in words: every command that reads a
+    config says them on stderr and beside its error (:class:`KinematicConfig` and
+    :class:`~dextar.config.Scenario` alike). A config file with no table (``source``, None
+    without a file) gives ``defaults`` (words: what the command then uses); a robot whose
+    lengths are all below :data:`METRES_LIKE_MM` looks written in metres."""
+    out = []
+    if not doc and source is not None:
+        out.append(f"{source} has no table: {defaults}")
+    g = geometry_mm
+    longest = max(g.l1, g.l2, g.L1, g.L2, g.d)
+    if longest < METRES_LIKE_MM:
+        shown = ", ".join(f"{k} = {getattr(g, k):g}" for k in ("l1", "l2", "L1", "L2", "d"))
+        out.append(f"the robot's lengths ({shown}) are read in mm: its longest, "
+                   f"{longest:g} mm, looks like metres ({longest:g} m = "
+                   f"{longest * 1e3:g} mm); config lengths are in mm")
+    return tuple(out)
 
 
 @dataclass(frozen=True)
@@ -77,7 +105,10 @@ class RobotTable(Table):
                    t.get("encoder_counts"))
 
     def geometric_deg(self, readings_deg: tuple[float, float]) -> tuple[float, float]:
-        """Geometric angles (deg) of encoder readings (deg): reading + offset."""
+        """Geometric angles (deg) of encoder readings (deg): reading + offset; readings that
+        are NaN, infinite or beyond degrees' range are refused by name
+        (:func:`~dextar.calibration.data.check_readings_deg`)."""
+        check_readings_deg(readings_deg)
         a, b = self.encoder_offset_deg
         return (readings_deg[0] + a, readings_deg[1] + b)
 
@@ -169,7 +200,17 @@ class KinematicConfig:
     instrument: InstrumentTable = field(default_factory=InstrumentTable)
     has_instrument: bool = False
     doc: Mapping[str, Any] = field(default_factory=dict)
-    source: str = "defaults (the DexTAR)"
+    source: str = KINEMATIC_DEFAULT_SOURCE
+
+    @property
+    def notes(self) -> tuple[str, ...]:
+        """What the user may not have meant (:func:`config_notes`): a file with no table (the
+        robot is then the DexTAR), a robot that looks written in metres."""
+        g = DEXTAR_MM
+        return config_notes(None if self.source == KINEMATIC_DEFAULT_SOURCE else self.source,
+                            self.doc, self.robot.geometry_mm,
+                            f"the robot is the DexTAR (l1 = l2 = {g.l1:g}, L1 = L2 = "
+                            f"{g.L1:g}, d = {g.d:g} mm)")
 
     @property
     def model(self) -> KinematicModel:

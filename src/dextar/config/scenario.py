@@ -8,6 +8,7 @@ happens here, once, as the objects are built.
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from functools import cached_property
@@ -35,7 +36,7 @@ from ..units import SI, Units
 from .base import TABLES, Table
 from .design import DesignTable
 from .design_task import design_task
-from .kinematic import InstrumentTable, RobotTable, kinematic_model
+from .kinematic import InstrumentTable, RobotTable, config_notes, kinematic_model
 from .program import ProgramTable, read_moves
 from .tables import (
     ControlTable,
@@ -57,10 +58,6 @@ T = TypeVar("T", bound=Table)
 #: Where a scenario of no file comes from.
 DEFAULT_SOURCE = "defaults (the paper's example)"
 
-#: A robot whose longest length is below this (mm) looks written in metres: the DexTAR in
-#: metres is 0.087 at most, the smallest five-bars built are tens of millimetres.
-METRES_LIKE_MM = 1.0
-
 
 @dataclass(frozen=True)
 class Scenario:
@@ -81,7 +78,7 @@ class Scenario:
     """
 
     tables: Mapping[str, Table]
-    source: str = "defaults (the paper's example)"  # DEFAULT_SOURCE
+    source: str = DEFAULT_SOURCE
     moves: tuple[Move, ...] = ()
     doc: Mapping[str, Any] = field(default_factory=dict)
     text: bytes = b""
@@ -94,20 +91,13 @@ class Scenario:
     @property
     def notes(self) -> tuple[str, ...]:
         """What the user may not have meant, in words (each command says them on stderr and
-        beside its error): a config file with no table runs the paper's example; a robot
-        whose lengths are all below :data:`METRES_LIKE_MM` looks written in metres."""
-        out = []
-        if not self.doc and self.source != DEFAULT_SOURCE:
-            out.append(f"{self.source} has no table: this runs the paper's example (the "
-                       "DexTAR, the 120 mm semicircle, the optimal law)")
-        g = self.robot_table.geometry_mm
-        longest = max(g.l1, g.l2, g.L1, g.L2, g.d)
-        if longest < METRES_LIKE_MM:
-            shown = ", ".join(f"{k} = {getattr(g, k):g}" for k in ("l1", "l2", "L1", "L2", "d"))
-            out.append(f"the robot's lengths ({shown}) are read in mm: its longest, "
-                       f"{longest:g} mm, looks like metres ({longest:g} m = "
-                       f"{longest * 1e3:g} mm); config lengths are in mm")
-        return tuple(out)
+        beside its error; computed by :func:`~dextar.config.kinematic.config_notes`): a
+        config file with no table runs the paper's example; a robot that looks written in
+        metres."""
+        return config_notes(None if self.source == DEFAULT_SOURCE else self.source, self.doc,
+                            self.robot_table.geometry_mm,
+                            "this runs the paper's example (the DexTAR, the 120 mm semicircle, "
+                            "the optimal law)")
 
     def _get(self, cls: type[T]) -> T:
         t = self.tables[cls.NAME]
@@ -408,15 +398,37 @@ def scenario_from_dict(doc: Mapping[str, Any], *, source: str | None = None,
 MODEL_TABLES = ("robot", "inertia", "friction", "gravity")
 
 
+#: The first line dextar writes at the top of a model it fitted to data (``identified.toml``,
+#: and ``calibrated.toml`` alike): ``# identified by dextar from DATA (STATUS: ...)``; the
+#: status is the verb when the fit succeeded.
+_FITTED_BY = re.compile(r"# (?P<verb>\w+) by dextar from (?P<data>.*?) \((?P<status>[^():]+): ")
+
+
+def check_model_status(model: str | FilePath, text: bytes) -> None:
+    """Refuse (:class:`ConfigError`) a model file whose first line says dextar's fit of it did
+    not succeed (``# identified by dextar from DATA (poor fit: ...)``): its status names
+    what to fix, and the user may delete that line to use the model anyway."""
+    first = text.split(b"\n", 1)[0].decode("utf-8", errors="replace").rstrip("\r")
+    m = _FITTED_BY.match(first)
+    if m is None or m["status"] == m["verb"]:
+        return
+    raise ConfigError(f"--model {str(model)!r} is a model dextar {m['verb']} from {m['data']} "
+                      f"with the status {m['status']!r}, not {m['verb']!r} (its first line "
+                      "gives the reasons): it is not used. Fit it again from better data, or "
+                      "delete that first line to use it anyway")
+
+
 def load_scenario(path: str | FilePath | None = None, *,
                   model: str | FilePath | None = None) -> Scenario:
     """Read a config file (or none: the paper's example) into a :class:`Scenario`; the file
     is read once. ``model``: a model file whose robot, inertia, friction and gravity replace
-    the config's (its other tables kept): what ``--model identified.toml`` does."""
+    the config's (its other tables kept): what ``--model identified.toml`` does; a model file
+    whose first line says its fit did not succeed is refused (:func:`check_model_status`)."""
     doc, text = ({}, b"") if path is None else read_config(path)
     source = None if path is None else str(path)
     if model is not None:
         mdoc, mtext = read_config(model)
+        check_model_status(model, mtext)
         missing = [t for t in ("robot", "inertia") if t not in mdoc]
         if missing:
             raise ConfigError(f"--model {str(model)!r} has no [{missing[0]}] table: a model "

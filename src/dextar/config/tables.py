@@ -124,12 +124,18 @@ class InertiaTable(Table):
     PARAMS: ClassVar[dict[str, Param]] = {
         "effector_mass": Param("number", "kg", 1.0, "end-effector mass", positive=True),
         "payload": Param("number", "kg", 0.0, "payload at P", minimum=0.0),
-        "proximal_mass": _pair("kg", "proximal rods' masses", None, minimum=0.0),
-        "distal_mass": _pair("kg", "distal rods' masses", None, minimum=0.0),
-        "proximal_com": _pair("mm", "proximal centres of mass from the joint"),
-        "distal_com": _pair("mm", "distal centres of mass from the elbow"),
-        "proximal_inertia": _pair("", "proximal inertias about the com, kg mm^2", minimum=0.0),
-        "distal_inertia": _pair("", "distal inertias about the com, kg mm^2", minimum=0.0),
+        "proximal_mass": _pair("kg", "proximal rods' masses (default 0.08 x effector_mass)",
+                               None, minimum=0.0),
+        "distal_mass": _pair("kg", "distal rods' masses (default 0.1 x effector_mass)", None,
+                             minimum=0.0),
+        "proximal_com": _pair("mm", "proximal centres of mass from the joint (default: half "
+                              "the rod)"),
+        "distal_com": _pair("mm", "distal centres of mass from the elbow (default: half the "
+                            "rod)"),
+        "proximal_inertia": _pair("", "proximal inertias about the com, kg mm^2 (default: a "
+                                  "uniform rod, m l^2 / 12)", minimum=0.0),
+        "distal_inertia": _pair("", "distal inertias about the com, kg mm^2 (default: a "
+                                "uniform rod, m L^2 / 12)", minimum=0.0),
         "rotor_inertia": _pair("", "rotor inertias, kg mm^2", 0.0, minimum=0.0),
     }
 
@@ -356,7 +362,8 @@ class MotorsTable(Table):
 
     NAME: ClassVar[str] = "motors"
     PARAMS: ClassVar[dict[str, Param]] = {
-        "peak_torque": _pair("N m", "peak torques", None, positive=True),
+        "peak_torque": _pair("N m", "peak torques (required when the table is given)", None,
+                             positive=True),
         "rms_torque": _pair("N m", "continuous (RMS) torque ratings", None, positive=True),
         "max_speed_rpm": _pair("", "maximum speeds, rpm", None, positive=True),
         "knee_speed_rpm": _pair("", "end of full torque, rpm (< max_speed_rpm)", None,

@@ -7,6 +7,7 @@ from .exact import (
     Model,
     Reactions,
     TorqueResult,
+    accelerations,
     bias_forces,
     gravity_torques,
     inverse_dynamics,
@@ -28,6 +29,6 @@ __getattr__, __dir__ = lazy_attributes(__name__, dict.fromkeys(
     ("RobotAlongJointLine", "RobotAlongPath", "time_optimal_law"), ".along_path"))
 
 
-__all__ = ["Inertia", "Model", "Reactions", "Rod", "bias_forces", "gravity_torques",
+__all__ = ["Inertia", "Model", "Reactions", "Rod", "accelerations", "bias_forces", "gravity_torques",
            "inverse_dynamics", "joint_reactions", "kinetic_energy", "mass_matrix",
            "paper_inertia", "state_dynamics", "TorqueResult", "trajectory_torques", "RobotAlongJointLine", "RobotAlongPath", "time_optimal_law"]

@@ -10,7 +10,7 @@ import numpy as np
 from .._arrays import Array
 from .._lazy import lazy_module
 from ..errors import ConvergenceError, ParameterError, SingularityError
-from .exact import Model, inverse_dynamics, mass_matrix, state_dynamics
+from .exact import Model, accelerations, state_dynamics
 
 integrate = lazy_module("scipy.integrate")
 interpolate = lazy_module("scipy.interpolate")
@@ -120,7 +120,6 @@ def forward_dynamics(model: Model, torque: TorqueFunction, q0: object, dq0: obje
         raise ConvergenceError(f"forward dynamics failed at t = {sol.t[-1]:.6g}: {sol.message}")
     q, dq = sol.y[:2].T, sol.y[2:].T
     tau = np.array([torque(ti, qi, dqi) for ti, qi, dqi in zip(sol.t, q, dq, strict=True)])
-    h = inverse_dynamics(model, q, dq, np.zeros_like(q), t=sol.t)
-    ddq = np.linalg.solve(mass_matrix(model, q), (tau - h)[..., None])[..., 0]
+    ddq = accelerations(model, q, dq, tau, t=sol.t)
     return ForwardResult(t=sol.t, q=q, dq=dq, tau=tau, status=int(sol.status),
                          message=str(sol.message), ddq=ddq, nfev=nfev)

@@ -14,7 +14,7 @@ from ..identification.coverage import JointRegion
 from ..identification.data import MotionData, read_motion_csv
 from ..identification.excite import ExcitationResult, design_excitation
 from ..identification.fit import IdentificationResult, identify
-from ..output.identification import IdentificationReport
+from ..output.identification import IdentificationReport, model_comment
 
 
 def task_motion(path: str, sc: Scenario) -> tuple[Array, Array, Array]:
@@ -88,7 +88,7 @@ def identify_model(data_path: str, sc: Scenario, *, config: str | None = None,
                    cutoff_hz: float | None = None, task: str | None = None,
                    validate: str | None = None) -> Identified:
     """Identify the scenario's robot (its prior model, SI) from the CSV ``data_path``; the
-    prediction uncertainty along the task file ``task`` (default: the data's envelope); with
+    prediction uncertainty along the task file ``task`` (default: the recorded motion); with
     ``validate`` (a second recording) its prediction measured. ``config`` names the config
     in the outputs."""
     if cutoff_hz is not None and not (math.isfinite(cutoff_hz) and cutoff_hz > 0):
@@ -101,9 +101,5 @@ def identify_model(data_path: str, sc: Scenario, *, config: str | None = None,
                    reference_name=f"the task {task}")
     rep = IdentificationReport.of(res, data, model, sc.mode, data_path, config, vdata,
                                   validate)
-    comment = (f"identified by dextar from {data_path} ({res.method}, condition number "
-               f"{res.condition_number:.4g})\nbase parameters reproduced exactly; the split "
-               "between rods, rotor and payload that the torques cannot see follows "
-               f"{config or 'the defaults'}")
-    return Identified(res, rep, data, sc.model_file(sc.robot_mm, sc.mode, res.inertia,
-                                                    comment))
+    return Identified(res, rep, data, sc.model_file(
+        sc.robot_mm, sc.mode, res.inertia, model_comment(res, data_path, config)))

@@ -79,10 +79,12 @@ class Simulated:
         The planned motion.
     result : ControlResult
         The plant's motion, torques, errors and the verdict (``status`` 0: followed within
-        the tolerance; 1: it met a singularity or the integration stopped; 2: it left the
-        tolerance).
+        the tolerance; 1: it met a singularity; 2: it left the tolerance; 3: incomplete,
+        the integration stopped by its step budget).
     control : dict
-        The controller's settings in run units (``[control]``).
+        The controller's settings in run units (``[control]``), the tolerance the one used
+        (``tolerance``, run length unit, and ``tolerance_mm``: the default's value where the
+        config gives none).
     """
 
     scenario: Scenario
@@ -104,6 +106,9 @@ def simulate(sc: Scenario) -> Simulated:
         natural_frequency=c["natural_frequency"], damping=c["damping"],
         torque_limit=c["torque_limit"], initial_error=c["initial_error"],
         tolerance=c["tolerance"], time_s=sc.units.time_s, length_mm=sc.units.length_mm)
+    used = res.tolerance if res.tolerance is not None else c["tolerance"]
+    c = {**c, "tolerance": used,
+         "tolerance_mm": None if used is None else used * sc.units.length_mm}
     return Simulated(sc, tr, res, c)
 
 

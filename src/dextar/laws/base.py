@@ -168,7 +168,10 @@ class TrapezoidalLaw(Law):
                 raise ParameterError(f"trapezoid: distance {S:.6g} cannot be covered in "
                                      f"duration {T:.6g} with amax {a:.6g} (needs at least "
                                      f"{tmin:.6g})")
-            v = 0.5 * (a * T - math.sqrt(disc))
+            # the smaller root of v^2 - a T v + a S = 0, without the cancellation of
+            # (a T - sqrt(disc)) / 2, which gave v = 0 (no motion at all) where a T^2 >> S
+            # (a 1e9 s trapezoid over 123 mm: found by the long-motion fuzz shape)
+            v = 2.0 * a * S / (a * T + math.sqrt(disc))
             if v > vm * (1 + 1e-12):
                 raise ParameterError(f"trapezoid: duration {T:.6g} needs cruise speed {v:.6g} "
                                      f"above vmax {vm:.6g}")

@@ -597,7 +597,8 @@ class CalibrationRun:
         nominal robot assumed."""
         res = self.result
         if self.outliers:  # one line: the rows, what to do, where the diagnosis is
-            return [f"dextar calibrate: {self.problem} (--robust soft_l1); the fit with them "
+            them = "it" if len(self.outliers) == 1 else "them"
+            return [f"dextar calibrate: {self.problem} (--robust soft_l1); the fit with {them} "
                     f"kept is in {self.out} (no calibrated.toml)"]
         out: list[str] = []
         if res.status != 0:

@@ -194,7 +194,9 @@ def animation_gif(an: Analysis, frames: int = 41) -> bytes:
     """A GIF of the robot following the path, played in real time: at most ``frames``
     poses, one every whole number of centiseconds (a GIF's clock; 20 ms at least, as
     browsers play shorter delays slowly), the last at the end of the motion, then a pause
-    of :data:`ANIMATION_PAUSE_MS` before it loops.
+    of :data:`ANIMATION_PAUSE_MS` before it loops. A motion longer than ``frames - 1``
+    delays of :data:`MAX_FRAME_MS` plays sped up, said in the title
+    (:func:`animation_pace`).
 
     The still part (axes, path, pivots, title) is drawn once; each frame restores it and
     draws only the arm and the time over it (blitting), and the frames share one palette.
@@ -218,13 +220,14 @@ def animation_gif(an: Analysis, frames: int = 41) -> bytes:
     ax.set_xlabel(f"x ({length})", fontsize=8)
     ax.set_ylabel(f"y ({length})", fontsize=8)
     ax.tick_params(labelsize=7)
-    ax.set_title(f"The robot following the path ({an.law.name} law), in real time",
-                 fontsize=9)
+    times_s = tr.t * an.inputs.units.time_s
+    index, durations = _real_time_frames(times_s - times_s[0], frames)
+    pace = animation_pace(an, frames)
+    ax.set_title(f"The robot following the path ({an.law.name} law),"
+                 f"{' ' if pace <= 1.0 else chr(10)}{pace_words(pace, short=True)}", fontsize=9)
     tight_layout(fig)
     canvas.draw()  # type: ignore[no-untyped-call]  # matplotlib's Agg canvas is untyped
     still = canvas.copy_from_bbox(fig.bbox)  # type: ignore[no-untyped-call]  # the same
-    times_s = tr.t * an.inputs.units.time_s
-    index, durations = _real_time_frames(times_s - times_s[0], frames)
     packed = []
     for i in index:
         canvas.restore_region(still)  # type: ignore[no-untyped-call]  # the same
@@ -246,9 +249,34 @@ def animation_gif(an: Analysis, frames: int = 41) -> bytes:
 ANIMATION_PAUSE_MS = 600
 #: The shortest delay between frames (ms): browsers play shorter GIF delays at 100 ms.
 MIN_FRAME_MS = 20
-#: The longest (ms): a GIF's delay is at most 65535 centiseconds; longer motions get more
-#: frames than asked.
+#: The longest (ms): a GIF's delay is at most 65535 centiseconds. A motion longer than
+#: ``frames - 1`` of them plays sped up (:func:`animation_pace`), never with more frames than
+#: asked (a 1e9 s motion had asked for 1.7e7 frames).
 MAX_FRAME_MS = 60_000
+
+
+def _speedup(total_ms: float, frames: int) -> float:
+    """How many times faster than real time a motion of ``total_ms`` plays in at most
+    ``frames`` frames (1: real time)."""
+    return max(1.0, total_ms / (max(frames - 1, 1) * MAX_FRAME_MS))
+
+
+def animation_pace(an: Analysis, frames: int) -> float:
+    """How many times faster than real time the run's animation of at most ``frames``
+    frames plays (1: real time; more for a motion longer than ``frames - 1`` delays of
+    :data:`MAX_FRAME_MS`)."""
+    t = an.trajectory.t * an.inputs.units.time_s
+    return _speedup(1e3 * float(t[-1] - t[0]), frames)
+
+
+def pace_words(speedup: float, *, short: bool = False) -> str:
+    """The animation's pace in words (``short``: its title; else the report's caption)."""
+    if speedup <= 1.0:
+        return "in real time"
+    if short:
+        return f"sped up {speedup:.3g} times (not real time)"
+    return (f"sped up {speedup:.3g} times (not real time: a GIF frame lasts at most "
+            f"{MAX_FRAME_MS / 1e3:g} s)")
 
 
 def _real_time_frames(t_s: Array, frames: int) -> tuple[Array, list[int]]:
@@ -256,8 +284,15 @@ def _real_time_frames(t_s: Array, frames: int) -> tuple[Array, list[int]]:
     them) and each frame's delay in ms, so that the motion ``t_s`` (seconds from 0, rising)
     plays in real time: a frame every ``step`` ms (whole centiseconds, from
     :data:`MIN_FRAME_MS` to :data:`MAX_FRAME_MS`), the last one at the motion's end within
-    5 ms (a motion shorter than :data:`MIN_FRAME_MS` plays in that time)."""
+    5 ms (a motion shorter than :data:`MIN_FRAME_MS` plays in that time). A motion longer
+    than ``frames - 1`` delays of :data:`MAX_FRAME_MS` plays sped up (:func:`_speedup`):
+    ``frames`` frames evenly spaced in time, each shown :data:`MAX_FRAME_MS`."""
     total_ms = 1e3 * float(t_s[-1])
+    speedup = _speedup(total_ms, frames)
+    if speedup > 1.0:
+        at = np.linspace(0.0, total_ms, max(frames, 2))
+        index = np.minimum(np.searchsorted(t_s * 1e3, at - 1e-9 * total_ms), len(t_s) - 1)
+        return index, [MAX_FRAME_MS] * (len(at) - 1) + [ANIMATION_PAUSE_MS]
     step = min(max(MIN_FRAME_MS, 10 * math.ceil(total_ms / max(frames - 1, 1) / 10)),
                MAX_FRAME_MS)
     at = np.arange(0.0, total_ms, step)

@@ -19,11 +19,10 @@ from ..dynamics import Model, inverse_dynamics
 from ..dynamics.regressor import NAMES
 from ..identification.data import MotionData
 from ..identification.excite import (
-    ACCELERATION_FLOOR,
     COND_CEILING,
-    RANGE_FLOOR,
-    SPEED_FLOOR,
+    REFERENCE_WORDS,
     ExcitationResult,
+    coverage_floors,
 )
 from ..identification.fit import (
     RESIDUAL_FACTOR,
@@ -78,23 +77,52 @@ def excitation_payload(res: ExcitationResult, harmonics: int, base_hz: float, sa
 
 
 def _coverage(res: ExcitationResult) -> dict[str, Any]:
-    """The excitation's coverage against its floors (JSON)."""
+    """The excitation's coverage against its advisory floors (JSON)."""
     c = res.coverage
     assert c is not None
-    return {"floors": {"range": RANGE_FLOOR, "speed": SPEED_FLOOR,
-                       "acceleration": ACCELERATION_FLOOR, "condition_number": COND_CEILING},
+    ref = c.reference
+    return {"floors": {**coverage_floors(), "condition_number": COND_CEILING},
+            "advisory": True,
             "range_deg": [float(v) for v in np.degrees(c.range)],
-            "allowed_range_deg": [float(v) for v in np.degrees(c.allowed.range)],
+            "reference_range_deg": [float(v) for v in np.degrees(ref.range)],
             "peak_speed_rad_s": [float(v) for v in c.speed],
-            "allowed_speed_rad_s": [float(v) for v in c.allowed.speed],
+            "reference_speed_rad_s": [float(v) for v in ref.speed],
+            "rated_speed_rad_s": [_finite(v) for v in ref.rated_speed],
+            "speed_of_rated": [_finite(v) for v in c.rated_fraction],
             "peak_acceleration_rad_s2": [float(v) for v in c.acceleration],
-            "allowed_acceleration_rad_s2": [float(v) for v in c.allowed.acceleration],
+            "reference_acceleration_rad_s2": [float(v) for v in ref.acceleration],
             "fractions": {k: [float(x) for x in v] for k, v in c.fractions.items()},
             "met": c.met, "missed": list(c.missed),
-            "note": "each motor's range, peak speed and peak acceleration over what the "
-                    "task region (or the free range from the rest pose) and the motors "
-                    "allow; a design that misses a floor is made again from new "
-                    "deterministic starts"}
+            "note": f"each motor's range, peak speed and peak acceleration over a reference "
+                    f"(the range: {ref.range_of}; the speed and acceleration: the top "
+                    "harmonic sweeping that range, capped by the motors), which a motion of "
+                    "both motors may exceed; the peak speed also over the motors' rated "
+                    "speed. The floors are advisory (a design below them is made again from "
+                    "new deterministic starts, then kept with a warning): identify's verdict "
+                    "tells whether the data fix the model"}
+
+
+def coverage_text(res: ExcitationResult, task: bool) -> str:
+    """The excitation's coverage in words (``dextar excite``'s summary)."""
+    c = res.coverage
+    assert c is not None
+    fr, ref = c.fractions, c.reference
+
+    def two(x: Array, fmt: str) -> str:
+        return " / ".join(format(float(v), fmt) for v in x)
+
+    rated = ("" if not np.isfinite(c.rated_fraction).all() else
+             f"; {two(100 * c.rated_fraction, '.3g')} % of the rated "
+             f"{two(ref.rated_speed, '.3g')} rad/s")
+    floors = " / ".join(f"{100 * v:g}" for v in coverage_floors().values())
+    return (f"coverage, motor A / D: range {two(np.degrees(c.range), '.3g')} deg "
+            f"({two(100 * fr['range'], '.3g')} % of {'the task' if task else 'each motor'}'s "
+            f"{'range' if task else 'free range from the rest pose, the other at rest'}), "
+            f"peak speed {two(c.speed, '.3g')} rad/s ({two(100 * fr['speed'], '.3g')} % of "
+            f"{REFERENCE_WORDS['speed']}{rated}), peak acceleration "
+            f"{two(c.acceleration, '.3g')} rad/s^2 ({two(100 * fr['acceleration'], '.3g')} % "
+            f"of {REFERENCE_WORDS['acceleration']}); advisory floors {floors} %, "
+            f"{res.attempts} design{'s' if res.attempts > 1 else ''}")
 
 
 def _finite(v: float) -> float | None:
@@ -145,7 +173,11 @@ class IdentificationReport:
             "prediction_uncertainty_limit": UNCERTAINTY_LIMIT,
             "prediction_uncertainty_note": (
                 "RMS standard deviation of the torques predicted along the reference over "
-                "their RMS, per motor (the parameters' covariance propagated)"),
+                "their RMS, per motor (the parameters' covariance propagated; 1 sigma). "
+                "Without --task the reference is the recorded motion, its poses and speeds "
+                "named: the verdict covers motions like it; elsewhere a prediction "
+                "extrapolates (--task measures the uncertainty along the motion the model "
+                "is for, --validate names the samples of another motion outside)"),
             "reasons": list(res.reasons),
             "unphysical_distance_sigmas": res.unphysical_distance,
             "poorly_determined": list(res.poorly_determined),
@@ -202,6 +234,25 @@ class IdentificationReport:
                          f"{s['validation_inside_fraction']:.1%} of its samples inside the "
                          "excited region")
         return lines
+
+
+def model_comment(res: IdentificationResult, data_path: str, config: str | None) -> str:
+    """The comment at the top of ``identified.toml``: its first line names the status as
+    ``dextar calibrate``'s ``calibrated.toml`` does, ``identified by dextar from DATA
+    (STATUS: ...)``, with every reason when the status is not "identified" (``--model``
+    refuses such a file: :func:`dextar.config.scenario.load_scenario`)."""
+    if res.success:
+        what = (f"identified: {res.method}, condition number {res.condition_number:.4g}; "
+                f"predicted torques along {res.reference} uncertain by "
+                f"{100 * res.uncertainty[0]:.3g} / {100 * res.uncertainty[1]:.3g} % of their "
+                "RMS, motor A / D")
+    else:
+        said = res.message.replace("\n", " ")  # every reason, the worst first
+        what = (said if said.startswith(f"{res.status_text}:")
+                else f"{res.status_text}: {said}") + "; dextar refuses this file as --model"
+    return (f"identified by dextar from {data_path} ({what})\nbase parameters reproduced "
+            "exactly; the split between rods, rotor and payload that the torques cannot see "
+            f"follows {config or 'the defaults'}")
 
 
 #: Every file an identification may write.

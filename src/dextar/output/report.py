@@ -34,8 +34,9 @@ def _title(s: dict[str, Any]) -> str:
 
 
 def render_report(an: Analysis, s: dict[str, Any], pngs: dict[str, bytes],
-                  gif: bytes | None = None) -> str:
-    """The run's report as one self-contained HTML page (figures and animation inline)."""
+                  gif: bytes | None = None, pace: str = "in real time") -> str:
+    """The run's report as one self-contained HTML page (figures and animation inline;
+    ``pace``: how the animation plays, in words)."""
     u = s["units"]
     intro = (f"<p>Config: {html.escape(str(s['config']))}. dextar {s['dextar_version']}. "
              f"Units: length {u['length_unit']}, mass {u['mass_unit']}, time "
@@ -45,7 +46,7 @@ def render_report(an: Analysis, s: dict[str, Any], pngs: dict[str, bytes],
              f"{u['time_unit_in_s']:g} s.</p>")
     body = [intro, "<h2>Parameters</h2>", table(_parameters(s)), "<h2>Results</h2>",
             table(_results(s)), _claims(s), "<h2>Validation</h2>", table(_validation(s)),
-            "<h2>Figures</h2>", _figures(s, pngs, gif), "<h2>Assumptions</h2><ul>",
+            "<h2>Figures</h2>", _figures(s, pngs, gif, pace), "<h2>Assumptions</h2><ul>",
             *(f"<li>{html.escape(a)}</li>" for a in s["assumptions"]), "</ul>"]
     return page(_title(s), "".join(body))
 
@@ -157,12 +158,13 @@ def _num(v: float | None) -> str:
     return "-" if v is None else f"{v:.3g}"
 
 
-def _figures(s: dict[str, Any], pngs: dict[str, bytes], gif: bytes | None) -> str:
+def _figures(s: dict[str, Any], pngs: dict[str, bytes], gif: bytes | None, pace: str
+             ) -> str:
     law = s["law"]["type"]
     parts = [image(data, name, _caption(name, law)) for name, data in pngs.items()]
     if gif is not None:
         parts.append(image(gif, "animation",
-                           f"The robot following the path ({law} law), in real time.",
+                           f"The robot following the path ({law} law), {html.escape(pace)}.",
                            mime="image/gif"))
     return "".join(parts)
 

@@ -107,7 +107,8 @@ def write_run(od: OutputDir, an: Analysis, uniform: Trajectory, summary: dict[st
     summary["files"] = sorted(set(od.written) | {"summary.json", "report.html"})
     stage("report.html", lambda: od.write_text("report.html",
                                                _report(an, summary, pngs,
-                                                       files.get("animation.gif"))))
+                                                       files.get("animation.gif"),
+                                                       animation_frames)))
     od.write_text("summary.json", json.dumps(summary, indent=2, allow_nan=False) + "\n")
 
 
@@ -145,5 +146,6 @@ def _figures(an: Analysis, uniform: Any, wanted: tuple[str, ...], animation_fram
 
 
 def _report(an: Analysis, summary: dict[str, Any], pngs: dict[str, bytes],
-            gif: bytes | None) -> str:
-    return render_report(an, summary, pngs, gif)
+            gif: bytes | None, animation_frames: int) -> str:
+    return render_report(an, summary, pngs, gif,
+                         fg.pace_words(fg.animation_pace(an, animation_frames)))

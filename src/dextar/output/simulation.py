@@ -34,7 +34,7 @@ def write_tracking(out: str, tr: Trajectory, res: ControlResult, units: Units,
     left = res.left_at
     report = {"units": units.describe(), "control": dict(control),
               "status": res.status, "message": res.message,
-              "followed": res.status == 0, "tolerance_mm": tol_mm,
+              "followed": res.status == 0, "complete": res.complete, "tolerance_mm": tol_mm,
               "tolerance_note": "the task error within which the motion is followed: "
                                 "[control].tolerance_mm, default 3 % of the robot's reach",
               "left_tolerance_at_s": None if left is None else float(res.t[left]

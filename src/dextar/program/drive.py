@@ -181,16 +181,19 @@ def pvt_points(res: ProgramResult, drive: DriveUnits) -> PvtPoints:
     idx = np.arange(0, len(t), step)
     pos = np.round(drive.counts(res.q[idx]))
     vel = res.dq[idx] * drive.counts_per_rad
-    tk = t[idx]
+    # every time from its whole number of servo ticks, as the setpoints' own (k / rate): a
+    # sum of rounded times had written 1.7080000000000002 s for the 7 ms period's 1.708 s
+    rate = res.servo_rate_hz or 1.0 / tick
     planned = drive.counts(res.q)
-    ts = t
+    ticks = idx
     if idx[-1] != len(t) - 1:  # one period more: the final pose, held at rest
         hold = step - (len(t) - 1 - idx[-1])
-        tk = np.append(tk, tk[-1] + step * tick)
+        ticks = np.append(idx, idx[-1] + step)
         pos = np.vstack([pos, np.round(planned[-1:])])
         vel = np.vstack([vel, np.zeros((1, 2))])
-        ts = np.concatenate([t, t[-1] + tick * np.arange(1, hold + 1)])
         planned = np.vstack([planned, np.repeat(planned[-1:], hold, axis=0)])
+    tk = ticks / rate
+    ts = np.arange(len(planned)) / rate
     err = float(np.abs(hermite(ts, tk, pos, vel) - planned).max()) if len(tk) > 1 else 0.0
     return PvtPoints(tk, pos, vel, err)
 

@@ -16,7 +16,7 @@ Path moves joined by a blend (``blend > 0``) are one motion: each corner is repl
 quintic of continuous curvature that stays within ``blend`` of the corner
 (:mod:`dextar.paths.composite`), and the law of the first move of the chain runs over the
 whole of it, without stopping at the corners. Other moves start and end at rest. A move's law
-is any registered law (:mod:`.laws`). Everything is in SI (m, kg, s, N m, rad).
+is any registered law (:mod:`dextar.program.laws`). Everything is in SI (m, kg, s, N m, rad).
 """
 
 from __future__ import annotations
@@ -223,6 +223,9 @@ class ProgramResult:
         Every move's type, in program order.
     rms_fit : RmsFit, optional
         How the cycle was fitted within the RMS ratings (``cycle = "fit-rms"``).
+    servo_rate_hz : float, optional
+        The setpoints' rate: ``t = arange(n) / servo_rate_hz`` (None: samples of another
+        kind, a sweep's run task).
     """
 
     moves: list[PlannedMove]
@@ -238,6 +241,7 @@ class ProgramResult:
     rms_limit: tuple[float, float] | None = None
     move_types: tuple[str, ...] = ()
     rms_fit: RmsFit | None = None
+    servo_rate_hz: float | None = None
 
     def timeline(self) -> list[MoveTiming]:
         """Every move of the program in order, each move of a blended chain on its own."""
@@ -724,4 +728,4 @@ def _setpoints(ctx: PlanContext, planned: list[PlannedMove], cycle: float,
         ddq[past] = 0.0
     tau = inverse_dynamics(ctx.free_model, q, dq, ddq)
     return ProgramResult(planned, cycle, t, move, P, q, dq, ddq, tau, ctx.motors, rms_limit,
-                         types)
+                         types, servo_rate_hz=rate)

@@ -48,9 +48,12 @@ TRACKING_TOLERANCE = 0.03
 #: of Coulomb friction (its steps held to the friction's time constant); LSODA 3 s, the same
 #: tracking errors to four digits on the examples.
 SOLVER = "LSODA"
-#: Steps after which the plant's integration is stopped (a result: status 1, the files hold
-#: the motion up to there).
+#: Steps after which the plant's integration is stopped: the simulation is incomplete (a
+#: result, :data:`INCOMPLETE`; the files hold the motion up to there).
 MAX_STEPS = 100_000
+
+#: ``ControlResult.status`` of each outcome.
+FOLLOWED, SINGULARITY_MET, LEFT_TOLERANCE, INCOMPLETE = 0, 1, 2, 3
 
 
 def tracking_tolerance(robot: FiveBar) -> float:
@@ -64,8 +67,9 @@ class ControlResult(SimResult):
     """Tracking: a :class:`~dextar.dynamics.forward.SimResult` on the trajectory's time grid
     (``q, dq`` the plant's, ``tau`` the applied, saturated torques; ``status`` 0 when the
     robot followed the motion within the tolerance, 1 when the plant met a singularity and
-    the samples end there, 2 when it left the tolerance; ``message`` saying which and when)
-    with
+    the samples end there, 2 when it left the tolerance, 3 when the simulation is
+    incomplete: its integration stopped after :data:`MAX_STEPS` steps, the robot within the
+    tolerance until then; ``message`` saying which and when) with
 
     Attributes
     ----------
@@ -83,6 +87,9 @@ class ControlResult(SimResult):
         The task error within which the motion counts as followed (run length unit).
     left_at : int or None
         The first sample whose task error exceeds the tolerance.
+    complete : bool
+        The samples reach the motion's end (neither a singularity nor the step budget
+        stopped the integration).
     """
 
     P: Array
@@ -92,6 +99,7 @@ class ControlResult(SimResult):
     torque_limit: float | None = None
     tolerance: float | None = None
     left_at: int | None = None
+    complete: bool = True
 
     def summary(self) -> dict[str, float]:
         """Tracking figures: task errors (run length unit), joint error (rad), saturation."""
@@ -177,7 +185,8 @@ def simulate_computed_torque(trajectory: Trajectory, controller: Model, plant: M
 
     y0 = np.concatenate([tr.q[0] + np.asarray(initial_error, float), tr.dq[0]])
     dt = float(np.min(np.diff(tr.t)))
-    t_end, sol, stop = _integrate(rhs, tr.t, y0, rtol=rtol, max_step=4 * dt, time_s=time_s)
+    t_end, sol, stop, budget = _integrate(rhs, tr.t, y0, rtol=rtol, max_step=4 * dt,
+                                          time_s=time_s)
     n = int(np.searchsorted(tr.t, t_end, side="right"))
     t = tr.t[:n]
     y = sol(t)
@@ -189,15 +198,21 @@ def simulate_computed_torque(trajectory: Trajectory, controller: Model, plant: M
     task_error = np.linalg.norm(tr.P[:n] - P, axis=-1)
     outside = np.flatnonzero(~(task_error <= tolerance))
     left_at = int(outside[0]) if outside.size else None
-    if stop is not None:
-        status, message = 1, stop
+    if stop is not None and not budget:
+        status, message = SINGULARITY_MET, stop
     elif left_at is not None:
         k = int(np.argmax(task_error))
-        status = 2
+        status = LEFT_TOLERANCE
         message = (f"the controlled robot left the tolerance {tolerance * length_mm:.4g} mm at "
                    f"t = {t[left_at] * time_s:.6g} s (task error {task_error[left_at] * length_mm:.4g} "
                    f"mm), its largest error {task_error[k] * length_mm:.4g} mm at "
-                   f"t = {t[k] * time_s:.6g} s")
+                   f"t = {t[k] * time_s:.6g} s" + ("" if stop is None else f"; then {stop}"))
+    elif stop is not None:
+        status = INCOMPLETE
+        message = (f"{stop} of the motion's {tr.t[-1] * time_s:.6g} s; until then the "
+                   f"controlled robot followed within "
+                   f"{tolerance * length_mm:.4g} mm (largest error "
+                   f"{float(task_error.max()) * length_mm:.4g} mm)")
     else:
         status, message = 0, (f"the controlled robot followed the whole motion within "
                                f"{tolerance * length_mm:.4g} mm (largest error "
@@ -205,23 +220,26 @@ def simulate_computed_torque(trajectory: Trajectory, controller: Model, plant: M
     return ControlResult(t=t, q=q, dq=dq, tau=np.array(taus), status=status, message=message,
                          P=P, joint_error=tr.q[:n] - q, task_error=task_error,
                          saturated=saturated, torque_limit=torque_limit, tolerance=tolerance,
-                         left_at=left_at)
+                         left_at=left_at, complete=stop is None)
 
 
 def _integrate(rhs: Callable[[float, Array], Array], t: Array, y0: Array, *, rtol: float,
                max_step: float, time_s: float = 1.0
-               ) -> tuple[float, Callable[[Array], Array], str | None]:
-    """Step the plant from ``t[0]`` towards ``t[-1]``; a singularity met on the way ends the
-    integration there (a result, not a failure). Returns the last time reached, the dense
-    solution up to it and why it stopped early (None: it did not)."""
+               ) -> tuple[float, Callable[[Array], Array], str | None, bool]:
+    """Step the plant from ``t[0]`` towards ``t[-1]``; a singularity met on the way, or
+    :data:`MAX_STEPS` steps, end the integration there (a result, not a failure). Returns
+    the last time reached, the dense solution up to it, why it stopped early (None: it did
+    not) and whether the step budget stopped it."""
     solver = getattr(integrate, SOLVER)(rhs, float(t[0]), y0, float(t[-1]), rtol=rtol, atol=1e-10,
                   max_step=max_step)
     times, pieces = [float(t[0])], []
     stop: str | None = None
+    budget = False
     while solver.status == "running":
         if len(times) > MAX_STEPS:
-            stop = (f"the integration was stopped after {MAX_STEPS} steps at t = "
-                    f"{solver.t * time_s:.6g} s")
+            stop = (f"the integration was stopped after {MAX_STEPS} steps (its budget) at "
+                    f"t = {solver.t * time_s:.6g} s")
+            budget = True
             break
         try:
             solver.step()
@@ -236,4 +254,4 @@ def _integrate(rhs: Callable[[float, Array], Array], t: Array, y0: Array, *, rto
     if not pieces:
         raise SingularityError(f"the controlled robot cannot start: {stop}")
     sol = integrate.OdeSolution(times, pieces)
-    return times[-1], (lambda tt: np.asarray(sol(tt))), stop
+    return times[-1], (lambda tt: np.asarray(sol(tt))), stop, budget

@@ -25,7 +25,7 @@ import numpy as np
 
 from .._arrays import Array
 from .._lazy import lazy_module
-from ..dynamics.exact import Model, inverse_dynamics
+from ..dynamics.exact import Model, accelerations
 from ..errors import DextarError
 
 integrate = lazy_module("scipy.integrate")
@@ -235,28 +235,16 @@ def _accelerations(model: Model, q: Array, dq: Array, tau: Array
     dynamics are not defined (a parallel singularity within the model's tolerance, rods that
     cannot meet)."""
     try:
-        return _solve(model, q, dq, tau), {}
+        return accelerations(model, q, dq, tau), {}
     except DextarError:
         pass
     acc = np.zeros_like(q)
     bad: dict[int, str] = {}
     for i in range(len(q)):  # rare: the windows that left the domain, one by one
         try:
-            acc[i] = _solve(model, q[i:i + 1], dq[i:i + 1], tau[i:i + 1])[0]
+            acc[i] = accelerations(model, q[i:i + 1], dq[i:i + 1], tau[i:i + 1])[0]
         except DextarError as exc:
             bad[i] = str(exc).replace(" at sample 0", "")
     return acc, bad
 
 
-def _solve(model: Model, q: Array, dq: Array, tau: Array) -> Array:
-    zero = np.zeros_like(q)
-    h = inverse_dynamics(model, q, dq, zero)
-    e1, e2 = zero.copy(), zero.copy()
-    e1[:, 0] = 1.0
-    e2[:, 1] = 1.0
-    m1 = inverse_dynamics(model, q, dq, e1) - h
-    m2 = inverse_dynamics(model, q, dq, e2) - h
-    r = tau - h
-    det = m1[:, 0] * m2[:, 1] - m2[:, 0] * m1[:, 1]
-    return np.stack([(r[:, 0] * m2[:, 1] - m2[:, 0] * r[:, 1]) / det,
-                     (m1[:, 0] * r[:, 1] - r[:, 0] * m1[:, 1]) / det], axis=1)
