@@ -17,7 +17,14 @@ import numpy as np
 from .._arrays import Array
 from .._lazy import lazy_module
 from ..design.pareto import Choice
-from ..design.space import LENGTHS, METRICS, DesignSpace
+from ..design.space import (
+    LENGTHS,
+    METRICS,
+    UNITS,
+    DesignSpace,
+    columns_of_width,
+    row_columns,
+)
 from ..design.sweep import SweepStats
 from ..errors import ConfigError
 from ..geometry import FiveBar
@@ -34,8 +41,15 @@ else:
     mfigure = lazy_module("matplotlib.figure")
 
 
-#: Columns of designs.csv and pareto.csv.
-COLUMNS = ("design", *(f"{k}_mm" for k in LENGTHS), "feasible", "reason", *METRICS)
+def columns(variables: Sequence[str] = LENGTHS) -> tuple[str, ...]:
+    """The columns of designs.csv and pareto.csv for designs of ``variables`` (the lengths,
+    and the counterweights and motor indices a sweep varies), each with its unit."""
+    return ("design", *(f"{k}_{UNITS[k]}" if UNITS[k] else k for k in variables), "feasible",
+            "reason", "motor", *METRICS)
+
+
+#: Columns of designs.csv and pareto.csv of a sweep of the lengths.
+COLUMNS = columns()
 
 
 #: Every file a sweep may write.
@@ -44,40 +58,44 @@ DESIGN_FILES = ("designs.csv", "sweep.json", "pareto.csv", "best.toml", "summary
                                  for e in ("png", "svg")))
 
 
-def header() -> str:
+def header(variables: Sequence[str] = LENGTHS) -> str:
     """The CSV header line."""
-    return ",".join(COLUMNS) + "\n"
+    return ",".join(columns(variables)) + "\n"
 
 
 def row_line(row: Mapping[str, Any]) -> str:
     """One design's CSV line: numbers to 17 digits, an empty cell for a metric that does not
     exist (the plan failed first), ``true``/``false`` for ``feasible``."""
     cells: list[str] = [str(int(row["design"]))]
-    cells += [number(row[k]) for k in LENGTHS]
-    cells += ["true" if row["feasible"] else "false", str(row["reason"])]
+    cells += [number(row[k]) for k in row_columns(row)]
+    cells += ["true" if row["feasible"] else "false", str(row["reason"]),
+              str(row.get("motor", ""))]
     cells += ["" if row[k] is None else number(row[k]) for k in METRICS]
     buf = io.StringIO()
     csv.writer(buf, lineterminator="\n").writerow(cells)
     return buf.getvalue()
 
 
-def parse_line(line: str) -> dict[str, Any] | None:
-    """A row back from its CSV line; None for a line cut short (a sweep killed mid-write)."""
+def parse_line(line: str, variables: Sequence[str] = LENGTHS) -> dict[str, Any] | None:
+    """A row back from its CSV line (of designs of ``variables``); None for a line cut short
+    (a sweep killed mid-write)."""
     if not line.endswith("\n"):
         return None
     try:
         cells = next(csv.reader([line]))
     except (csv.Error, StopIteration):
         return None
-    if len(cells) != len(COLUMNS):
+    if len(cells) != len(columns(variables)):
         return None
+    n = len(variables)
     try:
         row: dict[str, Any] = {"design": int(cells[0])}
-        row.update({k: float(c) for k, c in zip(LENGTHS, cells[1:6], strict=True)})
-        row["feasible"] = cells[6] == "true"
-        row["reason"] = cells[7]
+        row.update({k: float(c) for k, c in zip(variables, cells[1:n + 1], strict=True)})
+        row["feasible"] = cells[n + 1] == "true"
+        row["reason"] = cells[n + 2]
+        row["motor"] = cells[n + 3]
         row.update({k: None if c == "" else float(c)
-                    for k, c in zip(METRICS, cells[8:], strict=True)})
+                    for k, c in zip(METRICS, cells[n + 4:], strict=True)})
     except ValueError:
         return None
     return row
@@ -144,9 +162,10 @@ def design_report(summary: Mapping[str, Any], pareto_rows: Sequence[Mapping[str,
               "resumed": "resumed from an earlier run"}
     facts = table([(label, _rounded(summary[k])) for k, label in labels.items()
                    if k in summary])
-    pareto = grid([c for c in COLUMNS if c not in ("feasible", "reason")],
-                  [(r["design"], *(_rounded(r[k]) for k in (*LENGTHS, *METRICS)))
-                   for r in pareto_rows])
+    variables = row_columns(pareto_rows[0]) if pareto_rows else LENGTHS
+    pareto = grid([c for c in columns(variables) if c not in ("feasible", "reason")],
+                  [(r["design"], *(_rounded(r[k]) for k in variables), r.get("motor", ""),
+                    *(_rounded(r[k]) for k in METRICS)) for r in pareto_rows])
     best = summary.get("best")
     chosen = (f"<p>Chosen (the Pareto design closest to the ideal point): design "
               f"{best['design']}, l1 = {best['l1']:.4g}, l2 = {best['l2']:.4g}, L1 = "
@@ -172,7 +191,7 @@ class DesignsFile:
     disk each time); :meth:`finish` rewrites the file in design order, atomically."""
 
     def __init__(self, od: OutputDir, designs: Array, signature: str, *, resume: bool,
-                 label: str) -> None:
+                 label: str, variables: Sequence[str] | None = None) -> None:
         """Read the rows to resume; nothing is written yet.
 
         Raises
@@ -181,6 +200,8 @@ class DesignsFile:
             ``resume`` without a sweep of the same signature, or with rows of other lengths.
         """
         self.od, self.designs, self.signature = od, designs, signature
+        self.variables = tuple(variables) if variables is not None else columns_of_width(
+            designs.shape[1])
         self.csv, self.meta = od.path / "designs.csv", od.path / "sweep.json"
         self.rows: dict[int, dict[str, Any]] = {}
         self._fh: Any = None
@@ -201,10 +222,11 @@ class DesignsFile:
                               "[design] or --samples/--seed; rerun without --resume (and "
                               "--force to overwrite it)")
         for line in self.csv.read_text().splitlines(keepends=True)[1:]:
-            r = parse_line(line)
+            r = parse_line(line, self.variables)
             if r is None or not 0 <= r["design"] < n:
                 continue
-            if not np.allclose([r[k] for k in LENGTHS], designs[r["design"]], rtol=1e-12):
+            if not np.allclose([r[k] for k in self.variables], designs[r["design"]],
+                               rtol=1e-12):
                 raise ConfigError(f"--resume: design {r['design']} in {self.csv} has other "
                                   "lengths than this sweep's")
             self.rows[r["design"]] = r
@@ -217,8 +239,8 @@ class DesignsFile:
     def __enter__(self) -> DesignsFile:
         write_text(self.meta, json.dumps({"signature": self.signature,
                                           "designs": len(self.designs)}) + "\n")
-        write_text(self.csv, header() + "".join(row_line(self.rows[i]) for i in
-                                                sorted(self.rows)))
+        write_text(self.csv, header(self.variables) + "".join(
+            row_line(self.rows[i]) for i in sorted(self.rows)))
         self.od.record("sweep.json")
         self.od.record("designs.csv")
         self._fh = open(self.csv, "a", encoding="utf-8")  # noqa: SIM115 - closed in __exit__
@@ -238,7 +260,7 @@ class DesignsFile:
     def finish(self) -> list[dict[str, Any]]:
         """Every row in design order, the file rewritten so (atomically)."""
         ordered = [self.rows[i] for i in range(len(self.designs))]
-        write_text(self.csv, header() + "".join(row_line(r) for r in ordered))
+        write_text(self.csv, header(self.variables) + "".join(row_line(r) for r in ordered))
         return ordered
 
 
@@ -294,19 +316,23 @@ def write_sweep_outputs(od: OutputDir, summary: Mapping[str, Any], choice: Choic
     pngs: dict[str, bytes] = {}
     if best_toml is not None:
         od.write_text("best.toml", best_toml)
+    variables = row_columns(rows[0]) if rows else LENGTHS
     if with_figures and choice.best >= 0 and best_figure is not None:
-        X = np.array([[r[k] for k in LENGTHS] for r in rows])
+        X = np.array([[r[k] for k in variables] for r in rows])
         names = list(summary["objectives"])
         for name, fig in (
                 ("pareto", pareto_figure(choice.F, choice.pareto, choice.best, names)),
                 ("designs", scatter_matrix(X[:, [c for c, _ in varied]],
                                            np.array([r["feasible"] for r in rows]),
-                                           [f"{label} [mm]" for _, label in varied])),
+                                           [f"{label} [{UNITS[variables[c]]}]"
+                                            if UNITS[variables[c]] else label
+                                            for c, label in varied])),
                 ("best_workspace", best_figure)):
             pngs[name] = png_bytes(fig)
             od.write_bytes(f"{name}.png", pngs[name])
             od.write_bytes(f"{name}.svg", svg_bytes(fig))
-    od.write_text("pareto.csv", header() + "".join(row_line(r) for r in choice.pareto_rows))
+    od.write_text("pareto.csv", header(variables)
+                  + "".join(row_line(r) for r in choice.pareto_rows))
     if with_figures:
         od.write_text("report.html", design_report(summary, choice.pareto_rows, pngs))
     od.write_text("summary.json", json.dumps(summary, indent=2, allow_nan=False) + "\n")
