@@ -34,6 +34,7 @@ from tests.robustness.harness import (  # noqa: E402
 from tests.robustness.strategies import (  # noqa: E402
     COMMANDS,
     configs,
+    counterweight_configs,
     dry_friction_runs,
     falling_simulations,
     kinematics_argv,
@@ -74,7 +75,9 @@ def main() -> int:
     n_metres = int(args.cases * 0.03)
     n_falling = int(args.cases * 0.03)
     n_dry = int(args.cases * 0.01)
-    n_cfg = int(args.cases * 0.65) - n_metres - n_falling - n_dry
+    # issue 32's shape: counterweights on the proximal rods
+    n_cw = int(args.cases * 0.02)
+    n_cfg = int(args.cases * 0.65) - n_metres - n_falling - n_dry - n_cw
 
     @settings(max_examples=n_cfg, deadline=None, database=None, derandomize=False,
               suppress_health_check=list(HealthCheck))
@@ -134,6 +137,15 @@ def main() -> int:
         outcome, detail = run_run_case(doc)
         record(outcome, detail, f"run with\n{toml_text(doc)}", time.perf_counter() - t0)
 
+    @settings(max_examples=n_cw, deadline=None, database=None,
+              suppress_health_check=list(HealthCheck))
+    @given(doc=counterweight_configs(),
+           command=st.sampled_from(["torques", "simulate", "export", "plan"]))
+    def fuzz_counterweights(doc: dict, command: str) -> None:
+        t0 = time.perf_counter()
+        outcome, detail = run_config_case(doc, command)
+        record(outcome, detail, f"{command} with\n{toml_text(doc)}", time.perf_counter() - t0)
+
     import random
 
     random.seed(args.seed)
@@ -144,6 +156,7 @@ def main() -> int:
     fuzz_metres()
     fuzz_falling()
     fuzz_dry_runs()
+    fuzz_counterweights()
     fuzz_argv()
     total = sum(counts.values())
     print(f"{total} cases in {time.perf_counter() - t_start:.0f} s: " + ", ".join(

@@ -7,6 +7,12 @@ a joint jerk and a torque rate (each optional). The time-optimal law plans withi
 constraint objects, :mod:`dextar.laws.constraints`; with a jerk or torque-rate limit it is
 third order, :mod:`dextar.laws.smooth`), programs are sized against it, exciting trajectories
 stay within it.
+
+Catalogues (``dextar design``'s ``[design].motors``): a :class:`Catalogue` of :class:`Motor`
+entries (at their own shafts) and gear ratios; a :class:`Gearmotor`, a motor behind an ideal
+gearbox, gives its joint's :class:`MotorLimits` (torques times the ratio, speeds over it),
+its continuous rating and its reflected rotor inertia (the ratio squared times the rotor's).
+The file is read by :mod:`dextar.config.catalogue`.
 """
 
 from __future__ import annotations

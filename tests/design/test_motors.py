@@ -118,6 +118,22 @@ def test_every_design_gets_the_lightest_motor_that_fits(example):
     assert row["shaking_force_N"] > row["rms_shaking_force_N"] > 0
 
 
+def test_a_cycle_fitted_to_the_ratings_takes_a_lighter_motor(example):
+    """``[program].cycle = "fit-rms"`` reaches the sweep: each gearmotor's cycle is stretched
+    to its RMS rating, so a lighter motor fits than under time-optimal moves as planned, and
+    its RMS torque is within its rating."""
+    sc, task, space = example
+    design = space.designs()[2]
+    planned = evaluate_design(task, design)
+    fitted = evaluate_design(replace(task, cycle="fit-rms"), design)
+    assert fitted["feasible"], fitted["reason"]
+    light = task.catalogue.motor(fitted["motor"])
+    assert light.mass < task.catalogue.motor(planned["motor"]).mass  # measured BL22 < BL42
+    rating = fitted["gear_ratio"] * light.rated_torque
+    assert max(fitted["rms_torque_A_Nm"], fitted["rms_torque_D_Nm"]) <= rating * (1 + 1e-3)
+    assert fitted["cycle_time_s"] > planned["cycle_time_s"]  # the price: a slower cycle
+
+
 def test_a_catalogue_with_no_motor_that_fits(example):
     """The smallest motor alone, direct drive: every design is refused, its reason naming
     the catalogue and the closest motor, the row still carrying its metrics."""
@@ -243,3 +259,63 @@ def test_the_example_sweeps_and_best_toml_names_the_motor(tmp_path, scheduler):
     assert best["counterweight_distance1"] == 20.0  # the task's, not varied here
     assert sc.si_motors.peak_torque[0] == pytest.approx(n * motor.peak_torque)
     json.dumps(best, allow_nan=False)  # the summary's best row is JSON
+
+
+def test_random_counterweight_and_motor_tables_are_read_or_refused_by_name(tmp_path):
+    """40 random [design] tables of counterweight and motor keys (a seeded draw, most of
+    them valid): each gives a design space whose first design evaluates to a row that goes
+    through its CSV line unchanged, or is refused with a ConfigError naming the key; both
+    happen (counted)."""
+    import random
+
+    from dextar.design.evaluate import evaluate_chunk
+    from dextar.output.design import parse_line, row_line
+
+    from ..robustness.harness import toml_text
+    from .test_design import TASK
+
+    base = {k: v for k, v in tomllib.loads(TASK).items() if k != "design"}
+    good = [[0.0, 0.1], [0.01, 0.05], [5.0, 30.0], [0.0, 40.0]]
+    bad = [[0.1, 0.0], [-1.0, 1.0], [0.5, 0.5], [float("nan"), 1.0], "x"]
+    rng = random.Random(7)
+
+    def draw_range():
+        return rng.choice(bad) if rng.random() < 0.1 else rng.choice(good)
+
+    outcomes = {"read": 0, "refused": 0, "evaluated": 0}
+    for case in range(40):
+        table = {"l": [60.0, 90.0], "samples": 2}
+        kind = rng.choices(["none", "both", "legs", "lone", "twice"], [3, 6, 3, 1, 1])[0]
+        if kind in ("both", "twice"):
+            table.update(counterweight_mass=draw_range(), counterweight_distance=draw_range())
+        if kind == "twice":  # a leg's range beside both legs' range: refused
+            table["counterweight_mass1"] = draw_range()
+        if kind == "legs":
+            table.update(counterweight_mass1=draw_range(), counterweight_distance=draw_range())
+        if kind == "lone":  # a mass with no distance anywhere: refused
+            table["counterweight_mass2"] = draw_range()
+        motors = rng.random() < 0.6
+        if motors:
+            table["motors"] = rng.choice([CATALOGUE.as_posix()] * 6 + ["nowhere.toml"])
+        if rng.random() < (0.6 if motors else 0.1):
+            table["ratios"] = rng.choice([[5, 10], [1], [20.0, 40.0], [5, 10], [0], [2, 2]])
+        if rng.random() < (0.6 if motors else 0.1):
+            table["motor_choice"] = rng.choice(["search", "search", "lightest", "best"])
+        path = tmp_path / f"t{case}.toml"
+        path.write_text(toml_text({**base, "design": table}))
+        try:
+            task, space = load_scenario(path).design_task()
+        except ConfigError as exc:
+            assert re.search(r"\[design\]|catalogue|config file", str(exc)), exc
+            outcomes["refused"] += 1
+            continue
+        outcomes["read"] += 1
+        designs = space.designs()
+        assert designs.shape == (2, len(space.columns)) and np.isfinite(designs).all()
+        if task.catalogue is not None and task.motor_choice != "search":
+            continue  # up to 20 plans a design: the example's tests cover them
+        for row in evaluate_chunk(task, designs[:1], 0):
+            assert parse_line(row_line(row), space.columns) == row
+            assert not row["reason"].startswith("internal error"), row["reason"]
+            outcomes["evaluated"] += 1
+    assert min(outcomes.values()) >= 5, outcomes

@@ -158,19 +158,19 @@ class DesignTable(Table):
     @staticmethod
     def _check_counterweights(dims: list[tuple[str, float, float, tuple[int, ...]]],
                               fixed: tuple[float, ...]) -> None:
-        """Refuse counterweights that cannot act: a mass varied at no distance, a distance
-        varied with no mass (each leg)."""
-        set_by = {c: name for name, _, _, cs in dims for c in cs}
-        for leg in (0, 1):
-            m, r = 5 + leg, 7 + leg
-            if m in set_by and r not in set_by and fixed[r] == 0:
-                raise ConfigError(f"config key [design].{set_by[m]} needs a distance: "
-                                  "[design].counterweight_distance or "
-                                  "[inertia].counterweight_distance")
-            if r in set_by and m not in set_by and fixed[m] == 0:
-                raise ConfigError(f"config key [design].{set_by[r]} needs a mass: "
-                                  "[design].counterweight_mass or "
-                                  "[inertia].counterweight_mass")
+        """Refuse counterweights that cannot act: a mass range for rods with no distance, a
+        distance range for rods with no mass (neither varied nor in ``[inertia]``)."""
+        varied = {c for _, _, _, cs in dims for c in cs}
+        for name, _, _, cs in dims:
+            if not name.startswith("counterweight_"):
+                continue
+            mass = name.startswith("counterweight_mass")
+            other = [c + 2 if mass else c - 2 for c in cs]  # the same legs' other column
+            if not any(o in varied or fixed[o] > 0 for o in other):
+                need = ("a distance: [design].counterweight_distance or "
+                        "[inertia].counterweight_distance" if mass else
+                        "a mass: [design].counterweight_mass or [inertia].counterweight_mass")
+                raise ConfigError(f"config key [design].{name} needs {need}")
 
     @property
     def motors(self) -> str | None:

@@ -34,7 +34,7 @@ def design_task(sc: Scenario, *, samples: int | None = None,
         return Task(sc.moves, sc.program_start, sc.program_mode, sc.assembly, motors, rms,
                     inertia, space.mass_per_length, sc.design.grid, sc.tolerances,
                     robot=sc.si_model.robot, columns=space.columns, catalogue=catalogue,
-                    motor_choice=sc.design.motor_choice), space
+                    motor_choice=sc.design.motor_choice, cycle=sc.program_table.cycle), space
     path = sc.path_table.build(SI)  # a run task: one path and law
     kind = sc.law_table.kind
     values = sc.law_table.run_values(SI)

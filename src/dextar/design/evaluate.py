@@ -29,7 +29,14 @@ from .._arrays import Array
 from .._lazy import lazy_module
 from ..dynamics import Counterweight, Inertia, Model, RobotAlongPath, Rod, inverse_dynamics
 from ..dynamics.balancing import shaking_summary_si
-from ..errors import DextarError, InfeasibleError
+from ..errors import (
+    AssemblyError,
+    DextarError,
+    GeometryError,
+    InfeasibleError,
+    ReachError,
+    SingularityError,
+)
 from ..geometry import FiveBar
 from ..kinematics import jacobian, workspace_map
 from ..kinematics.checker import Tolerances, pose_distances
@@ -46,6 +53,10 @@ ndimage = lazy_module("scipy.ndimage")
 
 #: Grid of the workspace map behind ``workspace_area_mm2`` (points per side).
 AREA_RESOLUTION = 61
+#: The errors of a plan that do not depend on the motors (a path out of reach, a
+#: singularity, a robot that cannot close): a design that meets one with a catalogue motor
+#: meets it with every other, so the others are not tried.
+GEOMETRIC_ERRORS = (GeometryError, ReachError, AssemblyError, SingularityError)
 #: Setpoint rate of the plans a sweep makes (the sizing integrates over them).
 SWEEP_RATE_HZ = 500.0
 
@@ -91,6 +102,9 @@ class Task:
         acceleration, jerk and torque-rate limits only; ``rms_limit`` is the motors').
     motor_choice : str
         ``"lightest"``, ``"cheapest"`` or ``"search"`` (see the module doc).
+    cycle : str
+        A program task's ``[program].cycle``: ``"as-planned"``, or ``"fit-rms"`` (each
+        design's cycle the shortest within its motors' RMS ratings).
     """
 
     moves: tuple[Move, ...]
@@ -112,6 +126,7 @@ class Task:
     columns: tuple[str, ...] = LENGTHS
     catalogue: Catalogue | None = None
     motor_choice: str = "lightest"
+    cycle: str = "as-planned"
 
     @property
     def kind(self) -> str:
@@ -281,7 +296,9 @@ def _choose(task: Task, robot: FiveBar, inertia: Inertia, x: Mapping[str, float]
         for gm in group:
             try:
                 tried.append(_attempt(task, robot, inertia, gm))
-            except InfeasibleError as exc:  # no motion within this gearmotor's limits
+            except GEOMETRIC_ERRORS:  # the same with any motor
+                raise
+            except DextarError as exc:  # no motion (or cycle) within this gearmotor's limits
                 if gm is None:
                     raise
                 errors.append(f"{gm.label}: {exc}")
@@ -373,7 +390,7 @@ def _plan(task: Task, robot: FiveBar, inertia: Inertia, motors: MotorLimits | No
     if task.path is None:
         return ProgramRequest(robot, inertia, task.moves, task.start, task.working_mode,
                               task.assembly, motors, rms_limit, SWEEP_RATE_HZ,
-                              task.grid, task.tolerances).plan()
+                              task.grid, task.tolerances, task.cycle).plan()
     model = Model(robot, inertia, task.assembly, tol=task.tolerances.type2)
     law = task.law
     if law is None:  # a law planned on the robot (time-optimal)

@@ -53,6 +53,14 @@ def row_columns(row: Mapping[str, object]) -> tuple[str, ...]:
     return tuple(k for k in (*LENGTHS, *COUNTERWEIGHTS, *MOTOR_COLUMNS) if k in row)
 
 
+#: The axis labels of the dimensions not named by their columns.
+AXIS_LABELS = {"counterweight_mass": "counterweight mass, AB = DC",
+               "counterweight_mass1": "counterweight mass, AB",
+               "counterweight_mass2": "counterweight mass, DC",
+               "counterweight_distance": "counterweight distance, AB = DC",
+               "counterweight_distance1": "counterweight distance, AB",
+               "counterweight_distance2": "counterweight distance, DC",
+               "motor": "motor (catalogue index)", "ratio": "gear ratio (index)"}
 #: The dimensions (config names) whose values are whole numbers (indices).
 INTEGER_DIMS = ("motor", "ratio")
 #: The metrics a design has (``-`` before one in ``objectives`` maximises it). The shaking
@@ -184,8 +192,10 @@ class DesignSpace:
     @property
     def varied_axes(self) -> list[tuple[int, str]]:
         """One ``(column, label)`` per varied dimension: columns tied to one range (``l``:
-        both proximal rods) are one axis, ``"l1 = l2"``."""
-        return sorted((cs[0], " = ".join(self.columns[c] for c in cs)) for *_, cs in self.dims)
+        both proximal rods) are one axis, ``"l1 = l2"``; the counterweights and the motor in
+        words (``"counterweight mass, AB = DC"``)."""
+        return sorted((cs[0], AXIS_LABELS.get(name) or " = ".join(self.columns[c] for c in cs))
+                      for name, _, _, cs in self.dims)
 
     def objective_values(self, rows: list[dict[str, float]]) -> Array:
         """The objectives of ``rows`` to minimise, shape (n, n_objectives)."""
