@@ -56,3 +56,8 @@ def test_paper_toml_is_the_default():
 def test_identification_script_runs(capsys):
     runpy.run_path(str(EXAMPLES / "identify_synthetic.py"), run_name="__main__")
     assert "identification checks passed" in capsys.readouterr().out
+
+
+def test_balancing_script_runs(capsys):
+    runpy.run_path(str(EXAMPLES / "balancing.py"), run_name="__main__")
+    assert "balancing checks passed" in capsys.readouterr().out

@@ -104,7 +104,8 @@ def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
     with OutputDir(args.out, force=args.force, keep=args.resume, produces=written.DESIGN_FILES,
                    hint=f"use --force to overwrite it or --resume to complete its {what}") as od:
         store = written.DesignsFile(od, sweep.designs if sweep.search is None else None,
-                                    sweep.signature, resume=args.resume, label=shown(args.out))
+                                    sweep.signature, resume=args.resume, label=shown(args.out),
+                                    variables=sweep.space.columns)
         res = jobs.design(sweep, workers=args.workers, scheduler=args.scheduler, store=store,
                           progress=_progress(args), dashboard=_dashboard(args),
                           label=args.config, store_label=shown(args.out, "designs.csv"))

@@ -3,7 +3,7 @@ batch by batch, the same designs for any number of workers, resumable.
 
 The search works in the unit cube of the space's dimensions (whatever
 :class:`~dextar.design.space.DesignSpace` declares: each range scaled to [0, 1], mapped back
-by :meth:`~dextar.design.space.DesignSpace.at`), so a variable the space gains joins the
+by :meth:`~dextar.design.space.DesignSpace.from_unit`), so a variable the space gains joins the
 search unchanged. Its first ``population`` designs are the space's own sample (scrambled
 Sobol); after them it proposes ``batch`` designs at a time, each batch one unit of work on a
 Dask worker (:func:`~dextar.design.sweep.evaluate_chunk_metered`).
@@ -49,7 +49,7 @@ from .._lazy import lazy_module
 from ..errors import ConfigError
 from .evaluate import Task
 from .pareto import pareto_mask
-from .space import LENGTHS, DesignSpace
+from .space import DesignSpace
 from .sweep import INSTALL_HINT, Chunks, Cluster, SweepStats, chunks_of, require_dask
 
 nsga2 = lazy_module("pymoo.algorithms.moo.nsga2")
@@ -279,13 +279,13 @@ def run_search(cluster: Cluster, task: Task, space: DesignSpace, settings: Searc
         algorithm_s += time.perf_counter() - ta
         if not len(U):
             return False
-        designs = space.at(U)
+        designs = space.from_unit(U)
         batch = _Batch(first, designs)
         for j, x in enumerate(designs):
             r = resumed.get(first + j)
             if r is None:
                 batch.left.add(first + j)
-            elif not np.allclose([r[k] for k in LENGTHS], x, rtol=1e-12, atol=0.0):
+            elif not np.allclose([r[k] for k in space.columns], x, rtol=1e-12, atol=0.0):
                 raise ConfigError(f"--resume: design {first + j} in {label} is not the design "
                                   "this search proposes under that number (made with another "
                                   "task, [design], seed or pymoo version)")

@@ -27,6 +27,7 @@ from ..design.search import (
 from ..design.space import LENGTHS, DesignSpace
 from ..design.sweep import Cluster, SweepStats, require_dask, run_sweep
 from ..geometry import FiveBar
+from ..motors import Gearmotor
 
 Row = dict[str, Any]
 
@@ -43,12 +44,13 @@ class DesignSweep:
         What each design is evaluated on (SI).
     space : DesignSpace
         The ranges, the sampling and the objectives.
-    designs : ndarray, shape (n, 5)
-        A sweep's designs ``l1, l2, L1, L2, d`` (mm), numbered by row; a search's first
+    designs : ndarray, shape (n, len(space.columns))
+        A sweep's designs (``l1, l2, L1, L2, d`` in mm, then the counterweights and the
+        motor's indices the space varies), numbered by row; a search's first
         population (the others it proposes as it goes).
     signature : str
-        What makes two runs the same (the task file, the space, the grid, the search and
-        the pymoo it runs on): a run resumes only its own designs.
+        What makes two runs the same (the task file, the space, the grid, the motor
+        catalogue, the search and the pymoo it runs on): a run resumes only its own designs.
     search : SearchSettings, optional
         The adaptive search (None for a sweep).
     """
@@ -79,8 +81,9 @@ def design_sweep(sc: Scenario, *, samples: int | None = None,
     if search is not None:
         require_pymoo()
     task, space = sc.design_task(samples=None if search else samples, seed=seed)
-    signature = hashlib.sha256(repr((sc.text, space, sc.design.grid) if search is None else
-                                    (sc.text, space, sc.design.grid, search,
+    signature = hashlib.sha256(repr((sc.text, space, sc.design.grid, task.catalogue)
+                                    if search is None else
+                                    (sc.text, space, sc.design.grid, task.catalogue, search,
                                      pymoo_version())).encode()).hexdigest()
     return DesignSweep(sc, task, space, space.designs(), signature, search)
 
@@ -217,17 +220,36 @@ def design(sweep: DesignSweep, *, workers: int | None = None, scheduler: str | N
     best = choice.best_row
     if best is None:
         return Designed(sweep, rows, stats, choice, None, hypervolume=curve)
-    lengths = [best[k] for k in LENGTHS]
-    robot_mm = FiveBar(*lengths)
+    robot_mm = FiveBar(*(best[k] for k in LENGTHS))
     rods = (f"uniform rods of {space.mass_per_length[0]:g} and "
             f"{space.mass_per_length[1]:g} kg/m" if space.mass_per_length else
             "each rod of the task's robot keeps its linear density and shape on its new length "
             "(mass and centre of mass scale with the length, the inertia about the centre "
             "with its cube); the effector, payload and rotors as given")
+    motors, tables = chosen_motors(task, best)
     best_toml = sc.model_file(
-        robot_mm, task.working_mode, inertia_of(task, robot_mm.scaled(1e-3)),
+        robot_mm, task.working_mode, inertia_of(task, robot_mm.scaled(1e-3), best),
         f"the Pareto design closest to the ideal point of dextar design {label or sc.source} "
         f"(design {best['design']} of {len(rows)}; objectives {', '.join(space.objectives)})\n"
-        f"rods: {rods}")
-    return Designed(sweep, rows, stats, choice, best_toml, evaluate_path(task, lengths), curve)
+        f"rods: {rods}{motors}", tables)
+    return Designed(sweep, rows, stats, choice, best_toml, evaluate_path(task, best), curve)
+
+
+def chosen_motors(task: Task, best: Row) -> tuple[str, dict[str, dict[str, object]] | None]:
+    """The words of ``best.toml``'s comment on its counterweights and motors, and the
+    ``[motors]`` and ``[drive]`` tables of the catalogue motor a design was planned with (None
+    without a catalogue)."""
+    said = ""
+    c1, c2 = inertia_of(task, FiveBar(*(best[k] for k in LENGTHS)).scaled(1e-3),
+                        best).counterweights
+    if not (c1.none and c2.none):
+        said += (f"\ncounterweights: {c1.mass:.4g} and {c2.mass:.4g} kg at {1e3 * c1.distance:.4g}"
+                 f" and {1e3 * c2.distance:.4g} mm behind the motor axes (in [inertia])")
+    if task.catalogue is None or not best.get("motor"):
+        return said, None
+    gm = Gearmotor(task.catalogue.motor(str(best["motor"])), float(best["gear_ratio"]))
+    said += (f"\nmotors: {gm.motor.name} on both joints, gear ratio {gm.ratio:g} (from "
+             f"{task.catalogue.source}); [motors] at the joints, its reflected rotor inertia "
+             f"{gm.reflected_inertia * 1e6:.4g} kg mm^2 in [inertia].rotor_inertia")
+    return said, gm.config_tables(task.motors)
 

@@ -19,7 +19,14 @@ from .._arrays import Array
 from .._lazy import lazy_module
 from ..design.pareto import Choice
 from ..design.search import REFERENCE_POINT, HypervolumeCurve, SearchSettings
-from ..design.space import LENGTHS, METRICS, DesignSpace
+from ..design.space import (
+    LENGTHS,
+    METRICS,
+    UNITS,
+    DesignSpace,
+    columns_of_width,
+    row_columns,
+)
 from ..design.sweep import SweepStats
 from ..errors import ConfigError
 from ..geometry import FiveBar
@@ -38,8 +45,17 @@ else:
 
 #: Most design numbers a resumed search's file may hold.
 MAX_DESIGNS = 10_000_000
-#: Columns of designs.csv and pareto.csv.
-COLUMNS = ("design", *(f"{k}_mm" for k in LENGTHS), "feasible", "reason", *METRICS)
+
+
+def columns(variables: Sequence[str] = LENGTHS) -> tuple[str, ...]:
+    """The columns of designs.csv and pareto.csv for designs of ``variables`` (the lengths,
+    and the counterweights and motor indices a sweep varies), each with its unit."""
+    return ("design", *(f"{k}_{UNITS[k]}" if UNITS[k] else k for k in variables), "feasible",
+            "reason", "motor", *METRICS)
+
+
+#: Columns of designs.csv and pareto.csv of a sweep of the lengths.
+COLUMNS = columns()
 
 
 #: Every file a sweep may write.
@@ -57,6 +73,11 @@ METRIC_WORDS = {
     "peak_torque_A_Nm": "peak torque of motor A", "peak_torque_D_Nm": "peak torque of motor D",
     "rms_torque_A_Nm": "RMS torque of motor A", "rms_torque_D_Nm": "RMS torque of motor D",
     "workspace_area_mm2": "usable workspace area",
+    "shaking_force_N": "peak shaking force", "rms_shaking_force_N": "RMS shaking force",
+    "shaking_moment_Nm": "peak shaking moment (about the middle of AD)",
+    "rms_shaking_moment_Nm": "RMS shaking moment (about the middle of AD)",
+    "motor_mass_kg": "mass of both motors", "motor_price": "price of both motors",
+    "gear_ratio": "gear ratio (motor turns per joint turn)",
 }
 #: Units of the metrics by the suffix of their names (longest first).
 UNIT_SUFFIXES = (("_mm2", "mm²"), ("_Nm", "N m"), ("_mm", "mm"), ("_kg", "kg"), ("_s", "s"),
@@ -78,40 +99,44 @@ def metric_label(objective: str) -> str:
     return f"{words} [{unit}]" + (", maximised" if objective.startswith("-") else "")
 
 
-def header() -> str:
+def header(variables: Sequence[str] = LENGTHS) -> str:
     """The CSV header line."""
-    return ",".join(COLUMNS) + "\n"
+    return ",".join(columns(variables)) + "\n"
 
 
 def row_line(row: Mapping[str, Any]) -> str:
     """One design's CSV line: numbers to 17 digits, an empty cell for a metric that does not
     exist (the plan failed first), ``true``/``false`` for ``feasible``."""
     cells: list[str] = [str(int(row["design"]))]
-    cells += [number(row[k]) for k in LENGTHS]
-    cells += ["true" if row["feasible"] else "false", str(row["reason"])]
+    cells += [number(row[k]) for k in row_columns(row)]
+    cells += ["true" if row["feasible"] else "false", str(row["reason"]),
+              str(row.get("motor", ""))]
     cells += ["" if row[k] is None else number(row[k]) for k in METRICS]
     buf = io.StringIO()
     csv.writer(buf, lineterminator="\n").writerow(cells)
     return buf.getvalue()
 
 
-def parse_line(line: str) -> dict[str, Any] | None:
-    """A row back from its CSV line; None for a line cut short (a sweep killed mid-write)."""
+def parse_line(line: str, variables: Sequence[str] = LENGTHS) -> dict[str, Any] | None:
+    """A row back from its CSV line (of designs of ``variables``); None for a line cut short
+    (a sweep killed mid-write)."""
     if not line.endswith("\n"):
         return None
     try:
         cells = next(csv.reader([line]))
     except (csv.Error, StopIteration):
         return None
-    if len(cells) != len(COLUMNS):
+    if len(cells) != len(columns(variables)):
         return None
+    n = len(variables)
     try:
         row: dict[str, Any] = {"design": int(cells[0])}
-        row.update({k: float(c) for k, c in zip(LENGTHS, cells[1:6], strict=True)})
-        row["feasible"] = cells[6] == "true"
-        row["reason"] = cells[7]
+        row.update({k: float(c) for k, c in zip(variables, cells[1:n + 1], strict=True)})
+        row["feasible"] = cells[n + 1] == "true"
+        row["reason"] = cells[n + 2]
+        row["motor"] = cells[n + 3]
         row.update({k: None if c == "" else float(c)
-                    for k, c in zip(METRICS, cells[8:], strict=True)})
+                    for k, c in zip(METRICS, cells[n + 4:], strict=True)})
     except ValueError:
         return None
     return row
@@ -217,9 +242,10 @@ def design_report(summary: Mapping[str, Any], pareto_rows: Sequence[Mapping[str,
               "resumed": "resumed from an earlier run"}
     facts = table([(label, _rounded(summary[k])) for k, label in labels.items()
                    if k in summary])
-    pareto = grid([c for c in COLUMNS if c not in ("feasible", "reason")],
-                  [(r["design"], *(_rounded(r[k]) for k in (*LENGTHS, *METRICS)))
-                   for r in pareto_rows])
+    variables = row_columns(pareto_rows[0]) if pareto_rows else LENGTHS
+    pareto = grid([c for c in columns(variables) if c not in ("feasible", "reason")],
+                  [(r["design"], *(_rounded(r[k]) for k in variables), r.get("motor", ""),
+                    *(_rounded(r[k]) for k in METRICS)) for r in pareto_rows])
     best = summary.get("best")
     chosen = (f"<p>Chosen (the Pareto design closest to the ideal point): design "
               f"{best['design']}, l1 = {best['l1']:.4g}, l2 = {best['l2']:.4g}, L1 = "
@@ -246,10 +272,11 @@ class DesignsFile:
     disk each time); :meth:`finish` rewrites the file in design order, atomically."""
 
     def __init__(self, od: OutputDir, designs: Array | None, signature: str, *, resume: bool,
-                 label: str) -> None:
-        """Read the rows to resume (of a sweep's ``designs``, their lengths checked; of a
+                 label: str, variables: Sequence[str] | None = None) -> None:
+        """Read the rows to resume (of a sweep's ``designs``, their values checked; of a
         search's, ``designs`` None: the search checks each against its proposal); nothing
-        is written yet.
+        is written yet. ``variables`` are the design's columns (default: from the width of
+        ``designs``; a search's must be given).
 
         Raises
         ------
@@ -257,6 +284,12 @@ class DesignsFile:
             ``resume`` without a run of the same signature, or with rows of other lengths.
         """
         self.od, self.designs, self.signature = od, designs, signature
+        if variables is not None:
+            self.variables = tuple(variables)
+        elif designs is not None:
+            self.variables = columns_of_width(designs.shape[1])
+        else:
+            raise ValueError("a search's designs file needs its variables")
         self.csv, self.meta = od.path / "designs.csv", od.path / "sweep.json"
         self.rows: dict[int, dict[str, Any]] = {}
         self._fh: Any = None
@@ -278,19 +311,20 @@ class DesignsFile:
                               "[design] or --samples/--seed; rerun without --resume (and "
                               "--force to overwrite it)")
         for line in self.csv.read_text().splitlines(keepends=True)[1:]:
-            r = parse_line(line)
+            r = parse_line(line, self.variables)
             if r is None or not 0 <= r["design"] < n:
                 continue
-            if designs is not None and not np.allclose([r[k] for k in LENGTHS],
+            if designs is not None and not np.allclose([r[k] for k in self.variables],
                                                        designs[r["design"]], rtol=1e-12):
                 raise ConfigError(f"--resume: design {r['design']} in {self.csv} has other "
                                   "lengths than this sweep's")
             self.rows[r["design"]] = r
 
     def __enter__(self) -> DesignsFile:
-        write_text(self.meta, json.dumps({"signature": self.signature}) + "\n")
-        write_text(self.csv, header() + "".join(row_line(self.rows[i]) for i in
-                                                sorted(self.rows)))
+        write_text(self.meta, json.dumps({"signature": self.signature} | (
+            {} if self.designs is None else {"designs": len(self.designs)})) + "\n")
+        write_text(self.csv, header(self.variables) + "".join(
+            row_line(self.rows[i]) for i in sorted(self.rows)))
         self.od.record("sweep.json")
         self.od.record("designs.csv")
         self._fh = open(self.csv, "a", encoding="utf-8")  # noqa: SIM115 - closed in __exit__
@@ -311,7 +345,7 @@ class DesignsFile:
         """The rows of designs ``0 .. n - 1`` in design order, the file rewritten so
         (atomically)."""
         ordered = [self.rows[i] for i in range(n)]
-        write_text(self.csv, header() + "".join(row_line(r) for r in ordered))
+        write_text(self.csv, header(self.variables) + "".join(row_line(r) for r in ordered))
         return ordered
 
 
@@ -385,21 +419,25 @@ def write_sweep_outputs(od: OutputDir, summary: Mapping[str, Any], choice: Choic
     pngs: dict[str, bytes] = {}
     if best_toml is not None:
         od.write_text("best.toml", best_toml)
+    variables = row_columns(rows[0]) if rows else LENGTHS
     if with_figures and choice.best >= 0 and best_figure is not None:
-        X = np.array([[r[k] for k in LENGTHS] for r in rows])
+        X = np.array([[r[k] for k in variables] for r in rows])
         names = list(summary["objectives"])
         for name, fig in (
                 ("pareto", pareto_figure(choice.F, choice.pareto, choice.best, names)),
                 ("designs", scatter_matrix(X[:, [c for c, _ in varied]],
                                            np.array([r["feasible"] for r in rows]),
-                                           [f"{label} [mm]" for _, label in varied])),
+                                           [f"{label} [{UNITS[variables[c]]}]"
+                                            if UNITS[variables[c]] else label
+                                            for c, label in varied])),
                 ("best_workspace", best_figure),
                 *((("hypervolume", hypervolume_figure(hypervolume, str(summary["search"]))),)
                   if hypervolume is not None else ())):
             pngs[name] = png_bytes(fig)
             od.write_bytes(f"{name}.png", pngs[name])
             od.write_bytes(f"{name}.svg", svg_bytes(fig))
-    od.write_text("pareto.csv", header() + "".join(row_line(r) for r in choice.pareto_rows))
+    od.write_text("pareto.csv", header(variables)
+                  + "".join(row_line(r) for r in choice.pareto_rows))
     if with_figures:
         od.write_text("report.html", design_report(summary, choice.pareto_rows, pngs))
     od.write_text("summary.json", json.dumps(summary, indent=2, allow_nan=False) + "\n")
