@@ -442,7 +442,7 @@ class Progress:
 
 class ProgressMeter:
     """Counts the rows of a sweep or search as they come, keeps the front found so far and
-    its hypervolume (:class:`Progress`)."""
+    its hypervolume (:class:`~dextar.design.search.Progress`)."""
 
     def __init__(self, space: DesignSpace, total: int, resumed: Iterable[Row] = (), *,
                  box_after: int = 40) -> None:
