@@ -43,6 +43,7 @@ def test_a_model_file_gives_the_same_model_back():
         assert (a.mass, a.com, a.inertia) == pytest.approx((b.mass, b.com, b.inertia), rel=1e-12)
 
 
+@pytest.mark.slow
 def test_torques_command_uses_them(tmp_path):
     cfg = tmp_path / "cw.toml"
     cfg.write_text('[inertia]\neffector_mass = 0.2\ncounterweight_mass = [0.3, 0.2]\n'

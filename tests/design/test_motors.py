@@ -71,6 +71,7 @@ def test_bad_catalogues_are_named(doc, message):
         catalogue_from_dict(doc, (1.0,), "motor catalogue 'c.toml'")
 
 
+@pytest.mark.slow
 def test_every_design_gets_the_lightest_motor_that_fits(example):
     """For a design of the example: the chosen motor and ratio fit (a plan made apart,
     with the limits and the reflected inertia written out by hand, gives the same cycle and
@@ -118,6 +119,7 @@ def test_every_design_gets_the_lightest_motor_that_fits(example):
     assert row["shaking_force_N"] > row["rms_shaking_force_N"] > 0
 
 
+@pytest.mark.slow
 def test_a_cycle_fitted_to_the_ratings_takes_a_lighter_motor(example):
     """``[program].cycle = "fit-rms"`` reaches the sweep: each gearmotor's cycle is stretched
     to its RMS rating, so a lighter motor fits than under time-optimal moves as planned, and
@@ -207,6 +209,7 @@ def test_objectives_on_motors_need_a_catalogue(tmp_path, capsys):
     assert code == 2 and "'motor_price' needs a motor catalogue ([design].motors)" in err
 
 
+@pytest.mark.slow
 def test_the_example_sweeps_and_best_toml_names_the_motor(tmp_path, scheduler):
     """The design job on the example (4 designs varying d and the counterweights' mass, two
     of its ratios, a coarser grid; the job without the command's figures, which take most

@@ -42,6 +42,7 @@ def lengths(rows):
 # ------------------------------------------------------------------ the driver, without Dask
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("settings", [SearchSettings("nsga2", 24, 160, 3, batch=4),
                                       SearchSettings("nsga2", 24, 150, 3, batch=24, lag=1)],
                          ids=["steady-state", "generational"])
@@ -70,6 +71,7 @@ def test_steady_state_keeps_the_batches_in_flight(monkeypatch):
     assert settings.in_flight == 6
 
 
+@pytest.mark.slow
 def test_a_resumed_search_replays_and_evaluates_only_what_is_missing(monkeypatch):
     settings = SearchSettings("nsga2", 24, 120, 5, batch=4)
     full, _, _ = _toy.run(monkeypatch, settings)
@@ -87,6 +89,7 @@ def test_a_resumed_search_replays_and_evaluates_only_what_is_missing(monkeypatch
         _toy.run(monkeypatch, settings, resumed=bad)
 
 
+@pytest.mark.slow
 def test_the_search_finds_the_toy_front_where_a_sweep_of_as_many_does_not(monkeypatch):
     """ZDT1 on three variables, with designs that are not feasible: 600 designs of the
     search reach 0.85 of the true front's hypervolume (measured 0.93-0.98 over 10 seeds, batch
@@ -198,6 +201,7 @@ def search2(tmp_path_factory, scheduler):
     return task, out
 
 
+@pytest.mark.slow
 def test_the_search_writes_its_rows_front_and_curve(search2):
     task, out = search2
     rows = rows_of(out)
@@ -216,6 +220,7 @@ def test_the_search_writes_its_rows_front_and_curve(search2):
     assert "design search of task.toml" in (out / "report.html").read_text().lower()
 
 
+@pytest.mark.slow
 def test_one_worker_gives_the_same_search_file(search2, tmp_path):
     task, out2 = search2
     out1 = tmp_path / "one"
@@ -224,6 +229,7 @@ def test_one_worker_gives_the_same_search_file(search2, tmp_path):
     assert (out1 / "pareto.csv").read_bytes() == (out2 / "pareto.csv").read_bytes()
 
 
+@pytest.mark.slow
 def test_a_killed_search_resumes_to_the_same_front(search2, tmp_path, scheduler):
     task, out2 = search2
     out = tmp_path / "killed"
@@ -252,6 +258,7 @@ def test_a_killed_search_resumes_to_the_same_front(search2, tmp_path, scheduler)
     assert s["resumed"] == done and s["evaluated"] == 32 - done
 
 
+@pytest.mark.slow
 def test_resume_refuses_another_search(search2, tmp_path, capsys):
     import shutil
 
@@ -262,6 +269,7 @@ def test_resume_refuses_another_search(search2, tmp_path, capsys):
     assert "was made with another task" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_the_dashboard_counts_the_designs(scheduler, tmp_path):
     """The workers report each chunk's designs to the scheduler: its Fine Performance
     Metrics (unit designs) under the tasks' prefix dextar-design."""
@@ -358,6 +366,7 @@ def _search_tables():
     return st.dictionaries(keys, value, max_size=5)
 
 
+@pytest.mark.slow
 def test_random_search_tables_are_read_or_refused_by_name():
     """Any [design] table of search keys either gives a space (and, for nsga2, settings whose
     first population is the space's sample) or is refused with a ConfigError naming the key."""

@@ -110,6 +110,7 @@ def test_power_balance_with_counterweights(kernel):
     assert np.abs(power - dT)[5:-5].max() < 1e-4 * np.abs(power).max()
 
 
+@pytest.mark.slow
 def test_mujoco_sees_the_counterweight_as_a_body():
     mujoco = pytest.importorskip("mujoco")
     from dextar.output.mjcf import mujoco_state, to_mjcf
