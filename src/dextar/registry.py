@@ -7,9 +7,10 @@ Laws, path types, move types, config tables, constraints and commands are each a
 :class:`UnknownNameError`, which lists the known names.
 
 Plugins. A registry with an entry-point group (``dextar.laws``, ``dextar.paths``,
-``dextar.moves``, ``dextar.commands``) loads, the first time it is listed or asked for a name
-it does not hold, every entry point of that group that the installed distributions declare. Each names a callable taking
-no argument that registers its items, e.g. in a plugin's ``pyproject.toml``::
+``dextar.moves``, ``dextar.constraints``, ``dextar.commands``) loads, the first time it is
+listed or asked for a name it does not hold, every entry point of that group that the
+installed distributions declare. Each names a callable taking no argument that registers
+its items, e.g. in a plugin's ``pyproject.toml``::
 
     [project.entry-points."dextar.moves"]
     nudge = "dextar_nudge:register"      # def register(): register_move(MoveType(...))

@@ -2,6 +2,7 @@
 through the public registry, plans from a config, and the docs and help list it."""
 
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -74,3 +75,39 @@ def test_the_docs_list_every_registered_path_and_law_a_new_one_too(toy_law):
     for name in [*PATH_TYPES, *LAW_TYPES]:
         assert f'type = "{name}"' in text and f'``"{name}"``' in text, name
     assert "const-accel" in LAW_TYPES and "constant acceleration from rest" in text
+
+
+def test_a_limit_registered_from_outside_is_planned_within():
+    """A new limit is a Constraint and one registration: a power-supply cap that halves each
+    motor's peak torque, registered as a constraint type, makes the time-optimal move slower
+    (gravity takes part of the torque: 1.73x measured) and as slow as with motors of half
+    the peak (the check fails when motor_constraints ignores the registry), and the written torques stay
+    within the halved limit; removed, the move is as before."""
+    from dextar.config import load_scenario
+    from dextar.dynamics import Model, RobotAlongPath
+    from dextar.laws import solve_time_optimal_law
+    from dextar.laws.constraints import CONSTRAINT_TYPES, ConstraintType, TorqueLimit
+    from dextar.motors import MotorLimits
+    from dextar.paths import Line
+
+    assert list(CONSTRAINT_TYPES)[:2] == ["torque", "speed"]
+    m = load_scenario(Path(__file__).parents[2] / "examples" / "pick_place.toml").si_model
+    along = RobotAlongPath(Model(m.robot, m.inertia, "up"), Line((-0.04, 0.09), (0.04, 0.12)), "+-",
+                           checked=True)
+    motors = MotorLimits((0.6, 0.6))
+    before = solve_time_optimal_law(along, motors=motors)
+    CONSTRAINT_TYPES.register(ConstraintType(
+        "supply", lambda m: TorqueLimit(tuple(0.5 * np.asarray(m.peak_torque))),
+        "half the peak torque"))
+    try:
+        capped = solve_time_optimal_law(along, motors=motors)
+    finally:
+        CONSTRAINT_TYPES.pop("supply")
+    assert before.success and capped.success
+    half = solve_time_optimal_law(along, motors=MotorLimits((0.3, 0.3)))
+    assert capped.duration > 1.3 * before.duration, (before.duration, capped.duration)
+    assert capped.duration == pytest.approx(half.duration, rel=1e-3)
+    tau = along.samples(capped, np.linspace(0, capped.duration, 501)).tau
+    assert np.abs(tau).max() <= 0.3 * (1 + 1e-3)
+    assert solve_time_optimal_law(along, motors=motors).duration == pytest.approx(
+        before.duration, rel=1e-9)

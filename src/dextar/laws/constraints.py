@@ -40,7 +40,7 @@ check finds an excess of a kind, the solver tightens every constraint of that ki
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from functools import cached_property
 from typing import Protocol
@@ -49,6 +49,7 @@ import numpy as np
 
 from .._arrays import Array
 from ..motors import MotorLimits
+from ..registry import Registry
 from .base import Law
 
 
@@ -191,8 +192,13 @@ class Constraint(ABC):
         return False
 
     @abstractmethod
+    def sample_ratios(self, js: JointSamples) -> Array:
+        """The ratio of the limited quantity to its limit at each sample (n,), or for a limit
+        on a rate between each two consecutive samples (n - 1,)."""
+
     def ratio(self, js: JointSamples) -> float:
         """Largest ratio of the limited quantity to its limit on the samples."""
+        return float(self.sample_ratios(js).max(initial=0.0))
 
     @abstractmethod
     def scaled(self, scales: Mapping[str, float]) -> Constraint:
@@ -236,9 +242,9 @@ class TorqueLimit(Constraint):
         """A viscous friction's bound is a tangent."""
         return bool(np.any(co.viscous > 0))
 
-    def ratio(self, js: JointSamples) -> float:
-        """Largest ``|tau_i| / peak_i``."""
-        return MotorLimits(self.peak).torque_ratio(js.tau, js.dq)
+    def sample_ratios(self, js: JointSamples) -> Array:
+        """``max_i |tau_i| / peak_i`` at each sample."""
+        return _torque_ratios(MotorLimits(self.peak), js)
 
     def scaled(self, scales: Mapping[str, float]) -> TorqueLimit:
         """The peak torques tightened by ``scales["torque"]``."""
@@ -264,9 +270,9 @@ class SpeedLimit(Constraint):
             return np.asarray(np.min(np.where(co.dq_ds != 0, (wmax / np.abs(co.dq_ds)) ** 2,
                                               np.inf), axis=1))
 
-    def ratio(self, js: JointSamples) -> float:
-        """Largest ``|qdot_i| / max_speed_i``."""
-        return float((np.abs(js.dq) / np.asarray(self.max_speed, float)).max())
+    def sample_ratios(self, js: JointSamples) -> Array:
+        """``max_i |qdot_i| / max_speed_i`` at each sample."""
+        return np.asarray((np.abs(js.dq) / np.asarray(self.max_speed, float)).max(axis=1))
 
     def scaled(self, scales: Mapping[str, float]) -> SpeedLimit:
         """The speeds tightened by ``scales["speed"]``."""
@@ -316,9 +322,9 @@ class TorqueSpeedEnvelope(Constraint):
         """The envelope's ``sqrt(x)`` is bounded by a tangent."""
         return True
 
-    def ratio(self, js: JointSamples) -> float:
-        """Largest ``|tau_i|`` over the torque available at the sample's speed."""
-        return MotorLimits(self.peak, self.max_speed, self.knee).torque_ratio(js.tau, js.dq)
+    def sample_ratios(self, js: JointSamples) -> Array:
+        """``max_i |tau_i|`` over the torque available at the sample's speed."""
+        return _torque_ratios(MotorLimits(self.peak, self.max_speed, self.knee), js)
 
     def scaled(self, scales: Mapping[str, float]) -> TorqueSpeedEnvelope:
         """Peak tightened by ``scales["torque"]``, speeds by ``scales["speed"]``."""
@@ -348,16 +354,28 @@ class AccelerationLimit(Constraint):
         return PointRows(np.concatenate([d1, -d1], axis=1), np.concatenate([d2, -d2], axis=1),
                          np.concatenate([amax, amax], axis=1))
 
-    def ratio(self, js: JointSamples) -> float:
-        """Largest ``|qddot_i| / max_acceleration_i`` (0 without accelerations)."""
+    def sample_ratios(self, js: JointSamples) -> Array:
+        """``max_i |qddot_i| / max_acceleration_i`` at each sample (0 without
+        accelerations)."""
         if js.ddq is None:
-            return 0.0
-        return float((np.abs(js.ddq) / np.asarray(self.max_acceleration, float)).max())
+            return np.zeros(len(js.tau))
+        return np.asarray((np.abs(js.ddq) / np.asarray(self.max_acceleration, float))
+                          .max(axis=1))
 
     def scaled(self, scales: Mapping[str, float]) -> AccelerationLimit:
         """The accelerations tightened by ``scales["acceleration"]``."""
         return replace(self, max_acceleration=_pair(np.asarray(self.max_acceleration, float)
                                                     * scales.get("acceleration", 1.0)))
+
+
+def _torque_ratios(motors: MotorLimits, js: JointSamples) -> Array:
+    """``max_i |tau_i| / available torque_i`` at each sample (``inf`` where a torque is asked
+    of a motor that has none left)."""
+    avail = motors.available_torque(js.dq)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r = np.where(avail > 0, np.abs(js.tau) / avail,
+                     np.where(np.abs(js.tau) > 0, np.inf, 0.0))
+    return np.asarray(r.max(axis=1))
 
 
 def _rate(values: Array | None, t: Array | None) -> Array | None:
@@ -377,10 +395,11 @@ class JerkLimit(Constraint):
     kind: str = "jerk"
     order: int = 3
 
-    def ratio(self, js: JointSamples) -> float:
-        """Largest ``|d qddot_i / dt| / max_jerk_i`` between consecutive samples."""
+    def sample_ratios(self, js: JointSamples) -> Array:
+        """``max_i |d qddot_i / dt| / max_jerk_i`` between consecutive samples."""
         r = _rate(js.ddq, js.t)
-        return 0.0 if r is None else float((np.abs(r) / np.asarray(self.max_jerk, float)).max())
+        return np.zeros(0) if r is None else np.asarray(
+            (np.abs(r) / np.asarray(self.max_jerk, float)).max(axis=1))
 
     def scaled(self, scales: Mapping[str, float]) -> JerkLimit:
         """The jerks tightened by ``scales["jerk"]``."""
@@ -397,11 +416,11 @@ class TorqueRateLimit(Constraint):
     kind: str = "torque_rate"
     order: int = 3
 
-    def ratio(self, js: JointSamples) -> float:
-        """Largest ``|d tau_i / dt| / max_torque_rate_i`` between consecutive samples."""
+    def sample_ratios(self, js: JointSamples) -> Array:
+        """``max_i |d tau_i / dt| / max_torque_rate_i`` between consecutive samples."""
         r = _rate(js.tau, js.t)
-        return 0.0 if r is None else float((np.abs(r) / np.asarray(self.max_torque_rate,
-                                                                     float)).max())
+        return np.zeros(0) if r is None else np.asarray(
+            (np.abs(r) / np.asarray(self.max_torque_rate, float)).max(axis=1))
 
     def scaled(self, scales: Mapping[str, float]) -> TorqueRateLimit:
         """The rates tightened by ``scales["torque_rate"]``."""
@@ -409,22 +428,62 @@ class TorqueRateLimit(Constraint):
                                                    * scales.get("torque_rate", 1.0)))
 
 
+@dataclass(frozen=True)
+class ConstraintType:
+    """A kind of limit the laws honour, built from the motors' limits.
+
+    Attributes
+    ----------
+    name : str
+        Its name in :data:`CONSTRAINT_TYPES` (and in the docs).
+    build : callable
+        ``build(motors)``: the constraint for these limits, or None where they do not set it
+        (a speed limit without ``max_speed``).
+    help : str
+        One line for the docs.
+    """
+
+    name: str
+    build: Callable[[MotorLimits], Constraint | None]
+    help: str = ""
+
+
+#: The limits every time-optimal law (second and third order) plans within, in the order
+#: they are built. A new limit is a :class:`Constraint` and one ``register`` call; an
+#: installed package adds one through the entry-point group ``dextar.constraints``.
+CONSTRAINT_TYPES: Registry[ConstraintType] = Registry("constraint", "constraint",
+                                                      group="dextar.constraints")
+
+
+def _finite_speed(m: MotorLimits) -> Constraint | None:
+    return (SpeedLimit(m.max_speed) if np.isfinite(np.asarray(m.max_speed, float)).any()
+            else None)
+
+
+for _kind in (
+        ConstraintType("torque", lambda m: TorqueLimit(m.peak_torque),
+                       "each motor's peak torque (with friction)"),
+        ConstraintType("speed", _finite_speed, "each motor's speed limit, when finite"),
+        ConstraintType("envelope", lambda m: None if m.knee_speed is None else
+                       TorqueSpeedEnvelope(m.peak_torque, m.max_speed, m.knee_speed),
+                       "the torque-speed envelope, when it has a knee"),
+        ConstraintType("acceleration", lambda m: None if m.max_acceleration is None else
+                       AccelerationLimit(m.max_acceleration),
+                       "each joint's acceleration limit, when given"),
+        ConstraintType("jerk", lambda m: None if m.max_jerk is None else
+                       JerkLimit(m.max_jerk), "each joint's jerk limit, when given"),
+        ConstraintType("torque_rate", lambda m: None if m.max_torque_rate is None else
+                       TorqueRateLimit(m.max_torque_rate),
+                       "each motor's torque rate limit, when given")):
+    CONSTRAINT_TYPES.register(_kind)
+
+
 def motor_constraints(motors: MotorLimits) -> tuple[Constraint, ...]:
-    """The motors' limits as constraints: the peak torque, the speed limit (when finite), the
-    torque-speed envelope (when it has a knee), and the acceleration, jerk and torque-rate
-    limits (when given)."""
-    out: list[Constraint] = [TorqueLimit(motors.peak_torque)]
-    if np.isfinite(np.asarray(motors.max_speed, float)).any():
-        out.append(SpeedLimit(motors.max_speed))
-    if motors.knee_speed is not None:
-        out.append(TorqueSpeedEnvelope(motors.peak_torque, motors.max_speed, motors.knee_speed))
-    if motors.max_acceleration is not None:
-        out.append(AccelerationLimit(motors.max_acceleration))
-    if motors.max_jerk is not None:
-        out.append(JerkLimit(motors.max_jerk))
-    if motors.max_torque_rate is not None:
-        out.append(TorqueRateLimit(motors.max_torque_rate))
-    return tuple(out)
+    """The motors' limits as constraints, one per registered :class:`ConstraintType` that
+    the limits set (:data:`CONSTRAINT_TYPES`: the peak torque, the speed limit when finite,
+    the torque-speed envelope when it has a knee, and the acceleration, jerk and torque-rate
+    limits when given)."""
+    return tuple(c for kind in CONSTRAINT_TYPES.values() if (c := kind.build(motors)) is not None)
 
 
 def point_rows(constraints: Sequence[Constraint], tangent: Tangent) -> PointRows:

@@ -200,7 +200,13 @@ def solve_time_optimal_law(dynamics: PathDynamics, *,
     x0 = _first_tangent(speed_cap(cons, co)) if tangent else None
     limits = (_torque_limit(cons), _speed_limit(cons))
     for solve in range(1, MAX_SOLVES + 1):
-        x = _reachability(co, ds, [c.scaled(scales) for c in cons], x0, units)
+        try:
+            x = _reachability(co, ds, [c.scaled(scales) for c in cons], x0, units, tmax)
+        except InfeasibleError:
+            if law is None or all(v == 1.0 for v in scales.values()):
+                raise  # no motion within the user's own limits
+            break  # the limits tightened for the grid leave none: the last law, beyond them
+
         tangent_moved = tangent and (x0 is None or np.abs(np.sqrt(x) - np.sqrt(x0)).max()
                                      > TANGENT_RTOL * np.sqrt(x).max())
         bounded = x0 is not None or not tangent  # friction bound in place
@@ -363,12 +369,11 @@ def _stage_rows(pu: Array, px: Array, ph: Array, xmax: Array, ds: Array
 
 
 def _reachability(co: PathCoefficients, ds: Array, constraints: Sequence[Constraint],
-                  x0: Array | None, units: Units | None) -> Array:
+                  x0: Array | None, units: Units | None, tmax: Array) -> Array:
     """Squared speeds ``x`` at the grid points of the fastest admissible motion: the
     controllable sets from rest at the end backward, then the largest acceleration from rest
-    at the start forward."""
+    at the start forward (``tmax``: the user's torque limits, for the words of an error)."""
     Gu, Gx, h = _rows(co, ds, constraints, x0)
-    tmax = np.asarray(_torque_limit(constraints), float)  # for the words of an error
 
     def unreachable(k: int) -> InfeasibleError:
         return _unreachable(co, k, tmax, units)

@@ -228,36 +228,71 @@ def moves_figure(res: ProgramResult, robot_mm: FiveBar, mode: str) -> Figure:
 
 
 def motion_figure(res: ProgramResult) -> Figure:
-    """Joint angles, speeds and torques against time, move boundaries dotted, limits dashed."""
-    fig = new_figure((7.0, 8.0))
-    axes = fig.subplots(3, 1, sharex=True)
-    t = res.t
-    labels = ("motor A", "motor D")
-    for i in range(2):
-        axes[0].plot(t, np.degrees(res.q[:, i]), label=labels[i])
-        axes[1].plot(t, res.dq[:, i], label=labels[i])
-        axes[2].plot(t, res.tau[:, i], label=labels[i])
+    """Joint angles, speeds and torques against time, move boundaries dotted, limits dashed;
+    with the joint accelerations when the motors limit them or their jerk, the joint jerks
+    (finite differences of the setpoints) when they limit the jerk, and the torque rates
+    when they limit those, each with its limits."""
     m = res.motors
+    t = res.t
+    acc = m is not None and (m.max_acceleration is not None or m.max_jerk is not None)
+    jerk = m is not None and m.max_jerk is not None
+    rate = m is not None and m.max_torque_rate is not None
+    rows = 3 + acc + jerk + rate
+    fig = new_figure((7.0, 2.6 * rows + 0.2))
+    axes = list(fig.subplots(rows, 1, sharex=True))
+    ax_q, ax_v = axes[0], axes[1]
+    ax_a = axes[2] if acc else None
+    ax_j = axes[2 + acc] if jerk else None
+    ax_r = axes[2 + acc + jerk] if rate else None
+    ax_tau = axes[-1]
+    labels = ("motor A", "motor D")
+    dt = np.diff(t)
+    safe = np.where(dt > 0, dt, np.inf)[:, None]
+    tm = 0.5 * (t[1:] + t[:-1])
+    for i in range(2):
+        ax_q.plot(t, np.degrees(res.q[:, i]), label=labels[i])
+        ax_v.plot(t, res.dq[:, i], label=labels[i])
+        ax_tau.plot(t, res.tau[:, i], label=labels[i])
+        if ax_a is not None:
+            ax_a.plot(t, res.ddq[:, i], label=labels[i])
+        if ax_j is not None:
+            ax_j.plot(tm, np.diff(res.ddq[:, i]) / safe[:, 0], label=labels[i])
+        if ax_r is not None:
+            ax_r.plot(tm, np.diff(res.tau[:, i]) / safe[:, 0], label=labels[i])
     if m is not None:
         for i, style in ((0, "C0"), (1, "C1")):
-            if np.isfinite(m.max_speed[i]):
-                for sgn in (1, -1):
-                    axes[1].axhline(sgn * m.max_speed[i], color=style, ls="--", lw=0.8)
+            limits = [(ax_v, m.max_speed[i])]
+            if ax_a is not None and m.max_acceleration is not None:
+                limits.append((ax_a, m.max_acceleration[i]))
+            if ax_j is not None and m.max_jerk is not None:
+                limits.append((ax_j, m.max_jerk[i]))
+            if ax_r is not None and m.max_torque_rate is not None:
+                limits.append((ax_r, m.max_torque_rate[i]))
+            for ax, lim in limits:
+                if np.isfinite(lim):
+                    for sgn in (1, -1):
+                        ax.axhline(sgn * lim, color=style, ls="--", lw=0.8)
             avail = m.available_torque(res.dq)[:, i]
-            axes[2].plot(t, avail, color=style, ls="--", lw=0.8)
-            axes[2].plot(t, -avail, color=style, ls="--", lw=0.8)
+            ax_tau.plot(t, avail, color=style, ls="--", lw=0.8)
+            ax_tau.plot(t, -avail, color=style, ls="--", lw=0.8)
     changes = t[1:][np.diff(res.move_index) != 0]  # where the next move starts
     for ax in axes:
         for tc in changes:
             ax.axvline(tc, color="grey", ls=":", lw=0.8)
         ax.grid(alpha=0.3)
-    axes[0].set_ylabel("angle [deg]")
-    axes[1].set_ylabel("speed [rad/s]")
-    axes[2].set_ylabel("torque [N m]")
-    axes[2].set_xlabel("time [s]")
-    axes[0].legend(fontsize=8)
-    axes[0].set_title("Joint motion and torques (dashed: the motors' limits; dotted: moves)",
-                      fontsize=10)
+    ax_q.set_ylabel("angle [deg]")
+    ax_v.set_ylabel("speed [rad/s]")
+    if ax_a is not None:
+        ax_a.set_ylabel("acceleration [rad/s^2]")
+    if ax_j is not None:
+        ax_j.set_ylabel("jerk [rad/s^3]")
+    if ax_r is not None:
+        ax_r.set_ylabel("torque rate [N m/s]")
+    ax_tau.set_ylabel("torque [N m]")
+    ax_tau.set_xlabel("time [s]")
+    ax_q.legend(fontsize=8)
+    ax_q.set_title("Joint motion and torques (dashed: the motors' limits; dotted: moves)",
+                   fontsize=10)
     tight_layout(fig)
     return fig
 

@@ -1,0 +1,267 @@
+"""The limits as rows of the transcription, at any motion, with their gradients in the states
+at the knots and the duration (the linearisation each linear programme takes)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..._arrays import Array
+from ..constraints import (
+    Constraint,
+    JerkLimit,
+    PointRows,
+    Tangent,
+    TorqueRateLimit,
+    point_rows,
+    speed_cap,
+)
+from .mesh import Mesh, Motion, knot_T
+from .table import DA, DB, DG, Q1, Q2, Q3, A, B, Table, interp
+
+#: Intervals whose rows are built at once (the temporaries of a block are a few hundred
+#: bytes a row).
+CHUNK = 2048
+
+
+@dataclass(frozen=True)
+class Rows:
+    """The rows ``F <= 0`` (R,) at a motion, each at a point of an interval ``k`` (R,), and
+    their gradients in the LP's variables of that interval: ``C`` (R, 5) in ``sigma_k, w_k,
+    alpha_k, alpha_k+1, T`` (the jerk of the interval is ``(alpha_k+1 - alpha_k) / h``).
+
+    Each row is its limit's polynomial form (``pu alpha + px w^2 - ph T^2``, ``q' J + ...
+    - j_max T^3``) over a normalisation ``norm`` (R,) taken at the motion (its limit's scale:
+    ``|ph| T^2``, ``j_max T^3``): the gradients keep the normalisation fixed, so the linear
+    model is the polynomial form's, whose dependence on ``T`` is concave (a tangent above
+    it: the model never underestimates a row when ``T`` shrinks)."""
+
+    F: Array
+    k: Array
+    C: Array
+    norm: Array
+    sizes: Array  # (R, 5) float32: |d/d sigma|, |d/d w|, |d/d alpha|, |d/d J|, |d/d T|
+    kinds: tuple[tuple[str, int], ...] = ()  # (what, how many) per block (development)
+
+    def kind_of(self, i: int) -> str:
+        """The block row ``i`` belongs to (for the log)."""
+        for name, n in self.kinds:
+            if i < n:
+                return name
+            i -= n
+        return "?"
+
+    def powers(self) -> Array:
+        """How each row's use scales with ``1 / T`` for a fixed normalised motion (about:
+        the speed cap 1, the torques and accelerations 2, the third-order limits 3; 0 for
+        the rows that do not scale)."""
+        p = {"second-order": 2.0, "cap": 1.0, "w>=0": 0.0}
+        return np.concatenate([np.full(n, p.get(name, 3.0)) for name, n in self.kinds])
+
+    def linear(self, d_sigma: Array, d_w: Array, d_alpha: Array, d_alpha_end: Array,
+               d_T: Array) -> Array:
+        """The rows' linear model after a change of the knots' states (M + 1,), of the
+        intervals' end accelerations in their own normalisation and of their durations
+        (M,)."""
+        k, C = self.k, self.C
+        return np.asarray(self.F + C[:, 0] * d_sigma[k] + C[:, 1] * d_w[k]
+                          + C[:, 2] * d_alpha[k] + C[:, 3] * d_alpha_end[k]
+                          + C[:, 4] * d_T[k])
+
+
+def local(h: Array, k: Array, theta: Array, gs: Array, gw: Array, ga: Array, gj: Array,
+           gT: Array) -> Array:
+    """A row's gradient ``C`` (n, 5) in its interval's ``sigma_k, w_k, alpha_k``, end
+    acceleration and duration ``T_k`` (all in the interval's normalisation) from its
+    derivatives in the point's ``sigma, w, alpha``, the interval's jerk ``J`` and ``T_k``
+    (each (n,)), the point ``theta`` into the interval ``k``; then those derivatives'
+    sizes (n, 5), for the bound of the row's change in a trust region."""
+    cJ = gs * theta**3 / 6 + gw * theta**2 / 2 + ga * theta + gj
+    ca = gs * theta**2 / 2 + gw * theta + ga
+    hk = h[k]
+    return np.stack([gs, gs * theta + gw, ca - cJ / hk, cJ / hk, gT, np.abs(gs), np.abs(gw),
+                     np.abs(ga), np.abs(gj), np.abs(gT)], axis=1)
+
+
+class Model:
+    """The rows of the transcription at any motion (see the module doc)."""
+
+    def __init__(self, mesh: Mesh, table: Table, second: Sequence[Constraint],
+                 third: Sequence[Constraint], length: float) -> None:
+        self.mesh, self.table, self.length = mesh, table, length
+        self.second, self.third = list(second), list(third)
+        M, h = mesh.M, mesh.h
+        k = np.arange(M)
+        # the points of the second-order rows: the inner knots and every interval's middle
+        self.k2 = np.concatenate([k[1:], k])
+        self.t2 = np.concatenate([np.zeros(M - 1), h / 2])
+        cap = speed_cap(second, table.co)
+        self._grad = True
+        self.root_cap = (None if not np.isfinite(cap).any()
+                         else np.sqrt(np.where(np.isfinite(cap), cap, 1e300)))
+
+    def tangent(self, mo: Motion) -> Array:
+        """The tangent points of the speed-dependent bounds on the grid: the motion's squared
+        speeds (floored at 1e-4 of the largest: a tangent above the speed is still an upper
+        bound, and near rest the viscous torque it bounds is small)."""
+        x = (np.maximum(mo.w, 0.0) / knot_T(mo.Tk)) ** 2
+        x0 = np.interp(self.table.s, mo.sigma, x)
+        return np.asarray(np.maximum(x0, 1e-4 * float(x0.max()) + 1e-300))
+
+    def rows(self, mo: Motion, gradients: bool = True) -> Rows:
+        """All rows at the motion, normalised by their limits (at its durations), built
+        :data:`CHUNK` intervals at a time (their temporaries bounded); without
+        ``gradients``, their values only (``C`` and ``sizes`` empty)."""
+        self._grad = gradients
+        x0 = self.tangent(mo)
+        tab = self.table
+        pr = point_rows(self.second, Tangent(tab.moving, np.concatenate([x0[:1], x0,
+                                                                           x0[-1:]])))
+        pr = PointRows(pr.pu[1:-1], pr.px[1:-1], pr.ph[1:-1])
+        finite = np.isfinite(pr.ph)
+        phmax = float(np.abs(np.where(finite, pr.ph, 0.0)).max(initial=0.0))
+        parts = [self._block(mo, pr, finite, phmax, k0, min(k0 + CHUNK, self.mesh.M))
+                 for k0 in range(0, self.mesh.M, CHUNK)]
+        if len(parts) == 1:
+            return parts[0]
+        return Rows(np.concatenate([r.F for r in parts]), np.concatenate([r.k for r in parts]),
+                    np.concatenate([r.C for r in parts]),
+                    np.concatenate([r.norm for r in parts]),
+                    np.concatenate([r.sizes for r in parts]),
+                    tuple(kind for r in parts for kind in r.kinds))
+
+    def _loc(self, h: Array, k: Array, theta: Array, gs: Array, gw: Array, ga: Array,
+             gj: Array, gT: Array, keep: Array | None = None) -> Array:
+        """:func:`local` of the rows (those ``keep`` selects), or nothing when the rows are
+        built without their gradients."""
+        if not self._grad:
+            return np.zeros((0, 10))
+        out = local(h, k, theta, gs, gw, ga, gj, gT)
+        return out if keep is None else out[keep]
+
+    def _block(self, mo: Motion, pr: PointRows, finite: Array, phmax: float, k0: int,
+               k1: int) -> Rows:
+        """The rows of the intervals ``k0`` to ``k1`` (excluded)."""
+        mesh, tab, S = self.mesh, self.table, self.length
+        h = mesh.h
+        m = pr.pu.shape[1]
+        in2 = (self.k2 >= k0) & (self.k2 < k1)
+        k, th = self.k2[in2], self.t2[in2]
+        sig, w, al = mo.at(mesh, k, th)
+        vals, slopes = interp(tab.s, np.concatenate([pr.pu, pr.px, np.where(finite, pr.ph,
+                                                                             0.0)], axis=1),
+                               sig)
+        pu, px, ph = vals[:, :m], vals[:, m:2 * m], vals[:, 2 * m:]
+        dpu, dpx, dph = slopes[:, :m], slopes[:, m:2 * m], slopes[:, 2 * m:]
+        keep = (interp(tab.s, finite.astype(float), sig)[0] > 1 - 1e-12).reshape(-1)
+        a_, w_, T = al[:, None], w[:, None], mo.Tk[k][:, None]
+        c = np.maximum(np.abs(ph), 1e-9 * phmax + 1e-300) * T * T
+        F = (pu * a_ + px * w_ * w_ - ph * T * T) / c
+        kk, tt = np.repeat(k, m), np.repeat(th, m)
+        zero = np.zeros(len(kk))
+
+        def flat(v: Array) -> Array:
+            return np.asarray(v.reshape(-1))
+
+        Cs = [self._loc(h, kk, tt, flat((dpu * a_ + dpx * w_ * w_ - dph * T * T) / c),
+                        flat(2 * px * w_ / c), flat(pu / c), zero, flat(-2 * ph * T / c),
+                        keep)]
+        norms = [flat(np.broadcast_to(c, F.shape))[keep]]
+        Fs, ks, names = [flat(F)[keep]], [kk[keep]], ["second-order"]
+        n2 = len(k)
+        if self.root_cap is not None:  # w <= sqrt(cap) T
+            rv, rs = interp(tab.s, self.root_cap[:, None], sig)
+            rv, rs = rv[:, 0], rs[:, 0]
+            T = mo.Tk[k]
+            c2 = np.maximum(rv, 1e-300) * T
+            Fc = (w - rv * T) / c2
+            Fs.append(Fc)
+            Cs.append(self._loc(h, k, th, -rs * T / c2, 1.0 / c2, np.zeros(n2),
+                                np.zeros(n2), -rv / c2))
+            norms.append(c2)
+            ks.append(k)
+            names.append("cap")
+        Fs.append(-w / S)  # the speed stays >= 0
+        norms.append(np.full(n2, S))
+        Cs.append(self._loc(h, k, th, np.zeros(n2), np.full(n2, -1.0 / S), np.zeros(n2),
+                            np.zeros(n2), np.zeros(n2)))
+        ks.append(k)
+        names.append("w>=0")
+        kM = np.arange(k0, k1)
+        for th3, before in zip((np.zeros(k1 - k0), h[kM] / 2, h[kM]), (False, False, True),
+                               strict=True):
+            sig, w, al = mo.at(mesh, kM, th3)
+            v, d = tab.at(sig, before)
+            F3, C3, k3, n3 = self._third_at(mo, kM, th3, v, d, w, al)
+            norms.append(n3)
+            Fs.append(F3)
+            Cs.append(C3)
+            ks.append(k3)
+            names.append("third")
+        C = np.concatenate([c[:, :5] for c in Cs])
+        sizes = np.concatenate([c[:, 5:].astype(np.float32) for c in Cs])
+        del Cs
+        return Rows(np.concatenate(Fs), np.concatenate(ks).astype(np.int32), C,
+                    np.concatenate(norms), sizes,
+                    tuple((n, len(f)) for n, f in zip(names, Fs, strict=True)))
+
+    def _third_at(self, mo: Motion, k: Array, theta: Array, v: Array, d: Array, w: Array,
+                  al: Array) -> tuple[Array, Array, Array, Array]:
+        """The joint jerk and torque-rate rows, on both sides of each limit, at offsets
+        ``theta`` into the intervals ``k`` (n,), with the table's columns ``v`` and slopes
+        ``d`` (n, 18) and the states ``w, al`` (n,) there: rows, gradients, intervals,
+        normalisations."""
+        T = mo.Tk[k][:, None]
+        h = self.mesh.h
+        q1, q2, q3 = v[:, Q1], v[:, Q2], v[:, Q3]
+        dq1, dq2, dq3 = d[:, Q1], d[:, Q2], d[:, Q3]
+        jj, ww, aa = mo.J[k][:, None], w[:, None], al[:, None]
+        Fs: list[Array] = []
+        Cs: list[Array] = []
+        Ns: list[Array] = []
+        for c in self.third:
+            if isinstance(c, JerkLimit):
+                lim = np.asarray(c.max_jerk, float)
+                val = q1 * jj + 3 * q2 * ww * aa + q3 * ww**3
+                gs = dq1 * jj + 3 * dq2 * ww * aa + dq3 * ww**3
+                gw = 3 * q2 * aa + 3 * q3 * ww * ww
+                ga = 3 * q2 * ww
+                gj = q1
+                gT = np.zeros_like(val)
+            elif isinstance(c, TorqueRateLimit):
+                lim = np.asarray(c.max_torque_rate, float)
+                a, b = v[:, A], v[:, B]
+                da, db, dg = v[:, DA], v[:, DB], v[:, DG]
+                co = self.table.co
+                vs = co.coulomb_speed
+                # the friction's slope in the joint speed at the motion's speed (held in the
+                # linearisation: near a reversal the regularised Coulomb torque's is steep)
+                cf = co.viscous + co.coulomb / vs / np.cosh(np.clip(q1 * ww / T / vs,
+                                                                    -300, 300)) ** 2
+                acc = q1 * aa + q2 * ww * ww  # T^2 qddot
+                val = (a * jj + (da + 2 * b) * ww * aa + db * ww**3 + dg * ww * T * T
+                       + cf * acc * T)
+                gs = (d[:, A] * jj + (d[:, DA] + 2 * d[:, B]) * ww * aa
+                      + d[:, DB] * ww**3 + d[:, DG] * ww * T * T
+                      + cf * (dq1 * aa + dq2 * ww * ww) * T)
+                gw = (da + 2 * b) * aa + 3 * db * ww * ww + dg * T * T + cf * 2 * q2 * ww * T
+                ga = (da + 2 * b) * ww + cf * q1 * T
+                gj = a
+                gT = 2 * dg * ww * T + cf * acc
+            else:
+                continue
+            scale = lim * T**3
+            kk, tt = np.repeat(k, 2), np.repeat(theta, 2)
+            for sign in (1.0, -1.0):
+                Fs.append(((sign * val - scale) / scale).reshape(-1))
+                Ns.append(np.broadcast_to(scale, val.shape).reshape(-1))
+                g_s, g_w, g_a, g_j = ((sign * x / scale).reshape(-1) for x in (gs, gw, ga, gj))
+                Cs.append(self._loc(h, kk, tt, g_s, g_w, g_a, g_j,
+                                    ((sign * gT - 3 * lim * T * T) / scale).reshape(-1)))
+        if not Fs:
+            return np.zeros(0), np.zeros((0, 10)), np.zeros(0, int), np.zeros(0)
+        n = len(Fs)
+        return (np.concatenate(Fs), np.concatenate(Cs), np.tile(np.repeat(k, 2), n),
+                np.concatenate(Ns))

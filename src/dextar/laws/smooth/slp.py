@@ -1,0 +1,361 @@
+"""Sequential linear programming with a trust region on the transcription's rows.
+
+Each linear programme minimises ``T`` plus an exact l-infinity penalty on the rows (an elastic
+slack, so that it is always feasible) within a trust region (a box on the knots'
+accelerations and on ``T``); a step is taken when the actual reduction of the merit function
+(``T`` plus the penalty on the true rows) is a fair share of the predicted one, the trust
+region growing or shrinking with their ratio (Fletcher's Sl1QP with a linear model; Fletcher,
+*Practical Methods of Optimization*, 2nd ed., Wiley 1987, ch. 14; Nocedal & Wright,
+*Numerical Optimization*, 2nd ed., Springer 2006, sec. 18.5).
+
+The programme's variables are the states at the knots (``sigma, w, alpha``), ``T`` and the
+slack; the equalities are the exact integration of each interval's constant jerk, so the
+programme is banded (:mod:`.banded`, linear in the knots). A row joins a programme when the
+trust region lets it reach its limit: the box on the accelerations bounds how far the speeds
+and arc lengths can move (their integrals from the nearer end, both ends being fixed), so the
+rows left out cannot be crossed by the programme's solution (checked after each programme).
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..._arrays import Array
+from .banded import LPResult, StagedLP, solve_staged
+from .mesh import Mesh, Motion, knot_T, motion, projected
+from .rows import Model, Rows
+
+log = logging.getLogger(__name__)
+
+#: The first trust region (a fraction of the largest knot acceleration of the start), and
+#: the one after a refinement or a tightening (from a motion near the answer).
+START_DELTA = 0.3
+RESTART_DELTA = 0.1
+#: The trust region's share for ``T``: it moves by at most this times ``delta`` (relative).
+T_SHARE = 0.5
+#: The trust region's share for the durations of neighbouring stretches relative to each
+#: other (their ratio moves by at most this times ``delta``).
+RHO_SHARE = 0.01
+#: The trust region's floor for the speeds, a fraction of the largest.
+W_FLOOR = 0.2
+#: Weight of the l-infinity penalty on the rows (normalised) against ``T / T_start``: above
+#: the sum of the rows' multipliers (at most about 1: relaxing every limit by a fraction
+#: ``e`` shortens the motion by at most ``e T``), so that the penalty is exact.
+PENALTY = 3.0
+#: Weight of the reward for progress (the mean of the knots' arc lengths over the path's
+#: length) against ``T / T_start``: it costs ``T`` at most this fraction.
+PROGRESS = 1e-4
+#: Convergence: a step taken after which the largest row (relative to its limit) is below
+#: ``FEAS_TOL`` (a tenth of the check's tolerance) and whose predicted reduction of the merit
+#: was below ``STEP_TOL``, or which moved ``T`` by less than ``STEP_TOL`` (relative) from
+#: inside the trust region. Near the solution the SLP converges fast (the programmes'
+#: solutions are near vertices), so the next step would be far smaller still.
+STEP_TOL = 1e-4
+FEAS_TOL = 1e-4
+
+
+def merit(T: float, T_ref: float, F: Array, ahead: float) -> float:
+    """``T`` (relative), the exact penalty on the largest row, the small reward for being
+    ahead (:data:`PROGRESS`)."""
+    return T / T_ref + PENALTY * max(0.0, float(F.max())) - PROGRESS * ahead
+
+
+@dataclass(frozen=True)
+class Run:
+    """What an SLP run found and what it cost: the normalised jerks and the intervals'
+    durations, the programmes solved, whether they settled, and the largest row at the
+    motion."""
+
+    J: Array
+    Tk: Array
+    programmes: int
+    converged: bool
+    worst: float
+
+
+class Programme:
+    """The linear programme on a mesh (see the module doc): its variables are each knot's
+    ``sigma, w, alpha, T`` (``T`` the duration of the knot's stretch) and the slack; its
+    equalities each interval's exact integration and, inside a stretch, the duration's
+    continuity (at a pinned knot the end states change normalisation, ``w_end = rho w``,
+    ``alpha_end = rho^2 alpha`` with ``rho = T_k / T_k+1``: linearised)."""
+
+    def __init__(self, mesh: Mesh, length: float) -> None:
+        M, h = mesh.M, mesh.h
+        self.mesh, self.M, self.length = mesh, M, length
+        K = M + 1
+        z, one = np.zeros(M), np.ones(M)
+        # w_k+1 - w_k = h (alpha_k + alpha_k+1) / 2, the arc length's over h, T_k = T_k+1,
+        # on (sigma, w, alpha, T) of knots k and k + 1
+        E = np.stack([np.stack([z, -one, -h / 2, z, z, one, -h / 2, z], axis=1),
+                      np.stack([-1 / h, -one, -h / 3, z, 1 / h, z, -h / 6, z], axis=1),
+                      np.stack([z, z, z, one, z, z, z, -one], axis=1)], axis=1)
+        self.into_pin = mesh.pinned[1:]  # the intervals that end at a pinned knot
+        E[self.into_pin, 2, :] = 0.0
+        self.E = E
+        lo = np.stack([np.zeros(K), np.zeros(K), np.zeros(K), np.zeros(K)], axis=1)
+        hi = np.stack([np.full(K, length), np.full(K, np.inf), np.zeros(K), np.zeros(K)],
+                      axis=1)
+        lo[-1, 0], hi[0, 0] = length, 0.0
+        hi[0, 1] = hi[-1, 1] = 0.0
+        lo[mesh.pins, 0] = hi[mesh.pins, 0] = mesh.pin_s
+        self.lo, self.hi = lo, hi
+        self.c = np.zeros(4 * K + 1)
+        self.c[4:4 * M:4] = -PROGRESS / ((M - 1) * length)  # the reward for being ahead
+        self.c[-1] = PENALTY
+        # how far the arc lengths and speeds can move per unit change of the accelerations:
+        # their integrals from the nearer end (at any point of the interval)
+        g = np.minimum(mesh.f[:-1], 1.0 - mesh.f[1:]) + h
+        self.reach_sw = np.stack([g * g / 2, g], axis=1)
+
+    def ahead(self, mo: Motion) -> float:
+        """The mean of the inner knots' arc lengths over the path's length."""
+        return float(mo.sigma[1:self.M].sum()) / ((self.M - 1) * self.length)
+
+    def reach(self, rows: Rows, mo: Motion, delta: float, scale: float, jscale: float
+              ) -> Array:
+        """The largest change of each row's linear model within the trust region: the
+        accelerations within ``delta * scale`` (so the speeds and arc lengths within their
+        integrals), the jerks within ``delta * jscale``, the durations within
+        ``T_SHARE * delta`` (relative; at a pinned knot the end acceleration with them)."""
+        G, k = rows.sizes, rows.k
+        d, dT = delta * scale, T_SHARE * delta
+        return np.asarray(d * (G[:, 0] * self.reach_sw[k, 0] + G[:, 1] * self.reach_sw[k, 1]
+                               + G[:, 2]) + delta * jscale * G[:, 3]
+                          + dT * (G[:, 4] * mo.Tk[k] + 4 * np.abs(rows.C[:, 3] * mo.alpha_end[k])
+                                  * self.into_pin[k]))
+
+    def _end_terms(self, mo: Motion) -> tuple[Array, Array, Array, Array, Array, Array]:
+        """The linearised end states of every interval in its own normalisation:
+        ``w_end = rw w_k+1 + tw``, ``alpha_end = ra alpha_k+1 + ta`` with ``tw, ta`` linear in
+        ``T_k / T0_k - T_k+1 / T0_k+1`` (coefficients ``cw, ca``); (M,) each."""
+        Tn = knot_T(mo.Tk)
+        rho = Tn[:-1] / Tn[1:]
+        pin = self.into_pin
+        rho = np.where(pin, rho, 1.0)
+        cw = np.where(pin, rho * mo.w[1:], 0.0)
+        ca = np.where(pin, 2 * rho * rho * mo.alpha[1:], 0.0)
+        return rho, rho * rho, cw, ca, Tn[:-1], Tn[1:]
+
+    def _local(self, C: Array, k: Array, mo: Motion, out: Array | None = None) -> Array:
+        """The rows' coefficients (n, 6) on ``sigma_k, w_k, alpha_k, T_k, alpha_k+1,
+        T_k+1`` from their gradients ``C`` (n, 5) in the interval's own states (into
+        ``out`` when given)."""
+        _, r2, _, ca, T0, T1 = self._end_terms(mo)
+        out = np.empty((len(k), 6)) if out is None else out
+        c3 = C[:, 3]
+        out[:, :3] = C[:, :3]
+        out[:, 3] = C[:, 4] + c3 * (ca / T0)[k]
+        out[:, 4] = c3 * r2[k]
+        out[:, 5] = -c3 * (ca / T1)[k]
+        return out
+
+    def x0(self, mo: Motion) -> Array:
+        """The motion as the programme's variables."""
+        return np.concatenate([np.stack([mo.sigma, mo.w, mo.alpha, knot_T(mo.Tk)],
+                                        axis=1).reshape(-1), [0.0]])
+
+    def solve(self, rows: Rows, use: Array, mo: Motion, T_ref: float, delta: float,
+              scale: float, jscale: float) -> LPResult:
+        """The programme on the rows ``use`` (a mask) about the motion ``mo``, within the
+        trust region: the accelerations within ``delta * scale`` of the motion's, the
+        durations within ``T_SHARE * delta`` (relative) of theirs."""
+        M, mesh = self.M, self.mesh
+        sel = np.flatnonzero(use)
+        R = len(sel)
+        pin = self.into_pin
+        kp, kj = np.flatnonzero(pin), np.flatnonzero(~pin)
+        n = R + 2 * len(kp) + 2 * len(kj)
+        k = np.empty(n, np.int64)
+        ra = np.zeros((n, 6))
+        rb = np.empty(n)
+        rg = np.zeros((n, 1))
+        k[:R] = rows.k[sel]
+        self._local(rows.C[sel], k[:R], mo, ra[:R])
+        x0 = self.x0(mo)
+        rb[:R] = -rows.F[sel]
+        for j, off in enumerate((0, 1, 2, 3, 6, 7)):
+            rb[:R] += ra[:R, j] * x0[4 * k[:R] + off]
+        rg[:R] = -1.0
+        # the stretches' durations relative to each other change less than the whole: the
+        # jerk of the short interval into a pinned knot changes with the square of their
+        # ratio over the interval's length
+        _, _, _, _, T0, T1 = self._end_terms(mo)
+        i = R + np.arange(len(kp))
+        k[i], k[i + len(kp)] = kp, kp
+        ra[i, 3], ra[i, 5] = 1.0 / T0[kp], -1.0 / T1[kp]
+        ra[i + len(kp)] = -ra[i]
+        rb[i], rb[i + len(kp)] = RHO_SHARE * delta, RHO_SHARE * delta
+        # the jerks within delta * jscale of theirs (inside a stretch)
+        i = R + 2 * len(kp) + np.arange(len(kj))
+        k[i], k[i + len(kj)] = kj, kj
+        ra[i, 2], ra[i, 4] = -1.0 / mesh.h[kj], 1.0 / mesh.h[kj]
+        ra[i + len(kj)] = -ra[i]
+        jb = delta * jscale
+        rb[i], rb[i + len(kj)] = mo.J[kj] + jb, jb - mo.J[kj]
+        # the integration into a pinned knot, linearised in the durations
+        rho, r2, cw, ca, T0, T1 = self._end_terms(mo)
+        E = self.E.copy()
+        h = mesh.h[pin]
+        E[pin, 0, 5] = rho[pin]
+        E[pin, 0, 6] = -h / 2 * r2[pin]
+        E[pin, 1, 6] = -h / 6 * r2[pin]
+        dTe = np.stack([cw[pin] - h / 2 * ca[pin], -h / 6 * ca[pin]], axis=1)  # per unit
+        E[pin, :2, 3] = dTe / T0[pin, None]
+        E[pin, :2, 7] = -dTe / T1[pin, None]
+        lo, hi = self.lo.copy(), self.hi.copy()
+        inner = slice(1, M)
+        lo[inner, 2] = mo.alpha[inner] - delta * scale
+        hi[inner, 2] = mo.alpha[inner] + delta * scale
+        # the speeds within delta of theirs (relative, with a floor): the third-order rows
+        # grow as their cube, so a slow stretch (a blend) moves in proportion
+        wr = delta * (np.abs(mo.w[inner]) + W_FLOOR * float(np.abs(mo.w).max()))
+        lo[inner, 1] = np.maximum(mo.w[inner] - wr, 0.0)
+        hi[inner, 1] = mo.w[inner] + wr
+        Tn = knot_T(mo.Tk)
+        lo[:, 3] = Tn * (1 - T_SHARE * delta)
+        hi[:, 3] = Tn * (1 + T_SHARE * delta)
+        c = self.c.copy()
+        c[3:4 * M:4] = mesh.h / T_ref
+        lp = StagedLP(c, k, ra, rg, rb, E, np.zeros((M, 3)),
+                      np.concatenate([lo.reshape(-1), [0.0]]),
+                      np.concatenate([hi.reshape(-1), [np.inf]]))
+        return solve_staged(lp, x0)
+
+    def model(self, rows: Rows, x: Array, mo: Motion) -> Array:
+        """Every row's linear model at the programme's variables ``x``."""
+        _, r2, _, ca, T0, T1 = self._end_terms(mo)
+        d = (x[:-1] - self.x0(mo)[:-1]).reshape(-1, 4)
+        k, C = rows.k, rows.C
+        c3 = C[:, 3]
+        return np.asarray(rows.F + C[:, 0] * d[k, 0] + C[:, 1] * d[k, 1] + C[:, 2] * d[k, 2]
+                          + (C[:, 4] + c3 * (ca / T0)[k]) * d[k, 3]
+                          + c3 * (r2[k] * d[k + 1, 2] - (ca / T1)[k] * d[k + 1, 3]))
+
+    def motion(self, x: Array, length: float) -> Motion:
+        """The motion of a programme's solution: its accelerations and durations, the jerks
+        between them projected to meet the ends and the pinned knots exactly (the
+        linearised normalisation at the pinned knots leaves them a little off)."""
+        mesh = self.mesh
+        s = x[:-1].reshape(-1, 4)
+        Tn = np.maximum(s[:, 3], 1e-300)
+        Tk = Tn[:-1]
+        a = s[:, 2] / (Tn * Tn)
+        a[-1] = 0.0
+        j = np.diff(a) / (mesh.h * Tk)
+        j = projected(mesh, j, Tk, length)
+        return motion(mesh, j * Tk**3, Tk, length)
+
+
+def time_scaled(model: Model, J: Array, Tk: Array) -> Array:
+    """The durations that bring the normalised motion ``J`` just within its rows (a start
+    that is slower than the limits allow is sped up, one beyond them slowed down), all
+    scaled alike: each row's use scales about as ``T^-p`` (:meth:`Rows.powers`); exact
+    where it does, so a few rounds, then stretching while a row is still beyond its limit
+    (gravity or friction rows that scale more slowly)."""
+    Tk = np.asarray(Tk, float)
+    for _ in range(40):
+        rows = model.rows(motion(model.mesh, J, Tk, model.length), gradients=False)
+        i = int(np.argmax(rows.F))
+        worst = float(rows.F[i])
+        p = rows.powers()
+        use = np.maximum(rows.F + 1.0, 0.0)
+        on = p > 0
+        factor = float(np.max(use[on] ** (1.0 / p[on]))) if on.any() else 1.0
+        if worst <= 0.0 and abs(factor - 1.0) < 1e-3:
+            break
+        if worst > 0.0:
+            if p[i] == 0:
+                break  # a row the duration does not change
+            factor = max(factor, 1.5)
+        Tk = Tk * (factor * (1 + 1e-4))
+    return Tk
+
+
+def slp(model: Model, J: Array, Tk: Array, budget: int, delta: float) -> Run:
+    """Sequential linear programming with a trust region from the motion ``(J, Tk)``, which
+    meets the end conditions (see the module doc)."""
+    mesh, S = model.mesh, model.length
+    lp = Programme(mesh, S)
+    mo = motion(mesh, J, Tk, S)
+    T_ref = mo.T
+    rows = model.rows(mo)
+    phi = merit(mo.T, T_ref, rows.F, lp.ahead(mo))
+    n = 0
+    converged = False
+    scale = max(float(np.abs(mo.alpha).max()), 1e-300)
+    jscale = max(float(np.abs(mo.J).max()), 1e-300)
+    debug = log.isEnabledFor(logging.DEBUG)
+    while n < budget:
+        use = rows.F + lp.reach(rows, mo, delta, scale, jscale) > -1e-9
+        res = None
+        for _ in range(5):  # a row left out and crossed (rounding only) joins
+            res = lp.solve(rows, use, mo, T_ref, delta, scale, jscale)
+            n += 1
+            if res.status != 0:
+                break
+            crossed = ~use & (lp.model(rows, res.x, mo) > res.x[-1] + 1e-9)
+            if not crossed.any():
+                break
+            log.debug("      %d rows left out crossed", int(crossed.sum()))
+            use |= crossed
+        assert res is not None
+        if res.status != 0:  # numerical trouble: a smaller step
+            log.debug("    programme status %d after %d iterations", res.status, res.nit)
+            delta *= 0.25
+            if delta < 1e-8:
+                break
+            continue
+        eps = float(res.x[-1])
+        pred = phi - res.fun
+        mn = lp.motion(res.x, S)
+        new = model.rows(mn, gradients=False)  # (with them once the step is taken)
+        phin = merit(mn.T, T_ref, new.F, lp.ahead(mn))
+        actual = phi - phin
+        ratio = actual / pred if pred > 0 else (1.0 if actual >= 0 else -1.0)
+        step = max(float(np.abs(mn.alpha - mo.alpha).max()) / scale,
+                   float(np.abs(mn.Tk / mo.Tk - 1.0).max()) / T_SHARE)
+        if debug:
+            i = int(np.argmax(new.F))
+            log.debug("    T %.7f eps %.1e max row %.2e (%s) rows %d/%d pred %.1e ratio %.2f "
+                      "delta %.2g iterations %d", mn.T, eps, new.F.max(), new.kind_of(i),
+                      int(use.sum()), len(use), pred, ratio, delta, res.nit)
+        if ratio <= 0.1:  # back along the step: the rows are evaluated, no programme
+            x0 = lp.x0(mo)
+            lin1 = lp.model(rows, res.x, mo)
+            ahead0 = lp.ahead(mo)
+            for part in (0.5, 0.25):
+                mp = lp.motion(x0 + part * (res.x - x0), S)
+                rp = model.rows(mp, gradients=False)
+                php = merit(mp.T, T_ref, rp.F, lp.ahead(mp))
+                model_p = (mo.T + part * (mn.T - mo.T)) / T_ref + PENALTY * max(
+                    0.0, float((rows.F + part * (lin1 - rows.F))[use].max())) - PROGRESS * (
+                    ahead0 + part * (lp.ahead(mn) - ahead0))
+                pp = phi - model_p
+                rp_ratio = (phi - php) / pp if pp > 0 else -1.0
+                log.debug("      back to %.2f of the step: ratio %.2f", part, rp_ratio)
+                if rp_ratio > 0.1:
+                    mn, new, phin, pred, ratio = mp, rp, php, pp, rp_ratio
+                    step *= part
+                    break
+        if ratio > 0.1:
+            T_prev, delta_prev = mo.T, delta
+            del rows
+            mo, rows, phi = mn, model.rows(mn), phin
+            if ratio > 0.75 and step > 0.5 * delta:
+                delta = min(2 * delta, 2.0)
+            elif ratio < 0.25 or step < 0.5 * delta_prev:
+                delta = max(0.5 * delta, step)
+            if float(rows.F.max()) <= FEAS_TOL and (
+                    pred <= STEP_TOL or (abs(mo.T - T_prev) <= STEP_TOL * mo.T
+                                         and step < 0.5 * delta_prev)):
+                converged = True  # feasible, and T no longer moves within the region
+                break
+        else:
+            delta = 0.3 * min(delta, step)
+        if delta < 1e-9:
+            break
+    return Run(mo.J, mo.Tk, n, converged, float(rows.F.max()))

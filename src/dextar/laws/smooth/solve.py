@@ -1,0 +1,364 @@
+"""The jerk-limited law's solve: the start, the sequential linear programmes, the output check
+with its refinement, and the registered ``time-optimal`` builder that takes this law when
+the motors have a third-order limit."""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+
+from ..._arrays import Array
+from ...errors import InfeasibleError, ParameterError
+from ...motors import MotorLimits
+from ...units import Units
+from ..base import Law
+from ..constraints import Constraint, PathDynamics, motor_constraints
+from ..time_optimal import TimeOptimalLaw, solve_time_optimal_law
+from .check import RATE_KINDS, check
+from .law import JerkLimitedLaw
+from .mesh import Mesh, integrate, make_mesh
+from .rows import Model
+from .slp import FEAS_TOL, RESTART_DELTA, START_DELTA, Run, slp, time_scaled
+from .start import (
+    CapConstraint,
+    Start,
+    filtered,
+    fractions,
+    pinned,
+    ramp,
+    start_jerks,
+    third_order_cap,
+    without_idle,
+)
+from .table import CachedDynamics, Table, make_table
+
+log = logging.getLogger(__name__)
+
+#: Fewest intervals of constant jerk of the first transcription (more where the monitor of
+#: :func:`.start.fractions` asks, and refined where the check needs).
+SEGMENTS = 32
+#: Segments of the second-order law that starts the search (a coarse grid: it only gives the
+#: start motion, which the programmes improve; the whole grid where the coarse one finds no
+#: motion, e.g. a blend narrower than its segments).
+START_GRID = 40
+#: Greatest number of linear programmes of one SLP run, and of a run that can be followed by
+#: a re-timing (a motion far from the answer, on knots placed for its start, moves slowly:
+#: placed anew for the motion reached, the programmes go faster).
+MAX_PROGRAMMES = 24
+FIRST_PROGRAMMES = 8
+#: The knots' density: the rows between them within about this of their values there.
+KNOT_TOL = 5e-3
+#: Rounds of refinement after the output check, then of tightening, then of stretching the
+#: motion in time (a slower motion, never a false "no motion").
+MAX_REFINE = 3
+MAX_TIGHTEN = 2
+MAX_STRETCH = 6
+#: Rounds of re-timing (a motion with idle time solved again without it).
+MAX_RETIME = 2
+#: Rounds of the start's cap (see :func:`_start`), and the excess over it accepted.
+START_ROUNDS = 4
+START_SLACK = 0.1
+#: Tolerance of the third-order ratios (finite differences) on the check samples.
+RATE_TOL = 1e-2
+#: How the use of each kind of limit falls when a motion is stretched in time (about
+#: ``T^-p``; gravity and friction do not fall, so stretching repeats).
+_POWERS = {"speed": 1.0, "torque": 2.0, "acceleration": 2.0, "jerk": 3.0, "torque_rate": 3.0}
+
+
+def solve_jerk_limited_law(dynamics: PathDynamics, *, motors: MotorLimits | None = None,
+                           constraints: Sequence[Constraint] | None = None,
+                           segments: int = SEGMENTS, grid: int | Array = 400,
+                           tol: float = 1e-3,
+                           rate_tol: float = RATE_TOL,
+                           units: Units | None = None) -> JerkLimitedLaw:
+    """The fastest rest-to-rest law along a path, with zero acceleration at both ends, within
+    the motors' limits including jerk and torque rate (see :mod:`dextar.laws.smooth`).
+
+    Parameters
+    ----------
+    dynamics : PathDynamics
+        The robot along the path (gravity and friction included).
+    motors : MotorLimits, optional
+        The limits (peak torque, speed, envelope, acceleration, jerk, torque rate).
+    constraints : sequence of Constraint, optional
+        The limits as constraint objects (instead of ``motors``); one of them must limit the
+        torques, one the jerk or the torque rate.
+    segments : int
+        Fewest intervals of constant jerk of the first transcription (at least 16; more
+        where the path's dynamics change fast, refined where the check needs).
+    grid : int or ndarray, shape (N + 1,)
+        The coefficient table along the path: a number of equal segments or its arc lengths
+        (from 0 to the length; the second-order start law takes every few of them).
+    tol, rate_tol : float
+        Allowed relative excess of a torque, speed or acceleration (``tol``) and of a jerk
+        or torque rate (``rate_tol``) over its limit on the check samples.
+    units : Units, optional
+        Only for the words of an error.
+
+    Returns
+    -------
+    JerkLimitedLaw
+        With ``status`` and ``message``.
+
+    Raises
+    ------
+    InfeasibleError
+        No motion within the limits exists (the second-order law on the whole grid finds
+        none: it names the point, the motor and the user's limit).
+    ParameterError
+        No limits, no third-order limit, or bad ``segments`` or tolerances.
+    """
+    if constraints is not None:
+        cons = tuple(constraints)
+    elif motors is not None:
+        cons = motor_constraints(motors)
+    else:
+        raise ParameterError("a jerk-limited law needs the motors' limits (or constraints)")
+    if int(segments) != segments or segments < 16:
+        raise ParameterError(f"segments = {segments!r} must be a whole number of at least 16")
+    if not (0 < tol < 1 and 0 < rate_tol < 1):
+        raise ParameterError(f"tolerances {tol!r}, {rate_tol!r} must be in (0, 1)")
+    second = [c for c in cons if c.order == 2]
+    third = [c for c in cons if c.order == 3]
+    if not third:
+        raise ParameterError("a jerk-limited law needs a jerk or torque-rate limit")
+    length = float(dynamics.length)
+    pts = (np.linspace(0.0, length, int(grid) + 1) if np.ndim(grid) == 0
+           else np.asarray(grid, float))
+    table = make_table(dynamics, pts)
+    base = _second_order(dynamics, table, second, units)
+    T2 = float(base.duration)
+    # the start: the second-order law, slower where the path's own third-order terms
+    # (a blend's curvature changing fast) would use much of their limits at its speeds
+    start = _start(dynamics, table, second, third, base, units)
+    mesh = pinned(fractions(start, table, cons, int(segments), KNOT_TOL), start, table.joints)
+    log.debug("%d knots; the path's joints at %s, pinned at knots %s", mesh.M + 1,
+              table.joints, mesh.pins)
+    J, Tk = start_jerks(start, mesh, length), np.full(mesh.M, start.T)
+    scales = dict.fromkeys((c.kind for c in cons), 1.0)
+    programmes = refined = tightened = stretched = retimed = 0
+    delta = START_DELTA
+    fresh = True  # a new start: its duration brought within the rows first
+    best: _Round | None = None
+    while True:
+        model = Model(mesh, table, [c.scaled(scales) for c in second],
+                      [c.scaled(scales) for c in third], length)
+        if fresh:
+            Tk = time_scaled(model, J, Tk)
+            fresh = False
+        run = slp(model, J, Tk, MAX_PROGRAMMES if retimed == MAX_RETIME else FIRST_PROGRAMMES,
+                  delta)
+        if run.worst > FEAS_TOL:  # the programmes left a limit exceeded: slower instead
+            run = replace(run, Tk=time_scaled(model, run.J, run.Tk))
+        delta = RESTART_DELTA
+        programmes += run.programmes
+        J, Tk = run.J, run.Tk
+        law = _law(run, mesh, length, base)
+        ratio, excess = check(dynamics, cons, law, tol, rate_tol)
+        bad = excess > 0
+        log.debug("check %s bad %d intervals %d T %.9g converged %s",
+                  {k: round(v, 5) for k, v in ratio.items()}, int(bad.sum()), mesh.M,
+                  law.duration,
+                  run.converged)
+        if not bad.any():
+            if best is None or law.duration < best.law.duration:
+                best = _Round(law, ratio, bad, mesh, run, refined, stretched)
+            again = (without_idle(law, always=not run.converged) if retimed < MAX_RETIME
+                     else None)
+            if again is None:
+                break
+            # the motion stops somewhere (it reached a pinned knot early) or waits at the
+            # end, or the programmes had not settled: again from it, with that time cut out
+            # and the knots placed anew (denser where its rows change fast)
+            retimed += 1
+            mesh = pinned(fractions(again, table, cons, int(segments), KNOT_TOL), again,
+                          table.joints)
+            J, Tk = start_jerks(again, mesh, length), np.full(mesh.M, again.T)
+            log.debug("re-timed: %d knots, %.9g s", mesh.M + 1, again.T)
+            fresh, delta, refined = True, START_DELTA, 0
+            continue
+        if refined < MAX_REFINE:
+            # split the intervals where a limit is exceeded, into as many pieces as bring
+            # an excess that falls with the square of the interval to a quarter of its
+            # tolerance (the same motion: each piece keeps its interval's jerk)
+            refined += 1
+            pieces = np.where(bad, np.clip(np.ceil(np.sqrt(4 * excess)), 2, 8), 1).astype(int)
+            mesh, J, Tk = _split(mesh, J, Tk, pieces)
+            continue
+        if tightened < MAX_TIGHTEN:
+            tightened += 1
+            for k, r in ratio.items():
+                kt = rate_tol if k in RATE_KINDS else tol
+                if r > 1 + kt:
+                    scales[k] *= (1 + 0.25 * kt) / r
+            continue
+        # last: the same motion, slower, until the check passes (a motion within the limits
+        # exists wherever holding still fits them)
+        while bad.any() and stretched < MAX_STRETCH:
+            stretched += 1
+            factor = max((r / (1 + 0.5 * (rate_tol if k in RATE_KINDS else tol)))
+                         ** (1 / _POWERS.get(k, 1.0)) for k, r in ratio.items())
+            Tk = Tk * max(factor, 1.0 + tol)
+            law = _law(replace(run, Tk=Tk), mesh, length, base)
+            ratio, excess = check(dynamics, cons, law, tol, rate_tol)
+            bad = excess > 0
+        break
+    last = _Round(law, ratio, bad, mesh, run, refined, stretched)
+    if best is not None and (bad.any() or best.law.duration <= law.duration):
+        last = best
+    return _verdict(last, scales, programmes, T2)
+
+
+def _second_order(dynamics: PathDynamics, table: Table, second: Sequence[Constraint],
+                  units: Units | None) -> TimeOptimalLaw:
+    """The second-order time-optimal law of the start, on a coarse grid (every few points of
+    the table's), or on the whole grid where the coarse one finds no motion: a coarse grid
+    can step over a short stretch of fast-changing dynamics (a blend) and see a false
+    impossibility there; the whole grid's verdict stands (its error names the user's
+    limit)."""
+    pts = table.s
+    step = max(1, int(np.ceil((len(pts) - 1) / START_GRID)))
+    coarse = np.unique(np.concatenate([pts[::step], pts[-1:]]))
+    cached = CachedDynamics(dynamics, table)
+    if len(coarse) > 11 and len(coarse) < len(pts):
+        try:
+            return solve_time_optimal_law(cached, constraints=second, grid=coarse, tol=0.05,
+                                          units=units)
+        except InfeasibleError as exc:
+            log.debug("the start's coarse grid found no motion (%s): the whole grid", exc)
+    return solve_time_optimal_law(cached, constraints=second, grid=pts, tol=0.05, units=units)
+
+
+def _start(dynamics: PathDynamics, table: Table, second: Sequence[Constraint],
+           third: Sequence[Constraint], base: TimeOptimalLaw, units: Units | None) -> Start:
+    """The start motion: the second-order law filtered (:func:`.start.filtered`); where the
+    path's own third-order terms cap the speed (:func:`.start.third_order_cap`), the
+    second-order law within that cap, and where its filtered version still passes faster
+    (the filter averages the speed over its width, and a steep deceleration into a blend is
+    shorter), the cap lowered there by the excess, a few rounds."""
+    cap = third_order_cap(table, third)
+    ok = np.sqrt(cap)
+    law = base
+    start = None
+    for _ in range(START_ROUNDS):
+        if law is base and not np.any(base.knots_v ** 2 > np.interp(base.knots_s, table.s,
+                                                                    cap)):
+            break  # the cap does not bind: the second-order law as it is
+        law = _second_order(dynamics, table, [*second, CapConstraint(table.s, cap)], units)
+        rho = min(ramp(law, table, third), 4.0 * float(law.duration))
+        start = filtered(law, rho, float(table.s[-1]))
+        over = np.interp(table.s, start.s, start.v) / ok
+        if over.max() <= 1.0 + START_SLACK:
+            return start
+        cap = np.where(over > 1.0, cap / np.maximum(over, 1.0) ** 2, cap)
+    if start is None:
+        rho = min(ramp(law, table, third), 4.0 * float(law.duration))
+        start = filtered(law, rho, float(table.s[-1]))
+    return start
+
+
+def _split(mesh: Mesh, J: Array, Tk: Array, pieces: Array) -> tuple[Mesh, Array, Array]:
+    """The mesh with interval ``k`` split into ``pieces[k]`` equal ones, and the same motion
+    (each piece keeps its interval's jerk and duration)."""
+    h = mesh.h
+    many = pieces > 1
+    n = pieces[many]
+    idx = np.repeat(np.flatnonzero(many), n - 1)
+    j = np.concatenate([np.arange(1, m) for m in n]) if n.size else np.zeros(0)
+    inner = mesh.f[idx] + h[idx] * j / np.repeat(n, n - 1)
+    f = np.sort(np.concatenate([mesh.f, inner]))
+    return (make_mesh(f, mesh.f[mesh.pins], mesh.pin_s), np.repeat(J, pieces),
+            np.repeat(Tk, pieces))
+
+
+def _law(run: Run, mesh: Mesh, length: float, base: TimeOptimalLaw) -> JerkLimitedLaw:
+    """The law of a run's normalised jerks and duration."""
+    dt = mesh.h * run.Tk
+    jerk = run.J / run.Tk**3
+    a, v, s = integrate(dt, jerk)
+    t = np.concatenate([[0.0], np.cumsum(dt)])
+    s[0], v[0], a[0] = 0.0, 0.0, 0.0
+    s[-1], v[-1], a[-1] = length, 0.0, 0.0
+    return JerkLimitedLaw(length, float(t[-1]), t, s, v, a, jerk,
+                          base.torque_limit, base.speed_limit, {}, float(base.duration), 0,
+                          "", 0)
+
+
+@dataclass(frozen=True)
+class _Round:
+    """A law the solve found, with its check and how it came."""
+
+    law: JerkLimitedLaw
+    ratio: dict[str, float]
+    bad: Array
+    mesh: Mesh
+    run: Run
+    refined: int
+    stretched: int
+
+
+def _verdict(r: _Round, scales: dict[str, float], programmes: int, T2: float
+             ) -> JerkLimitedLaw:
+    """The law with its ratios, status and message."""
+    law, ratio, bad, mesh, run = r.law, r.ratio, r.bad, r.mesh, r.run
+    refined, stretched = r.refined, r.stretched
+    ok = not bad.any()
+    T = law.duration
+    words = ", ".join(f"{k} ratio {r:.5f}" for k, r in ratio.items())
+    margin = "" if all(v == 1.0 for v in scales.values()) else (
+        "; limits tightened by " + " and ".join(f"{1 - v:.2%} ({k})" for k, v in scales.items()
+                                                 if v != 1.0)
+        + " so that they hold between the knots")
+    if stretched:
+        margin += f"; stretched in time {stretched} time(s) so that they hold"
+    how = (f"{mesh.M} intervals of constant jerk"
+           + (f" ({refined} refinement(s))" if refined else "")
+           + f", {programmes} linear programmes")
+    if ok:
+        msg = (f"jerk-limited time-optimal within the limits: {words} on the check samples "
+               f"({how}; {T / T2 - 1:+.2%} against the second-order law on the start's "
+               f"grid){margin}")
+    else:
+        msg = f"limits exceeded on the check samples ({how}): {words}"
+    if not run.converged:
+        msg += "; the linear programmes did not settle"
+    return replace(law, ratios=ratio, status=0 if ok else 1, message=msg, solves=programmes)
+
+
+def _build(r: Any) -> Law:
+    """The registered ``time-optimal`` builder: the second-order law (TOPP-RA) within the
+    motors' torque, speed and acceleration limits, or this jerk-limited one when the motors
+    have a jerk or torque-rate limit."""
+    from ...errors import ConfigError
+
+    p = r.params
+    motors = r.motors
+    if p.get("torque_limit") is not None:
+        own = MotorLimits.of(p["torque_limit"], p.get("speed_limit_deg_s"))
+        motors = own if motors is None else replace(
+            own, max_acceleration=motors.max_acceleration, max_jerk=motors.max_jerk,
+            max_torque_rate=motors.max_torque_rate)
+    elif motors is None:
+        raise ConfigError("config key [law].torque_limit is required for a time-optimal law "
+                          "(or a [motors] table with peak_torque)")
+    if motors.third_order:
+        return solve_jerk_limited_law(r.dynamics, motors=motors, grid=p["grid"], units=r.units)
+    return solve_time_optimal_law(r.dynamics, motors=motors, grid=p["grid"], units=r.units)
+
+
+def _register() -> None:
+    from ..registry import LAW_TYPES, LawType, register_law
+
+    second = LAW_TYPES["time-optimal"]
+    register_law(LawType(
+        "time-optimal", second.params, _build,
+        "the fastest rest-to-rest motion within the motors' limits: torque and speed "
+        "(TOPP-RA), and with a jerk or torque-rate limit third order (zero acceleration at "
+        "both ends; sequential linear programming)", needs_dynamics=True))
+
+
+_register()

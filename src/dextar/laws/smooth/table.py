@@ -1,0 +1,184 @@
+"""The path's coefficients on the grid of arc lengths, with their slopes along the path: what
+the transcription's rows interpolate (:class:`Table`), and the robot's dynamics answered from
+it at the grid's own points (:class:`CachedDynamics`, for the second-order start law)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+
+from ..._arrays import Array
+from ..base import Law
+from ..constraints import JointSamples, PathCoefficients, PathDynamics
+
+#: The table's columns (2 each): q', q'', q''' and a, b, g, a', b', g'.
+Q1, Q2, Q3, A, B, G, DA, DB, DG = (slice(2 * i, 2 * i + 2) for i in range(9))
+
+
+@dataclass(frozen=True)
+class Table:
+    """The path coefficients on the grid (``co``) and, stacked for one interpolation, the
+    path derivatives of the joints ``q', q'', q'''`` and the dynamics' ``a, b, g`` with
+    their derivatives ``a', b', g'`` (columns, 2 each), at both ends of every segment
+    (``lo``, ``hi``, each (N, 18): a derivative may jump at a grid point, ``joints``)."""
+
+    co: PathCoefficients
+    lo: Array
+    hi: Array
+    joints: Array  # arc lengths of the grid points where a derivative jumps
+
+    @property
+    def s(self) -> Array:
+        """The grid's arc lengths."""
+        return self.co.s
+
+    def at(self, s: Array, before: bool = False) -> tuple[Array, Array]:
+        """The columns at arc lengths ``s`` (n,) and their slopes, (n, 18) each; at a grid
+        point, those of the segment after it (``before``: the one before it)."""
+        return segments(self.co.s, self.lo, self.hi, s, before)
+
+    @cached_property
+    def moving(self) -> PathCoefficients:
+        """The coefficients with the first and last points doubled (N + 3 points): the
+        constraint objects' rows leave friction out at a path's two ends (the rest points of
+        a second-order law's grid), but the rows here are interpolated between the grid's
+        points, and friction is there as soon as the motion leaves rest."""
+        co = self.co
+
+        def ends(v: Array) -> Array:
+            return np.concatenate([v[:1], v, v[-1:]])
+
+        return PathCoefficients(ends(co.s), ends(co.P), ends(co.a), ends(co.b), ends(co.g),
+                                ends(co.dq_ds), co.coulomb, co.viscous, ends(co.ddq_ds),
+                                co.coulomb_speed)
+
+
+#: The table's grid is refined until every column's linear interpolation is within this
+#: fraction of the column's largest value at the segments' middles (the rows' coefficients,
+#: and so the limits' use, to about this much), in at most :data:`TABLE_ROUNDS` rounds.
+TABLE_TOL = 2e-4
+TABLE_ROUNDS = 4
+#: The step of the derivatives along the path (a fraction of the path's length): a central
+#: difference of the dynamics' own coefficients, or one-sided at a joint (truncation about
+#: the step times the next derivative, far below the interpolation's).
+DERIVATIVE_STEP = 1e-7
+#: A grid point is a joint (pieces of a path meet there, the curvature's derivative jumps)
+#: where a column's one-sided derivatives differ by more than this fraction of its largest.
+JOINT_JUMP = 1e-3
+
+
+def make_table(dynamics: PathDynamics, s: Array) -> Table:
+    """The table of the dynamics' coefficients from the grid ``s`` (N + 1,) of arc lengths,
+    refined where a column's linear interpolation misses its value at a segment's middle by
+    more than :data:`TABLE_TOL` of its largest (a blend's dynamics change over a fraction of
+    a millimetre). The derivatives along the path (of ``q''``, ``a``, ``b``, ``g``) are
+    differences of the dynamics' coefficients a short step apart, one-sided at the joints
+    (both sides kept: the segment before a joint ends with its left derivative, the one
+    after starts with its right one)."""
+    s = np.asarray(s, float)
+    length = float(s[-1])
+    for _ in range(TABLE_ROUNDS):
+        co, lo, hi, joint = _columns(dynamics, s, length)
+        mid = 0.5 * (s[1:] + s[:-1])
+        m = _columns(dynamics, mid, length, central_only=True)[1]
+        scale = np.abs(np.concatenate([lo, hi])).max(axis=0) + 1e-300
+        err = (np.abs(m - 0.5 * (lo + hi)) / scale).max(axis=1)
+        bad = err > TABLE_TOL
+        if not bad.any():
+            break
+        pieces = np.where(bad, np.clip(np.ceil(np.sqrt(err / TABLE_TOL)), 2, 8), 1)
+        s = _split(s, pieces.astype(int))
+    else:
+        co, lo, hi, joint = _columns(dynamics, s, length)
+    return Table(co, lo, hi, co.s[joint])
+
+
+def _split(s: Array, pieces: Array) -> Array:
+    """The grid with segment ``k`` split into ``pieces[k]`` equal ones."""
+    many = pieces > 1
+    n = pieces[many]
+    k = np.repeat(np.flatnonzero(many), n - 1)
+    j = np.concatenate([np.arange(1, v) for v in n])
+    return np.sort(np.concatenate([s, s[k] + (s[k + 1] - s[k]) * j / np.repeat(n, n - 1)]))
+
+
+def _columns(dynamics: PathDynamics, s: Array, length: float, central_only: bool = False
+             ) -> tuple[PathCoefficients, Array, Array, Array]:
+    """The coefficients at ``s`` (N + 1,), and the table's columns (see :class:`Table`) at
+    the starts and the ends of the segments (two arrays (N, 18)) and the joints (indices);
+    with ``central_only``, the columns at the points themselves (N + 1, 18), twice."""
+    step = DERIVATIVE_STEP * length
+    left, right = np.maximum(s - step, 0.0), np.minimum(s + step, length)
+    co, cl, cr = (dynamics.coefficients(x) for x in (s, left, right))
+
+    def base(c: PathCoefficients) -> Array:  # the columns with derivatives
+        return np.concatenate([c.ddq_ds, c.a, c.b, c.g], axis=1)
+
+    f0, fl, fr = base(co), base(cl), base(cr)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        dl = np.where((s > left)[:, None], (f0 - fl) / (s - left)[:, None], np.nan)
+        dr = np.where((right > s)[:, None], (fr - f0) / (right - s)[:, None], np.nan)
+    dl = np.where(np.isnan(dl), dr, dl)  # (at the path's ends, the one side there is)
+    dr = np.where(np.isnan(dr), dl, dr)
+    central = 0.5 * (dl + dr)
+
+    def table(d: Array) -> Array:
+        return np.concatenate([co.dq_ds, co.ddq_ds, d[:, :2], co.a, co.b, co.g, d[:, 2:]],
+                              axis=1)
+
+    if central_only:
+        return co, table(central), table(central), np.zeros(0, int)
+    scale = np.abs(central).max(axis=0) + 1e-300
+    joint = (np.abs(dr - dl) > JOINT_JUMP * scale).any(axis=1)
+    joint[[0, -1]] = False
+    after = np.where(joint[:, None], dr, central)
+    before = np.where(joint[:, None], dl, central)
+    return co, table(after)[:-1], table(before)[1:], np.flatnonzero(joint)
+
+
+def interp(grid: Array, values: Array, s: Array) -> tuple[Array, Array]:
+    """The piecewise-linear interpolant of ``values`` (N + 1, p) on ``grid`` at ``s`` (n,)
+    and its slope: two arrays (n, p)."""
+    return segments(grid, values[:-1], values[1:], s)
+
+
+def segments(grid: Array, lo: Array, hi: Array, s: Array, before: bool = False
+              ) -> tuple[Array, Array]:
+    """Linear on each segment from ``lo`` to ``hi`` (N, p): the values at ``s`` (n,) and the
+    slopes, two arrays (n, p) (at a grid point the segment after it, or ``before`` it)."""
+    k = np.searchsorted(grid, s, side="left" if before else "right") - 1
+    k = np.clip(k, 0, len(grid) - 2)
+    ds = grid[k + 1] - grid[k]
+    w = ((np.clip(s, grid[0], grid[-1]) - grid[k]) / ds)[:, None]
+    a, b = lo[k], hi[k]
+    return a + (b - a) * w, (b - a) / ds[:, None]
+
+
+class CachedDynamics:
+    """The dynamics with the table's coefficients for the grid's own points (the start's
+    second-order law asks for a subset of them)."""
+
+    def __init__(self, dynamics: PathDynamics, table: Table) -> None:
+        self._d, self._t = dynamics, table
+
+    @property
+    def length(self) -> float:
+        """The path's length."""
+        return float(self._d.length)
+
+    def coefficients(self, s: Array) -> PathCoefficients:
+        """The coefficients at ``s``: the table's rows where ``s`` are grid points, else the
+        dynamics'."""
+        grid = self._t.s
+        k = np.clip(np.searchsorted(grid, s), 0, len(grid) - 1)
+        if not np.allclose(grid[k], s, rtol=0.0, atol=1e-12 * grid[-1]):
+            return self._d.coefficients(s)
+        co = self._t.co
+        return PathCoefficients(co.s[k], co.P[k], co.a[k], co.b[k], co.g[k], co.dq_ds[k],
+                                co.coulomb, co.viscous, co.ddq_ds[k], co.coulomb_speed)
+
+    def samples(self, law: Law, times: Array) -> JointSamples:
+        """The dynamics' samples."""
+        return self._d.samples(law, times)

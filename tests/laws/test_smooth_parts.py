@@ -1,0 +1,269 @@
+"""The jerk-limited law's parts: the banded interior point against HiGHS, the exact
+integration of the transcription, the path table's derivatives and joints, the rows' linear
+model against finite differences, and the start's fall-backs (never a false "no motion")."""
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+from scipy.optimize import linprog
+
+from dextar.dynamics import Model, RobotAlongPath
+from dextar.errors import InfeasibleError
+from dextar.laws import solve_jerk_limited_law, time_optimal
+from dextar.laws.constraints import motor_constraints
+from dextar.laws.smooth import banded, mesh, rows, slp, solve, start, table
+from dextar.motors import MotorLimits
+from dextar.paths import Line
+from dextar.paths.composite import blended
+
+from ..program.test_program import EXAMPLES
+
+MOTORS = MotorLimits((1.5, 1.5), max_jerk=(3000.0, 3000.0))
+
+
+@pytest.fixture(scope="module")
+def chain():
+    """Two lines of the jerk example blended within 8 mm (two joints), the robot along."""
+    from dextar.config import load_scenario
+
+    m = load_scenario(str(EXAMPLES / "jerk_pick_place.toml")).si_model
+    path, _ = blended((Line((-0.06, 0.16), (-0.06, 0.2)), Line((-0.06, 0.2), (0.06, 0.2))),
+                      (0.008,))
+    return RobotAlongPath(Model(m.robot, m.inertia, "up"), path, "+-"), path
+
+
+def grid(path):
+    """200 equal segments and the joints (where the program's grids put them too)."""
+    return np.unique(np.concatenate([np.linspace(0.0, path.length, 201), path.starts]))
+
+
+@pytest.fixture(scope="module")
+def setup(chain):
+    """The transcription of the chain at its time-scaled start: model, mesh, motion."""
+    dyn, path = chain
+    cons = motor_constraints(MOTORS)
+    second = [c for c in cons if c.order == 2]
+    third = [c for c in cons if c.order == 3]
+    tab = table.make_table(dyn, grid(path))
+    base = solve._second_order(dyn, tab, second, None)
+    st = solve._start(dyn, tab, second, third, base, None)
+    me = start.pinned(start.fractions(st, tab, cons, 32, solve.KNOT_TOL), st, tab.joints)
+    J = start.start_jerks(st, me, dyn.length)
+    model = rows.Model(me, tab, second, third, dyn.length)
+    Tk = slp.time_scaled(model, J, np.full(me.M, st.T))
+    return model, me, J, Tk, tab
+
+
+def as_linprog(lp):
+    """A staged programme as a general one for HiGHS."""
+    nx, D, Q = len(lp.c), banded.D, banded.Q
+    M = len(lp.E)
+    R = len(lp.rk)
+    cols = (D * lp.rk)[:, None] + banded.ROW_X[None, :]
+    A = sp.csr_matrix((lp.ra.reshape(-1), (np.repeat(np.arange(R), banded.NR),
+                                           cols.reshape(-1))), shape=(R, nx))
+    A = A + sp.csr_matrix((lp.rg[:, 0], (np.arange(R), np.full(R, nx - 1))), shape=(R, nx))
+    exi = (D * np.arange(M))[:, None] + np.arange(2 * D)[None, :]
+    Aeq = sp.csr_matrix((lp.E.reshape(-1), (np.repeat(np.arange(Q * M), 2 * D),
+                                            np.repeat(exi, Q, axis=0).reshape(-1))),
+                        shape=(Q * M, nx))
+    return dict(c=lp.c, A_ub=A, b_ub=lp.rb, A_eq=Aeq, b_eq=np.asarray(lp.e).reshape(-1),
+                bounds=np.stack([lp.lo, lp.hi], 1))
+
+
+def programmes(setup, deltas=(0.3, 0.05)):
+    """The SLP's first programmes on the chain (two joints pinned: the durations' ratio and
+    the linearised normalisation at them), one per trust region."""
+    model, me, J, Tk, _ = setup
+    mo = mesh.motion(me, J, Tk, model.length)
+    r = model.rows(mo)
+    lp = slp.Programme(me, model.length)
+    out = []
+    captured = []
+    real = slp.solve_staged
+    try:
+        slp.solve_staged = lambda p, x0, **kw: captured.append((p, x0)) or real(p, x0, **kw)
+        for d in deltas:
+            use = r.F + lp.reach(r, mo, d, float(np.abs(mo.alpha).max()),
+                                 float(np.abs(mo.J).max())) > -1e-9
+            lp.solve(r, use, mo, mo.T, d, float(np.abs(mo.alpha).max()),
+                     float(np.abs(mo.J).max()))
+            out.append(captured[-1])
+    finally:
+        slp.solve_staged = real
+    return out
+
+
+def test_the_banded_interior_point_matches_highs(setup):
+    """Same objective as HiGHS's simplex to 1e-7 (relative) on the chain's programmes, and
+    the solution within the rows, equalities and bounds; stopped after three iterations it
+    says it has not converged."""
+    _, me, *_ = setup
+    assert len(me.pins) == 2
+    for lp, x0 in programmes(setup):
+        res = banded.solve_staged(lp, x0)
+        ref = linprog(**as_linprog(lp), method="highs-ds")
+        assert res.status == 0 and ref.status == 0
+        assert abs(res.fun - ref.fun) <= 1e-7 * (1 + abs(ref.fun))
+        g = as_linprog(lp)
+        scale = 1 + np.abs(lp.rb).max()
+        assert (g["A_ub"] @ res.x - lp.rb).max() <= 1e-7 * scale
+        assert np.abs(g["A_eq"] @ res.x - g["b_eq"]).max() <= 1e-7 * scale
+        assert np.all(res.x >= lp.lo - 1e-9) and np.all(res.x <= lp.hi + 1e-9)
+        early = banded.solve_staged(lp, x0, maxiter=3)
+        assert early.status == 1
+
+
+def test_the_integration_is_exact_and_the_end_rows_agree():
+    """The knots' states of a piecewise-constant jerk against its closed form (a cubic on
+    each interval), and the end rows (dense, a few) against the recurrence."""
+    rng = np.random.default_rng(3)
+    dt = rng.uniform(0.1, 1.0, 40)
+    j = rng.normal(size=40)
+    a, v, s = mesh.integrate(dt, j)
+    t = np.concatenate([[0.0], np.cumsum(dt)])
+    # closed form: a(t) = sum j_k * overlap, by brute summation over the intervals
+    for i in (7, 23, 40):
+        inside = np.clip(t[i] - t[:-1], 0.0, dt)
+        after = np.maximum(t[i] - t[1:], 0.0)
+        assert np.isclose(a[i], np.sum(j * inside), rtol=1e-12, atol=1e-12)
+        assert np.isclose(v[i], np.sum(j * (inside**2 / 2 + inside * after)), rtol=1e-12)
+        assert np.isclose(s[i], np.sum(j * (inside**3 / 6 + inside**2 * after / 2
+                                            + inside * after**2 / 2)), rtol=1e-12)
+    Ea, Ev, Es = mesh.knot_rows(dt, np.array([12, 40]))
+    assert np.allclose([Ea @ j, Ev @ j, Es @ j], [a[[12, 40]], v[[12, 40]], s[[12, 40]]],
+                       rtol=1e-12, atol=1e-14)
+
+
+def test_the_table_finds_the_joints_and_the_derivatives(chain):
+    """The blend's two joints (where the curvature's derivative jumps) found on the grid,
+    and the derivative columns (``q'''``, ``a'``, ``b'``, ``g'``) against central differences
+    of the dynamics' coefficients between the joints, to 1e-3 of their largest."""
+    dyn, path = chain
+    tab = table.make_table(dyn, grid(path))
+    starts = np.asarray(path.starts)[1:-1]
+    assert len(tab.joints) == len(starts)
+    assert np.allclose(np.sort(tab.joints), starts, atol=1e-9 * dyn.length)
+    s = np.linspace(0.0, dyn.length, 997)[1:-1]
+    s = s[np.min(np.abs(s[:, None] - starts[None, :]), axis=1) > 1e-4]
+    e = 1e-7
+    cp, cm = dyn.coefficients(s + e), dyn.coefficients(s - e)
+    fd = np.concatenate([cp.ddq_ds - cm.ddq_ds, cp.a - cm.a, cp.b - cm.b, cp.g - cm.g],
+                        axis=1) / (2 * e)
+    v = tab.at(s)[0]
+    ours = np.concatenate([v[:, table.Q3], v[:, table.DA], v[:, table.DB], v[:, table.DG]],
+                          axis=1)
+    assert np.all(np.abs(ours - fd) <= 1e-3 * np.abs(fd).max(axis=0) + 1e-9)
+
+
+def test_the_rows_linear_model_matches_finite_differences(setup):
+    """Each row's change (its polynomial form over its normalisation at the motion, the
+    model the programmes use) against its linear model, for a change of the jerks and of
+    each stretch's duration: the model's error is of second order (ten times smaller a
+    change, about a hundred times smaller an error) and below 1e-3 of the change."""
+    model, me, J, Tk, _ = setup
+    rng = np.random.default_rng(0)
+    mo = mesh.motion(me, J, Tk, model.length)
+    r = model.rows(mo)
+    dj = rng.normal(size=J.size) * np.abs(J).max()
+    dt = rng.normal(size=len(me.pins) + 1)[me.stretch]  # each stretch its own
+    errs = []
+    for eps in (1e-5, 1e-6):
+        Jn = J + eps * dj
+        Tn = Tk * (1 + eps * dt)
+        # the same end conditions and pins: the jerks projected (physical units)
+        j = mesh.projected(me, Jn / Tn**3, Tn, model.length)
+        mn = mesh.motion(me, j * Tn**3, Tn, model.length)
+        new = model.rows(mn)
+        change = new.F * new.norm / r.norm - r.F
+        lin = r.linear(mn.sigma - mo.sigma, mn.w - mo.w, mn.alpha - mo.alpha,
+                       mn.alpha_end - mo.alpha_end, mn.Tk - mo.Tk) - r.F
+        errs.append((np.abs(change - lin).max(), np.abs(change).max()))
+
+    assert errs[0][0] <= 1e-3 * errs[0][1]
+    assert errs[1][0] < errs[0][0] / 30
+
+
+def test_a_coarse_start_grid_that_finds_no_motion_is_retried_on_the_whole_grid(
+        chain, monkeypatch):
+    """Where the start's coarse second-order grid reports no motion (it can step over a
+    blend), the whole grid is tried and the law planned; where the whole grid too finds
+    none, the error stands."""
+    dyn, _ = chain
+    real = solve.solve_time_optimal_law
+    grids = []
+
+    def coarse_fails(d, *, grid, **kw):
+        grids.append(len(grid))
+        if len(grid) < 100:
+            raise InfeasibleError("no motion within the limits (the coarse grid)")
+        return real(d, grid=grid, **kw)
+
+    monkeypatch.setattr(solve, "solve_time_optimal_law", coarse_fails)
+    law = solve_jerk_limited_law(dyn, motors=MOTORS, grid=200)
+    assert law.status == 0 and min(grids) < 100 and max(grids) > 100
+
+    def always_fails(d, *, grid, **kw):
+        raise InfeasibleError("no motion within the limits (every grid)")
+
+    monkeypatch.setattr(solve, "solve_time_optimal_law", always_fails)
+    with pytest.raises(InfeasibleError, match="every grid"):
+        solve_jerk_limited_law(dyn, motors=MOTORS, grid=200)
+
+
+def test_limits_tightened_for_the_grid_never_make_a_false_no_motion(chain, monkeypatch):
+    """The second-order law tightens a limit the check finds exceeded between its grid
+    points; where the tightened limit leaves no motion, it returns its last law (beyond the
+    limits, status 1) rather than a "no motion" quoting a limit the user never set."""
+    dyn, _ = chain
+    real = time_optimal._reachability
+
+    def tight_fails(co, ds, cons, x0, units, tmax):
+        if any(c.torque_limit is not None and c.torque_limit[0] < tmax[0] for c in cons):
+            raise InfeasibleError("no motion within the limits (tightened)")
+        return real(co, ds, cons, x0, units, tmax)
+
+    monkeypatch.setattr(time_optimal, "_reachability", tight_fails)
+    law = time_optimal.solve_time_optimal_law(dyn, torque_limit=(1.5, 1.5), grid=12,
+                                              tol=1e-6)
+    assert law.status == 1 and "limits exceeded" in law.message
+
+
+class _Parabola:
+    """A torque ratio ``peak - c (t - t0)^2`` on motor A, at least 0.5 (a sharp bend, as the
+    envelope's near the speed limit), counting the calls."""
+
+    def __init__(self, peak, t0, c):
+        self.peak, self.t0, self.c, self.calls = peak, t0, c, 0
+
+    def samples(self, law, times):
+        from dextar.laws.constraints import JointSamples
+
+        self.calls += 1
+        r = np.maximum(self.peak - self.c * (times - self.t0) ** 2, 0.5)
+        tau = np.stack([r, np.zeros_like(times)], -1)
+        return JointSamples(tau, np.zeros_like(tau), np.zeros_like(tau), times)
+
+
+@pytest.mark.parametrize("peak, found", [(1.004, True), (0.9995, False)])
+def test_the_check_finds_a_peak_between_its_samples(peak, found):
+    """A ratio peaking halfway between two check samples, 0.999 at both: 1.004 at its peak
+    is found (the interval sampled more finely, its ratio to 1e-4, the interval marked for
+    refinement), 0.9995 is not an excess (and no finer sampling: one call). The samples alone
+    read 0.999 in both cases."""
+    from types import SimpleNamespace
+
+    from dextar.laws.constraints import TorqueLimit
+    from dextar.laws.smooth import check
+
+    knots = np.linspace(0.0, 1.0, 5)
+    h = 0.25 / (check.CHECK_PER_INTERVAL - 1)  # the samples' spacing
+    t0 = 0.5 + 3.5 * h  # halfway between two samples of the third interval
+    dyn = _Parabola(peak, t0, (peak - 0.999) / (h / 2) ** 2)
+    ratio, excess = check.check(dyn, [TorqueLimit((1.0, 1.0))], SimpleNamespace(knots_t=knots),
+                                1e-3, 1e-2)
+    if found:
+        assert ratio["torque"] == pytest.approx(peak, abs=1e-4)
+        assert np.flatnonzero(excess).tolist() == [2] and dyn.calls == 2
+    else:
+        assert ratio["torque"] <= 0.9995 and not excess.any() and dyn.calls == 1
