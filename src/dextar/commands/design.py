@@ -15,7 +15,8 @@ from ..output.files import OutputDir
 from .base import Result, config_argument, into_directory, load, note_lines, noted, shown
 
 if TYPE_CHECKING:  # the writers, imported when the command runs (start-up: dextar._lazy)
-    from ..design.search import Progress
+    import dextar.design.search  # (named in full: the docs' references find its Progress)
+
     from ..output import design as written
 else:
     written = lazy_module("dextar.output.design")
@@ -52,7 +53,7 @@ def duration_text(seconds: float) -> str:
     return f"{s // 3600} h {s % 3600 // 60:02d} min"
 
 
-def progress_line(p: Progress) -> str:
+def progress_line(p: dextar.design.search.Progress) -> str:
     """One line of progress: designs done, feasible share, the front's hypervolume, time
     left."""
     parts = [f"designs {p.done}/{p.total}" + (f" ({p.resumed} resumed)" if p.resumed else ""),
@@ -68,13 +69,13 @@ def _terminal(args: argparse.Namespace) -> bool:
     return sys.stderr.isatty() and not args.quiet
 
 
-def _progress(args: argparse.Namespace) -> Callable[[Progress], None] | None:
+def _progress(args: argparse.Namespace) -> Callable[[dextar.design.search.Progress], None] | None:
     """Progress on stderr, one line rewritten in place, at a terminal only."""
     if not _terminal(args):
         return None
     width = [0]
 
-    def progress(p: Progress) -> None:
+    def progress(p: dextar.design.search.Progress) -> None:
         line = progress_line(p)
         pad = max(0, width[0] - len(line))
         width[0] = len(line)
