@@ -35,6 +35,7 @@ from tests.robustness.harness import (  # noqa: E402
 from tests.robustness.strategies import (  # noqa: E402
     COMMANDS,
     configs,
+    counterweight_configs,
     dry_friction_runs,
     falling_simulations,
     kinematics_argv,
@@ -79,7 +80,9 @@ def main() -> int:
     n_dry = int(args.cases * 0.01)
     n_long = int(args.cases * 0.01)  # review 28: long motions with the animation drawn
     n_time = int(args.cases * 0.02)  # issue 28's time scales
-    n_cfg = int(args.cases * 0.65) - n_metres - n_falling - n_dry - n_long - n_time
+    n_cw = int(args.cases * 0.02)  # issue 32: counterweights on the proximal rods
+    n_cfg = (int(args.cases * 0.65) - n_metres - n_falling - n_dry - n_long - n_time
+             - n_cw)
 
     @settings(max_examples=n_cfg, deadline=None, database=None, derandomize=False,
               suppress_health_check=list(HealthCheck))
@@ -165,6 +168,15 @@ def main() -> int:
         record(outcome, detail, f"identify {options} config {config}, t_s x {factor:g}, on\n"
                f"{text[:300]}", time.perf_counter() - t0)
 
+    @settings(max_examples=n_cw, deadline=None, database=None,
+              suppress_health_check=list(HealthCheck))
+    @given(doc=counterweight_configs(),
+           command=st.sampled_from(["torques", "simulate", "export", "plan"]))
+    def fuzz_counterweights(doc: dict, command: str) -> None:
+        t0 = time.perf_counter()
+        outcome, detail = run_config_case(doc, command)
+        record(outcome, detail, f"{command} with\n{toml_text(doc)}", time.perf_counter() - t0)
+
     import random
 
     random.seed(args.seed)
@@ -177,6 +189,7 @@ def main() -> int:
     fuzz_dry_runs()
     fuzz_long_runs()
     fuzz_time_scales()
+    fuzz_counterweights()
     fuzz_argv()
     total = sum(counts.values())
     print(f"{total} cases in {time.perf_counter() - t_start:.0f} s: " + ", ".join(

@@ -28,7 +28,9 @@ def test_example_configs_plan(name):
     assert tr.t.size == 101
 
 
-@pytest.mark.parametrize("name", [n for n, doc in CONFIGS.items() if "move" in doc])
+# (a design task's motors come from its catalogue: tests/design/test_motors.py sweeps it)
+@pytest.mark.parametrize("name", [n for n, doc in CONFIGS.items()
+                                  if "move" in doc and "design" not in doc])
 def test_example_programs_plan_their_moves(name):
     """The program as `dextar program` plans it: every [[move]] of the file in order, from
     [program].start to the last move's target point, in the working mode the moves leave it
@@ -56,3 +58,8 @@ def test_paper_toml_is_the_default():
 def test_identification_script_runs(capsys):
     runpy.run_path(str(EXAMPLES / "identify_synthetic.py"), run_name="__main__")
     assert "identification checks passed" in capsys.readouterr().out
+
+
+def test_balancing_script_runs(capsys):
+    runpy.run_path(str(EXAMPLES / "balancing.py"), run_name="__main__")
+    assert "balancing checks passed" in capsys.readouterr().out

@@ -7,9 +7,9 @@
   are read, so that a new module appears without a hand edit; the docstrings through autodoc
   and numpydoc (whose template this extension compiles once instead of once a docstring).
 * The gallery and the figures of the guides: every example (``examples/*.toml`` through
-  ``dextar run`` or ``dextar program``, ``examples/*.py`` as a script) and the runs that
-  ``conf.py`` names in ``dextar_runs`` are run into ``<build>/gallery/NAME/`` while the
-  sources are read (two at a time); the pages show their figures and what they printed
+  ``dextar run``, ``dextar program`` or ``dextar design``, ``examples/*.py`` as a script)
+  and the runs that ``conf.py`` names in ``dextar_runs`` are run into
+  ``<build>/gallery/NAME/`` while the sources are read (two at a time); the pages show their figures and what they printed
   (directives ``dextar-gallery``, ``dextar-figure``, ``dextar-output``). A run whose
   inputs and package are unchanged since the last build is not run again. A run that fails
   is a warning (so an error under ``-W``).
@@ -226,17 +226,21 @@ def _title(path: Path) -> str:
 
 
 def example_runs() -> list[Run]:
-    """A run per example: a task file with moves is a program, any other config a run, a
-    script runs as it is."""
+    """A run per example: a task file with ``[design]`` a design sweep of 8 designs on one
+    worker, one with moves a program, any other config a run; a script runs as it is."""
     runs = []
     for path in sorted(EXAMPLES.glob("*.py")):
         runs.append(Run(path.stem, ["python", f"examples/{path.name}"], "", path,
                         _title(path)))
     for path in sorted(EXAMPLES.glob("*.toml")):
         raw = tomllib.loads(path.read_text())
-        command = "program" if "move" in raw or "program" in raw else "run"
-        runs.append(Run(path.stem, ["dextar", command, f"examples/{path.name}"],
-                        f"{path.stem}/", path, _title(path)))
+        if "design" in raw:  # a design task: a small sweep of it (the whole one is minutes)
+            argv = ["dextar", "design", f"examples/{path.name}", "--samples", "8",
+                    "--workers", "1"]
+        else:
+            argv = ["dextar", "program" if "move" in raw or "program" in raw else "run",
+                    f"examples/{path.name}"]
+        runs.append(Run(path.stem, argv, f"{path.stem}/", path, _title(path)))
     return runs
 
 

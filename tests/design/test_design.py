@@ -17,7 +17,7 @@ from dextar.cli import main
 from dextar.config import load_scenario
 from dextar.design.evaluate import Task, evaluate_design
 from dextar.design.pareto import closest_to_ideal, pareto_mask
-from dextar.design.space import METRICS
+from dextar.design.space import METRICS, MOTOR_METRICS
 from dextar.output.design import parse_line
 
 pytest.importorskip("distributed")
@@ -131,7 +131,9 @@ def test_one_design_is_a_row_without_a_cluster(tmp_path):
     task, _ = load_scenario(write_task(tmp_path)).design_task()
     row = evaluate_design(task, (72.0, 72.0, 87.0, 87.0, 60.0))
     assert row["feasible"] and row["reason"] == "" and row["footprint_mm"] == 72 + 87 + 30
-    assert all(np.isfinite(row[k]) for k in METRICS) and row["cycle_time_s"] > 0
+    assert all(np.isfinite(row[k]) for k in METRICS if k not in MOTOR_METRICS)
+    assert row["cycle_time_s"] > 0 and row["shaking_force_N"] > 0  # no counterweights
+    assert all(row[k] is None for k in MOTOR_METRICS)  # no catalogue: no motor chosen
     assert max(row["peak_torque_A_Nm"], row["peak_torque_D_Nm"]) <= 3.4  # [motors]
     short = evaluate_design(task, (20.0, 20.0, 30.0, 30.0, 60.0))  # reach 50 mm: start at 130
     assert not short["feasible"] and "out of reach of leg 1" in short["reason"]

@@ -399,3 +399,31 @@ def time_scaled_motion_files(draw: st.DrawFn) -> tuple[str, list[str], float]:
                       *(",".join(repr(float(v)) for v in r) for r in rows)]) + "\n"
     opts = ["--cutoff-hz", "5"] if draw(st.integers(0, 3)) == 1 else []
     return text, opts, factor
+
+
+# --- issue 32: counterweights on the proximal rods ------------------------------------------
+
+@st.composite
+def counterweight_configs(draw: st.DrawFn) -> dict[str, Any]:
+    """A config whose proximal rods carry counterweights: masses from none to far heavier than
+    the robot, distances from on the axis to far beyond the rods, with or without their own
+    inertia, sometimes a mass without its distance or out of range (refused by name); with
+    gravity, friction and either unit system."""
+    mass = draw(st.sampled_from([0.0, 1e-6, 0.02, 0.5, 50.0, [0.1, 0.0], [0.0, 3.0], -0.1]))
+    inertia: dict[str, Any] = {"effector_mass": draw(st.sampled_from([0.05, 1.0])),
+                               "counterweight_mass": mass}
+    if draw(st.integers(0, 9)) > 0:  # mostly with a distance
+        inertia["counterweight_distance"] = draw(st.sampled_from(
+            [0.0, 1e-6, 5.0, 30.0, 500.0, 1e6, [10.0, 40.0], -1.0]))
+    if draw(st.booleans()):
+        inertia["counterweight_inertia"] = draw(st.sampled_from([0.0, 10.0, 1e4, [5.0, 0.0]]))
+    return {
+        "inertia": inertia,
+        "path": {"type": "arc", "radius": 30.0, "center": [0.0, 110.0], "start_deg": 0.0,
+                 "end_deg": draw(st.sampled_from([90.0, 180.0]))},
+        "law": {"type": draw(st.sampled_from(["min-jerk", "optimal"])),
+                "duration": draw(st.sampled_from([0.3, 2.0]))},
+        "friction": {"coulomb": draw(st.sampled_from([0.0, 0.02])), "viscous": 1e-3},
+        "gravity": {"vector": [0.0, draw(st.sampled_from([0.0, -9810.0]))]},
+        "output": {"units": draw(st.sampled_from(["si", "paper"])), "samples": 101},
+    }

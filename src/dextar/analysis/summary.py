@@ -153,12 +153,17 @@ def run_summary(an: Analysis, checks: dict[str, Any] | None, uniform: Trajectory
 
 
 def _inertia(ine: Inertia) -> dict[str, Any]:
-    return {
+    out: dict[str, Any] = {
         "effector_mass": ine.effector_mass, "payload": ine.payload,
         "proximal": [vars(r) for r in ine.proximal], "distal": [vars(r) for r in ine.distal],
         "rotor": list(ine.rotor), "viscous": list(ine.viscous), "coulomb": list(ine.coulomb),
         "gravity": list(ine.gravity), "coulomb_speed": ine.coulomb_speed,
         "note": "rods: mass, com (distance from the proximal joint), inertia about the com"}
+    if ine.has_counterweights:
+        out["counterweights"] = [vars(c) for c in ine.counterweights]
+        out["note"] += ("; the proximal rods include their counterweights (mass, distance "
+                        "behind the motor axis, inertia about their centre)")
+    return out
 
 
 def _paper(p: PaperComparison) -> dict[str, Any]:

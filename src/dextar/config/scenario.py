@@ -329,14 +329,17 @@ class Scenario:
         does not depend on the robot is computed once here), in SI."""
         return design_task(self, samples=samples, seed=seed)
 
-    def model_file(self, robot_mm: FiveBar, mode: str, inertia: Inertia, comment: str) -> str:
+    def model_file(self, robot_mm: FiveBar, mode: str, inertia: Inertia, comment: str,
+                   tables: Mapping[str, Mapping[str, Any]] | None = None) -> str:
         """A config file of ``inertia`` (SI) on ``robot_mm`` with this scenario's friction
         speed and gravity and its ``[motors]`` and ``[tolerances]`` as the file gives them
-        (``identified.toml``, ``best.toml``)."""
+        (``identified.toml``, ``best.toml``); ``tables`` (config units) replace or add
+        tables (a chosen motor's ``[motors]`` and ``[drive]``)."""
+        extra = {**self.raw("motors", "tolerances"), **(tables or {})}
         return model_toml(robot_mm, mode, self.assembly, inertia,
                           coulomb_speed_deg_s=self.friction_table.coulomb_speed_deg_s,
-                          gravity_mm_s2=self.gravity_table.vector,
-                          extra=self.raw("motors", "tolerances"), comment=comment)
+                          gravity_mm_s2=self.gravity_table.vector, extra=extra,
+                          comment=comment)
 
     @cached_property
     def crossings(self) -> tuple[Crossing, ...]:

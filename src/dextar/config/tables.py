@@ -17,7 +17,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
-from ..dynamics import Inertia, Rod
+from ..dynamics import Counterweight, Inertia, Rod
 from ..dynamics.friction import DEFAULT_COULOMB_SPEED_DEG_S
 from ..errors import ConfigError, DextarError
 from ..geometry import FiveBar
@@ -149,6 +149,14 @@ class InertiaTable(Table):
         "distal_inertia": _pair("", "distal inertias about the com, kg mm^2 (default: a "
                                 "uniform rod, m L^2 / 12)", minimum=0.0),
         "rotor_inertia": _pair("", "rotor inertias, kg mm^2", 0.0, minimum=0.0),
+        "counterweight_mass": _pair("kg", "counterweights on the proximal rods, behind the "
+                                    "motor axes (folded exactly into the rods' mass, centre "
+                                    "and inertia)", 0.0, minimum=0.0),
+        "counterweight_distance": _pair("mm", "distance of each counterweight's centre "
+                                        "behind its motor axis, on the rod's axis", None,
+                                        minimum=0.0),
+        "counterweight_inertia": _pair("", "counterweights' inertias about their own "
+                                       "centres, kg mm^2", 0.0, minimum=0.0),
     }
 
     effector_mass: float = 1.0
@@ -160,11 +168,36 @@ class InertiaTable(Table):
     proximal_inertia: tuple[float, float] | None = None
     distal_inertia: tuple[float, float] | None = None
     rotor_inertia: tuple[float, float] = (0.0, 0.0)
+    counterweight_mass: tuple[float, float] = (0.0, 0.0)
+    counterweight_distance: tuple[float, float] | None = None
+    counterweight_inertia: tuple[float, float] = (0.0, 0.0)
+
+    @classmethod
+    def from_toml(cls, raw: Mapping[str, object]) -> InertiaTable:
+        """Read ``[inertia]``; a counterweight's mass needs its distance."""
+        t = cls(**read_params(cls.NAME, raw, cls.PARAMS))
+        if any(m > 0 for m in t.counterweight_mass) and t.counterweight_distance is None:
+            raise ConfigError("config key [inertia].counterweight_mass needs "
+                              "[inertia].counterweight_distance (mm behind the motor axis)")
+        for m, i in zip(t.counterweight_mass, t.counterweight_inertia, strict=True):
+            if m == 0 and i > 0:
+                raise ConfigError(f"config key [inertia].counterweight_inertia "
+                                  f"{list(t.counterweight_inertia)}: a counterweight of no "
+                                  "mass has no inertia")
+        return t
+
+    def counterweights(self, units: Units) -> tuple[Counterweight, Counterweight]:
+        """The proximal rods' counterweights in run units (none without a mass)."""
+        r = self.counterweight_distance or (0.0, 0.0)
+        cw = [Counterweight(units.mass(self.counterweight_mass[k]), units.length(r[k]),
+                            units.inertia(self.counterweight_inertia[k])) for k in range(2)]
+        return cw[0], cw[1]
 
     def build(self, units: Units, g: FiveBar, friction: FrictionTable,
               gravity: GravityTable) -> Inertia:
         """The run's :class:`~dextar.dynamics.Inertia` (uniform rods where not given; the
-        paper's Fig. 9 ratios 0.08 and 0.1 of the end-effector mass by default)."""
+        paper's Fig. 9 ratios 0.08 and 0.1 of the end-effector mass by default), the
+        counterweights folded into the proximal rods."""
         m = self.effector_mass
 
         def rods(masses: tuple[float, float] | None, coms: tuple[float, float] | None,
@@ -192,7 +225,8 @@ class InertiaTable(Table):
                 coulomb=(units.torque(friction.coulomb[0]), units.torque(friction.coulomb[1])),
                 gravity=(units.acceleration(gravity.vector[0]),
                          units.acceleration(gravity.vector[1])),
-                coulomb_speed=math.radians(friction.coulomb_speed_deg_s) * units.time_s)
+                coulomb_speed=math.radians(friction.coulomb_speed_deg_s) * units.time_s
+            ).with_counterweights(self.counterweights(units))
         except DextarError as exc:
             raise ConfigError(f"config table [inertia]: {exc}") from None
 

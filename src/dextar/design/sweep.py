@@ -5,12 +5,18 @@ default, or a running cluster by its scheduler's address. A chunk is evaluated b
 :func:`~dextar.design.evaluate.evaluate_chunk`; a worker that dies has its chunks retried by
 Dask; a design that fails is a row with its reason, so the sweep never stops for one design.
 Rows reach the caller chunk by chunk (``on_chunk``), in the order chunks finish.
+
+In the Dask dashboard (``Cluster.dashboard``, with bokeh installed) the chunks are the tasks
+named ``dextar-design`` (their key prefix): the Progress panel of the status page counts
+them, the Task Stream shows each one; the Fine Performance Metrics page (unit ``designs``)
+counts the designs evaluated, ``feasible`` and ``not feasible``, as the workers report them.
 """
 
 from __future__ import annotations
 
 import importlib.util
 import time
+import uuid
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from itertools import islice
@@ -23,6 +29,7 @@ from .evaluate import Task, evaluate_chunk
 
 #: Dask's distributed scheduler (the ``design`` extra), imported when a sweep runs.
 dask_distributed = lazy_module("distributed")
+dask_metrics = lazy_module("distributed.metrics")
 
 #: How to get the extra that holds Dask.
 INSTALL_HINT = "pip install -e '.[design]' (or pip install 'dextar[design]')"
@@ -30,6 +37,8 @@ INSTALL_HINT = "pip install -e '.[design]' (or pip install 'dextar[design]')"
 IN_FLIGHT_PER_WORKER = 4
 #: Seconds to wait for a scheduler given by address.
 CONNECT_TIMEOUT_S = 8
+#: The key prefix of every chunk's Dask task (the name the dashboard shows).
+TASK_PREFIX = "dextar-design"
 
 
 @dataclass(frozen=True)
@@ -57,6 +66,37 @@ def chunks_of(indices: Sequence[int], size: int) -> list[list[int]]:
         else:
             out.append([i])
     return out
+
+
+def evaluate_chunk_metered(task: Task, designs: Array, first: int) -> list[dict[str, Any]]:
+    """:func:`~dextar.design.evaluate.evaluate_chunk`, and on a Dask worker the designs it
+    evaluated reported to the dashboard's Fine Performance Metrics (unit ``designs``:
+    ``feasible`` and ``not feasible``)."""
+    rows = evaluate_chunk(task, designs, first)
+    ok = sum(1 for r in rows if r["feasible"])
+    meter = dask_metrics.context_meter
+    meter.digest_metric("feasible", ok, "designs")
+    meter.digest_metric("not feasible", len(rows) - ok, "designs")
+    return rows
+
+
+class Chunks:
+    """The units of work of one run on a cluster: the task sent to every worker once, each
+    chunk a Dask task named ``dextar-design-<run>-<first design>`` (retried twice when its
+    worker dies)."""
+
+    def __init__(self, cluster: Cluster, task: Task) -> None:
+        """Send ``task`` to the workers."""
+        self.client = cluster.client
+        # a key of its own (hash=False): a sweep run right after another on the same client
+        # would otherwise share the key the first one is releasing, and lose the task
+        self.task = self.client.scatter(task, broadcast=True, hash=False)
+        self.run = uuid.uuid4().hex[:8]
+
+    def submit(self, designs: Array, first: int) -> Any:
+        """The future of the rows of ``designs`` (m, columns) numbered from ``first``."""
+        return self.client.submit(evaluate_chunk_metered, self.task, designs, first,
+                                  key=f"{TASK_PREFIX}-{self.run}-{first}", retries=2)
 
 
 class Cluster:
@@ -87,6 +127,14 @@ class Cluster:
             self.cluster = distributed.LocalCluster(n_workers=workers, threads_per_worker=1,
                                                     processes=True, dashboard_address=":0")
             self.client = distributed.Client(self.cluster)
+
+    @property
+    def dashboard(self) -> str | None:
+        """The address of the Dask dashboard (None when bokeh, which serves it, is missing)."""
+        if importlib.util.find_spec("bokeh") is None:
+            return None
+        link = getattr(self.client, "dashboard_link", None)
+        return str(link) if link else None
 
     @property
     def workers(self) -> int:
@@ -131,18 +179,14 @@ def run_sweep(cluster: Cluster, task: Task, designs: Array, todo: Sequence[int],
     """
     distributed = require_dask()
     t0 = time.perf_counter()
-    client = cluster.client
     n_workers = cluster.workers
     done = 0
     if todo:
-        # a key of its own (hash=False): a sweep run right after another on the same client
-        # would otherwise share the key the first one is releasing, and lose the task
-        task_f = client.scatter(task, broadcast=True, hash=False)
+        chunks = Chunks(cluster, task)
         parts = iter(chunks_of(sorted(todo), chunk))
 
         def submit(p: list[int]) -> Any:
-            return client.submit(evaluate_chunk, task_f, designs[p[0]:p[-1] + 1], p[0],
-                                 pure=False, retries=2)
+            return chunks.submit(designs[p[0]:p[-1] + 1], p[0])
 
         # a bounded number of chunks in flight: the scheduler and this process stay small
         # whatever the number of designs

@@ -17,7 +17,7 @@ from .exact import (
     state_dynamics,
     trajectory_torques,
 )
-from .inertia import Inertia, Rod, paper_inertia
+from .inertia import Counterweight, Inertia, Rod, paper_inertia
 
 if TYPE_CHECKING:
     from .along_path import RobotAlongJointLine, RobotAlongPath, time_optimal_law
@@ -29,6 +29,6 @@ __getattr__, __dir__ = lazy_attributes(__name__, dict.fromkeys(
     ("RobotAlongJointLine", "RobotAlongPath", "time_optimal_law"), ".along_path"))
 
 
-__all__ = ["Inertia", "Model", "Reactions", "Rod", "accelerations", "bias_forces", "gravity_torques",
+__all__ = ["Counterweight", "Inertia", "Model", "Reactions", "Rod", "accelerations", "bias_forces", "gravity_torques",
            "inverse_dynamics", "joint_reactions", "kinetic_energy", "mass_matrix",
            "paper_inertia", "state_dynamics", "TorqueResult", "trajectory_torques", "RobotAlongJointLine", "RobotAlongPath", "time_optimal_law"]

@@ -7,6 +7,15 @@ about its proximal joint ``J = I + m c^2`` (the proximal rods' masses only throu
 each motor's friction through its viscous and Coulomb coefficients (the Coulomb column is
 ``tanh(qdot / v_s)``, the regularisation speed being fixed).
 
+Counterweights. A counterweight of mass ``m_c`` at ``r`` behind a motor axis, with inertia
+``I_c`` about its centre, is part of its proximal rod's rigid body
+(:meth:`~dextar.dynamics.Rod.with_counterweight`): it adds ``I_c + m_c r^2`` to ``J_A`` (or
+``J_D``) and takes ``m_c r`` off ``h_AB`` (or ``h_DC``); its mass, like the rod's, is not in
+the torques. So the regressor is unchanged, an identification identifies each proximal rod
+with its counterweight (``J`` and ``h`` of the pair: the data cannot tell them apart), and a
+counterweight added or changed after an identification shifts those two parameters by these
+amounts.
+
 Derivation (the same virtual-power decomposition as :mod:`dextar.dynamics.exact`): a distal
 rod BP loads B and P with ``f = m (B'' - g) + (h / L)(P'' - B'')`` and the couple of its
 rotary inertia; projected on the partial velocities, with ``T_X(F)`` the torques of a force
@@ -47,10 +56,14 @@ class StandardParameter:
 #: preference of the base-parameter reduction: a column that depends on earlier ones is
 #: lumped into them (the distal masses into the proximal parameters).
 STANDARD: tuple[StandardParameter, ...] = (
-    StandardParameter("J_A", "rotor A + proximal rod AB about A", "kg m^2", True),
-    StandardParameter("h_AB", "first moment of rod AB about A (m c)", "kg m", False),
-    StandardParameter("J_D", "rotor D + proximal rod DC about D", "kg m^2", True),
-    StandardParameter("h_DC", "first moment of rod DC about D (m c)", "kg m", False),
+    StandardParameter("J_A", "rotor A + proximal rod AB (with its counterweight) about A",
+                      "kg m^2", True),
+    StandardParameter("h_AB", "first moment of rod AB (with its counterweight) about A (m c)",
+                      "kg m", False),
+    StandardParameter("J_D", "rotor D + proximal rod DC (with its counterweight) about D",
+                      "kg m^2", True),
+    StandardParameter("h_DC", "first moment of rod DC (with its counterweight) about D (m c)",
+                      "kg m", False),
     StandardParameter("m_P", "point mass at P (end-effector + payload)", "kg", True),
     StandardParameter("J_BP", "distal rod BP about B", "kg m^2", True),
     StandardParameter("h_BP", "first moment of rod BP about B (m c)", "kg m", False),

@@ -601,7 +601,8 @@ def _flat(m: Array, q: Array, active: Array) -> _Flat:
 def _unreachable(co: PathCoefficients, k: int, tmax: Array, units: Units | None
                  ) -> InfeasibleError:
     need = np.abs(co.g[k]) + co.coulomb
-    i = int(np.argmax(need / tmax))
+    with np.errstate(divide="ignore", invalid="ignore"):  # a limit tightened to 0: that motor
+        i = int(np.argmax(need / tmax))
     motor = "A" if i == 0 else "D"
     return InfeasibleError(
         f"no motion within the limits passes {_describe(co, k, units)}: the motor at {motor} "

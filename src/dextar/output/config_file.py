@@ -7,7 +7,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from ..dynamics import Inertia
-from ..errors import NumericalError
+from ..errors import DextarError, NumericalError
 from ..geometry import FiveBar
 from .tables import number
 
@@ -32,6 +32,17 @@ def model_toml(robot_mm: FiveBar, working_mode: str, assembly_mode: str, inertia
     tables of ``extra`` as given) whose model is ``inertia`` (SI) on ``robot_mm``; values in
     config units (mm, kg, kg mm^2, N m, N m s/rad), written to 17 digits."""
     p1, p2 = inertia.proximal
+    weights: list[str] = []
+    if inertia.has_counterweights:
+        try:  # the rods apart from their counterweights (read back, they fold the same)
+            p1, p2 = inertia.bare_proximal
+        except DextarError:  # rods that no longer hold their record: the folded rods
+            pass
+        else:
+            c1, c2 = inertia.counterweights
+            weights = [f"counterweight_mass = {_pair(c1.mass, c2.mass)}",
+                       f"counterweight_distance = {_pair(c1.distance * 1e3, c2.distance * 1e3)}",
+                       f"counterweight_inertia = {_pair(c1.inertia * 1e6, c2.inertia * 1e6)}"]
     d1, d2 = inertia.distal
     kgmm2 = 1e6
     lines = [f"# {line}" for line in comment.splitlines()] + [
@@ -51,6 +62,7 @@ def model_toml(robot_mm: FiveBar, working_mode: str, assembly_mode: str, inertia
         f"distal_com = {_pair(d1.com * 1e3, d2.com * 1e3)}",
         f"distal_inertia = {_pair(d1.inertia * kgmm2, d2.inertia * kgmm2)}",
         f"rotor_inertia = {_pair(inertia.rotor[0] * kgmm2, inertia.rotor[1] * kgmm2)}",
+        *weights,
         "",
         "[friction]           # N m s/rad, N m, deg/s",
         f"viscous = {_pair(*inertia.viscous)}",

@@ -19,6 +19,11 @@ loop closed and the motion's velocities. Load it with::
 
 Joint order in ``qpos``: ``phi, theta1, psi, theta2``, where ``theta1`` and ``theta2`` are the
 distal rods' angles relative to their proximal rods.
+
+A proximal rod's counterweight (:attr:`dextar.dynamics.Inertia.counterweights`) is a body of
+its own, welded to its rod (a child body without a joint) at its distance behind the motor
+axis, with its mass and inertia and a sphere to see it: MuJoCo combines the two, so the
+export checks the folding of :meth:`dextar.dynamics.Rod.with_counterweight` independently.
 """
 
 from __future__ import annotations
@@ -27,6 +32,8 @@ import numpy as np
 
 from .._arrays import Array
 from ..dynamics.exact import Model
+from ..dynamics.inertia import Counterweight
+from ..errors import DextarError
 from ..kinematics import direct_kinematics, elbows, task_velocity
 
 #: Constraint softness: as stiff as MuJoCo allows (impedance 0.9999).
@@ -63,6 +70,13 @@ def to_mjcf(model: Model, *, name: str = "dextar",
     (pass an SI model for MuJoCo's usual units)."""
     r, ine = model.robot, model.inertia
     p1, p2 = ine.proximal
+    cws: tuple[Counterweight | None, Counterweight | None] = (None, None)
+    if ine.has_counterweights:
+        try:  # the rods apart from their counterweights
+            p1, p2 = ine.bare_proximal
+            cws = ine.counterweights
+        except DextarError:  # rods that do not hold their record: the folded rods, exact
+            p1, p2 = ine.proximal
     d1, d2 = ine.distal
     mP = ine.point_mass
     # distal rod BP with the point mass at its tip
@@ -76,10 +90,16 @@ def to_mjcf(model: Model, *, name: str = "dextar",
             (r.A, p1, r.l1, r.L1, m13, c13, i13),
             (r.D, p2, r.l2, r.L2, d2.mass, d2.com, d2.inertia)), start=1):
         joint = "phi" if k == 1 else "psi"
+        cw = cws[k - 1]
+        weight = "" if cw is None or cw.none else f"""
+      <body name="counterweight{k}" pos="{_fmt(-cw.distance, 0, 0)}">
+        <inertial pos="0 0 0" mass="{cw.mass:.17g}" diaginertia="{_fmt(*(max(cw.inertia, 1e-15),) * 3)}"/>
+        <geom type="sphere" size="{2.5 * rad:.6g}" mass="0" contype="0" conaffinity="0"/>
+      </body>"""
         leg.append(f"""    <body name="proximal{k}" pos="{_fmt(pivot[0], pivot[1], 0)}">
       <joint name="{joint}" type="hinge" axis="0 0 1" armature="{ine.rotor[k - 1]:.17g}" damping="{ine.viscous[k - 1]:.17g}" frictionloss="{ine.coulomb[k - 1]:.17g}" solreffriction="{SOLREF_FRICTION}"/>
       {_inertial(prox.mass, prox.com, prox.inertia)}
-      <geom type="capsule" fromto="0 0 0 {l:.17g} 0 0" size="{rad:.6g}" mass="0" contype="0" conaffinity="0"/>
+      <geom type="capsule" fromto="0 0 0 {l:.17g} 0 0" size="{rad:.6g}" mass="0" contype="0" conaffinity="0"/>{weight}
       <body name="distal{k}" pos="{l:.17g} 0 0">
         <joint name="theta{k}" type="hinge" axis="0 0 1"/>
         {_inertial(mass_d, com_d, inert_d)}
