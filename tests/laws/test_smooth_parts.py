@@ -49,7 +49,7 @@ def setup(chain):
     st = solve._start(dyn, tab, second, third, base, None)
     me = start.pinned(start.fractions(st, tab, cons, 32, solve.KNOT_TOL), st, tab.joints)
     J = start.start_jerks(st, me, dyn.length)
-    model = rows.Model(me, tab, second, third, dyn.length)
+    model = rows.RowModel(me, tab, second, third, dyn.length)
     Tk = slp.time_scaled(model, J, np.full(me.M, st.T))
     return model, me, J, Tk, tab
 

@@ -85,7 +85,7 @@ def local(h: Array, k: Array, theta: Array, gs: Array, gw: Array, ga: Array, gj:
                      np.abs(ga), np.abs(gj), np.abs(gT)], axis=1)
 
 
-class Model:
+class RowModel:
     """The rows of the transcription at any motion (see the module doc)."""
 
     def __init__(self, mesh: Mesh, table: Table, second: Sequence[Constraint],

@@ -26,7 +26,7 @@ import numpy as np
 from ..._arrays import Array
 from .banded import LPResult, StagedLP, solve_staged
 from .mesh import Mesh, Motion, knot_T, motion, projected
-from .rows import Model, Rows
+from .rows import RowModel, Rows
 
 log = logging.getLogger(__name__)
 
@@ -250,7 +250,7 @@ class Programme:
         return motion(mesh, j * Tk**3, Tk, length)
 
 
-def time_scaled(model: Model, J: Array, Tk: Array) -> Array:
+def time_scaled(model: RowModel, J: Array, Tk: Array) -> Array:
     """The durations that bring the normalised motion ``J`` just within its rows (a start
     that is slower than the limits allow is sped up, one beyond them slowed down), all
     scaled alike: each row's use scales about as ``T^-p`` (:meth:`Rows.powers`); exact
@@ -275,7 +275,7 @@ def time_scaled(model: Model, J: Array, Tk: Array) -> Array:
     return Tk
 
 
-def slp(model: Model, J: Array, Tk: Array, budget: int, delta: float) -> Run:
+def slp(model: RowModel, J: Array, Tk: Array, budget: int, delta: float) -> Run:
     """Sequential linear programming with a trust region from the motion ``(J, Tk)``, which
     meets the end conditions (see the module doc)."""
     mesh, S = model.mesh, model.length

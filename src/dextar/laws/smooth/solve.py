@@ -21,7 +21,7 @@ from ..time_optimal import TimeOptimalLaw, solve_time_optimal_law
 from .check import RATE_KINDS, check
 from .law import JerkLimitedLaw
 from .mesh import Mesh, integrate, make_mesh
-from .rows import Model
+from .rows import RowModel
 from .slp import FEAS_TOL, RESTART_DELTA, START_DELTA, Run, slp, time_scaled
 from .start import (
     CapConstraint,
@@ -145,7 +145,7 @@ def solve_jerk_limited_law(dynamics: PathDynamics, *, motors: MotorLimits | None
     fresh = True  # a new start: its duration brought within the rows first
     best: _Round | None = None
     while True:
-        model = Model(mesh, table, [c.scaled(scales) for c in second],
+        model = RowModel(mesh, table, [c.scaled(scales) for c in second],
                       [c.scaled(scales) for c in third], length)
         if fresh:
             Tk = time_scaled(model, J, Tk)
