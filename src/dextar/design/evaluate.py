@@ -314,9 +314,7 @@ def _choose(task: Task, robot: FiveBar, inertia: Inertia, x: Mapping[str, float]
             raise InfeasibleError(errors[0])
         raise InfeasibleError(f"no motor of {task.catalogue.source} moves the task within "
                               f"its limits at any ratio; the last tried, {errors[-1]}")
-    v = last.size.violations[0]
-    where = f" at t = {v.t_s:.4g} s in move {v.move}" if v.t_s is not None else ""
-    said = (f"motor {v.motor} {v.quantity} {v.value:.4g} above {v.limit:.4g}{where}")
+    said = last.size.violations[0].text()
     if task.catalogue is None or task.motor_choice == "search":
         return last, f"motors exceeded: {said}"
     assert last.gearmotor is not None

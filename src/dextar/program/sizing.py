@@ -71,17 +71,30 @@ class Violation:
     limit: float
     move: int | None
     t_s: float | None
+    #: Where the limit comes from when it is not the plain one (the torque-speed envelope).
+    note: str = ""
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready."""
         return asdict(self)
 
+    @property
+    def unit(self) -> str:
+        """The SI unit of the value and the limit."""
+        return UNITS.get(self.quantity, "")
+
     def text(self) -> str:
-        """The violation in words."""
+        """The violation in words, with its unit."""
         where = (f" at t = {self.t_s:.4g} s in move {self.move}" if self.t_s is not None
                  else "")
-        return (f"motor {self.motor} {self.quantity} {self.value:.4g} above its limit "
-                f"{self.limit:.4g}{where}")
+        u = f" {self.unit}" if self.unit else ""
+        return (f"motor {self.motor} {self.quantity} {self.value:.4g}{u} above its limit "
+                f"{self.limit:.4g}{u}{self.note}{where}")
+
+
+#: The units of the quantities a :class:`Violation` names (SI).
+UNITS = {"torque": "N m", "rms_torque": "N m", "speed": "rad/s", "acceleration": "rad/s^2",
+         "jerk": "rad/s^3", "torque_rate": "N m/s"}
 
 
 @dataclass(frozen=True)
@@ -126,9 +139,12 @@ def sizing(res: ProgramResult) -> Sizing:
             ratios["peak_speed_ratio"] = float(np.abs(dq[:, i]).max() / m.max_speed[i])
             k = int(np.argmax(ratio))
             if ratio[k] > 1.0 + SIZING_TOL:
+                peak = float(np.asarray(m.peak_torque, float)[i])
+                note = (f" (the torque-speed envelope's at {abs(dq[k, i]):.4g} rad/s; the peak "
+                        f"{peak:.4g} N m)" if avail[k] < peak * (1 - 1e-9) else "")
                 violations.append(Violation(name, "torque", float(abs(tau[k, i])),
                                             float(avail[k]), int(res.move_index[k]),
-                                            float(t[k])))
+                                            float(t[k]), note))
             k = int(np.argmax(np.abs(dq[:, i])))
             if abs(dq[k, i]) > m.max_speed[i] * (1 + SIZING_TOL):
                 violations.append(Violation(name, "speed", float(abs(dq[k, i])),
