@@ -31,6 +31,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -38,6 +39,7 @@ from ..._arrays import Array
 from ..._lazy import lazy_module
 
 lapack = lazy_module("scipy.linalg.lapack")
+sparse = lazy_module("scipy.sparse")
 
 #: States per knot (arc length, speed, acceleration, duration), equalities per interval
 #: (the exact integration and the duration's continuity), border variables (the slack).
@@ -64,6 +66,13 @@ REG = 1e-11
 ETA = 0.99
 #: The start's multipliers: on the central path of this complementarity.
 MU0 = 1e-3
+#: Rows whose terms of the Newton matrix are built at once (the temporaries of a chunk are
+#: a few hundred bytes a row; one chunk for the programmes of a move).
+CHUNK = 8192
+#: A programme whose rows' products with their pairs of variables are at most this many
+#: keeps them from iteration to iteration, as sparse matrices (memory: about 16 bytes
+#: each; larger programmes, by chunks, compute them in every iteration).
+KEEP = 1 << 20
 
 
 @dataclass(frozen=True)
@@ -121,6 +130,10 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
     residual may stall or grow: the best iterate met is returned, converged when it is
     within a hundred times those tolerances."""
     c, rk, ra, rg, rb, E, lo, hi = (lp.c, lp.rk, lp.ra, lp.rg, lp.rb, lp.E, lp.lo, lp.hi)
+    # the rows in the order of their intervals (so that a chunk of rows touches one stretch
+    # of the band; the rows' order is internal: the result is the states)
+    order = np.argsort(rk, kind="stable")
+    rk, ra, rg, rb = rk[order], ra[order], rg[order], rb[order]
     e = np.asarray(lp.e, float).reshape(-1)
     nx = len(c)
     K = (nx - P) // D
@@ -151,13 +164,31 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
     # that LAPACK takes it as it is): flat index j * nrow + KL + KU + i - j
     nrow = 2 * KL + KU + 1
     clear = (cols * nrow + KL + KU + fpos[:, None] - cols)[ok]
-    # the rows' terms of the matrix, by pairs of their variables (a <= b): each pair's sum
-    # over the rows of an interval lands on one diagonal of the band
-    pairs = [(a, b) for a in range(NR) for b in range(a, NR)
-             if ra[:, a].any() and ra[:, b].any()]
+    # the rows' terms of the matrix, by ordered pairs of their variables (both triangles):
+    # the term of row r and pair (a, b) lands at band index base[r] * nrow + offset
+    used = [a for a in range(NR) if ra[:, a].any()]
+    pa = np.array([a for a in used for b in used], int)
+    pb = np.array([b for a in used for b in used], int)
+    pair_off = (ROW_POS[pb] * nrow + KL + KU + ROW_POS[pa] - ROW_POS[pb])
     diag_x = xband * nrow + KL + KU
     diag_y = yband * nrow + KL + KU
-
+    # the equalities' part of the band (and the dual regularisation): the same in every
+    # iteration
+    ab_eq = np.zeros(nrow * nb)
+    abT_eq = ab_eq.reshape(nb, nrow)  # abT[j, KL + KU + i - j] = A[i, j]
+    for q in range(Q):  # the equalities and their transposes, interval by interval
+        i = D + q
+        for a in range(2 * D):
+            j = EQ_POS[a]
+            abT_eq[j:nb - BLOCK + j + 1:BLOCK, KL + KU + i - j] += Em[:, q, a]
+            abT_eq[i:nb - BLOCK + i + 1:BLOCK, KL + KU + j - i] += Em[:, q, a]
+    ab_eq[diag_y] -= REG
+    # the rows by chunks (their temporaries bounded), each with its stretch of the band;
+    # a small programme's index arrays and products kept (one chunk)
+    keep = R * len(pa) <= KEEP
+    step = R if keep else CHUNK
+    chunks = [_Chunk(ra[r0:r0 + step], xr[r0:r0 + step], base[r0:r0 + step], pa, pb,
+                     pair_off, nrow, nb, keep) for r0 in range(0, R, step)]
     iu, il = np.flatnonzero(hasu), np.flatnonzero(hasl)
     nu, nl = len(iu), len(il)
     m_all = R + nu + nl
@@ -168,21 +199,24 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
 
     def G(x: Array) -> Array:
         """Every inequality's ``g . x``."""
-        out = rg @ x[nk:]
-        for a in range(NR):
-            out += ra[:, a] * x[xr + ROW_X[a]]
-        return np.concatenate([out, sgn * x[bnd]])
+        out = np.concatenate([rg @ x[nk:], sgn * x[bnd]])
+        r0 = 0
+        for ch in chunks:
+            out[r0:r0 + ch.n] += ch.times(x)
+            r0 += ch.n
+        return out
 
     def GT(z: Array) -> Array:
         """``sum z g`` over the inequalities (fixed variables' entries zero)."""
-        out = np.zeros(nx)
+        out = np.bincount(bnd, sgn * z[R:], minlength=nx)
         zr = z[:R]
-        for a in range(NR):
-            out[ROW_X[a]:nk] += np.bincount(xr, ra[:, a] * zr, minlength=nk)[:nk - ROW_X[a]]
-        out[nk:] = rg.T @ zr
-        out += np.bincount(bnd, sgn * z[R:], minlength=nx)
+        r0 = 0
+        for ch in chunks:
+            out[:nk] += ch.transposed(zr[r0:r0 + ch.n], nk)
+            r0 += ch.n
+        out[nk:] += rg.T @ zr
         out[fixed] = 0.0
-        return out
+        return np.asarray(out)
 
     def Ex(x: Array) -> Array:
         return np.asarray(np.einsum("kqj,kj->kq", E, x[exi]).reshape(-1) - e)
@@ -227,29 +261,18 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
         diag = np.full(nx, REG) + np.bincount(bnd, Dz[R:], minlength=nx)
         diag[fixed] = 1.0
         Dr = Dz[:R]
-        ab = np.zeros(nrow * nb)
-        abT = ab.reshape(nb, nrow)  # abT[j, KL + KU + i - j] = A[i, j]
-        for q in range(Q):  # the equalities and their transposes, interval by interval
-            i = D + q
-            for a in range(2 * D):
-                j = EQ_POS[a]
-                abT[j:nb - BLOCK + j + 1:BLOCK, KL + KU + i - j] += Em[:, q, a]
-                abT[i:nb - BLOCK + i + 1:BLOCK, KL + KU + j - i] += Em[:, q, a]
-        ab[diag_y] -= REG
-        for a, b in pairs:
-            add = np.bincount(base, Dr * ra[:, a] * ra[:, b], minlength=nb)
-            i, j = ROW_POS[a], ROW_POS[b]
-            abT[j:, KL + KU + i - j] += add[:nb - j]
-            if a != b:
-                abT[i:, KL + KU + j - i] += add[:nb - i]
+        ab = ab_eq.copy()
+        U = np.zeros((nb, P))
+        r0 = 0
+        for ch in chunks:
+            d = Dr[r0:r0 + ch.n]
+            ch.band(d, ab)
+            for p in range(P):
+                ch.border(d * rg[r0:r0 + ch.n, p], U[:, p])
+            r0 += ch.n
+        abT = ab.reshape(nb, nrow)
         ab[clear] = 0.0
         ab[diag_x] += diag[:nk]
-        U = np.zeros((nb, P))
-        for p in range(P):
-            drg = Dr * rg[:, p]
-            for a in range(NR):
-                U[ROW_POS[a]:, p] += np.bincount(base, drg * ra[:, a],
-                                                 minlength=nb)[:nb - ROW_POS[a]]
         U[fpos] = 0.0
         corner = (rg * Dr[:, None]).T @ rg + np.diag(diag[nk:])
         lu, piv, info = lapack.dgbtrf(abT.T, KL, KU, overwrite_ab=1)
@@ -316,6 +339,79 @@ class _Newton:
         dx[self.fixed] = 0.0
         dz = self.Dz * (self.G(dx) + t)
         return dx, db[self.yband], dz, (-cc - self.s * dz) / self.z
+
+
+class _Chunk:
+    """A chunk of a programme's rows (their coefficients ``ra``, first variables ``xr`` and
+    first band positions ``base``): their parts of ``G x``, ``G^T z``, the band and the
+    border. Kept (``keep``, a small programme), they are sparse matrices made once; else
+    index arrays and products made at each use (memory: the chunk's temporaries only)."""
+
+    def __init__(self, ra: Array, xr: Array, base: Array, pa: Array, pb: Array,
+                 pair_off: Array, nrow: int, nb: int, keep: bool) -> None:
+        self.ra, self.xr, self.base, self.n = ra, xr, base, len(ra)
+        self.pa, self.pb, self.pair_off, self.nrow = pa, pb, pair_off, nrow
+        top = BLOCK + int(ROW_POS.max()) + 1  # past a row's last band position
+        self.u0 = int(base[0]) if self.n else 0
+        self.u1 = min(int(base[-1]) + top, nb) if self.n else 0
+        self.kept: tuple[Any, Any, Any, Any] | None = None
+        if keep and self.n:
+            xi, bi, prod, ui = self._arrays()
+            n, nx = self.n, int(xi.max()) + 1
+            one = np.repeat(np.arange(n), NR)
+            g = sparse.csr_matrix((ra.reshape(-1), (one, xi.reshape(-1))), shape=(n, nx))
+            self.kept = (g, g.T.tocsr(),
+                         sparse.csr_matrix((prod.reshape(-1), (bi, np.repeat(np.arange(n),
+                                                                              len(pa)))),
+                                           shape=((self.u1 - self.u0) * nrow, n)),
+                         sparse.csr_matrix((ra.reshape(-1), (ui, one)),
+                                           shape=(self.u1 - self.u0, n)))
+
+    def _arrays(self) -> tuple[Array, Array, Array, Array]:
+        """The variables of each row (n, 6), the band indices of its pairs (n * pairs,),
+        the pairs' products (n, pairs) and each row's band positions (n * 6,)."""
+        ra, u0 = self.ra, self.u0
+        xi = self.xr[:, None] + ROW_X[None, :]
+        bi = ((self.base - u0) * self.nrow)[:, None] + self.pair_off[None, :]
+        prod = ra[:, self.pa] * ra[:, self.pb]
+        ui = self.base[:, None] + ROW_POS[None, :] - u0
+        return xi, bi.reshape(-1), prod, ui.reshape(-1)
+
+    def times(self, x: Array) -> Array:
+        """The rows' ``ra . x`` (n,)."""
+        if self.kept is not None:
+            g = self.kept[0]
+            return np.asarray(g @ x[:g.shape[1]])
+        return np.asarray(np.einsum("ij,ij->i", self.ra, x[self._arrays()[0]]))
+
+    def transposed(self, z: Array, nk: int) -> Array:
+        """``sum z ra`` over the rows, on the knots' states (nk,)."""
+        if self.kept is not None:
+            out = np.zeros(nk)
+            gt = self.kept[1]
+            out[:gt.shape[0]] = gt @ z
+            return out
+        xi = self._arrays()[0]
+        return np.bincount(xi.reshape(-1), (self.ra * z[:, None]).reshape(-1),
+                           minlength=nk)[:nk]
+
+    def band(self, d: Array, ab: Array) -> None:
+        """Add the rows' ``ra^T diag(d) ra`` to the band ``ab`` (flat, LAPACK's storage)."""
+        b0, b1 = self.u0 * self.nrow, self.u1 * self.nrow
+        if self.kept is not None:
+            ab[b0:b1] += self.kept[2] @ d
+            return
+        _, bi, prod, _ = self._arrays()
+        ab[b0:b1] += np.bincount(bi, (prod * d[:, None]).reshape(-1), minlength=b1 - b0)
+
+    def border(self, d: Array, u: Array) -> None:
+        """Add the rows' ``ra^T d`` to the band's part ``u`` (nb,) of a border column."""
+        if self.kept is not None:
+            u[self.u0:self.u1] += self.kept[3] @ d
+            return
+        ui = self._arrays()[3]
+        u[self.u0:self.u1] += np.bincount(ui, (self.ra * d[:, None]).reshape(-1),
+                                          minlength=self.u1 - self.u0)
 
 
 def _to_bound(v: Array, dv: Array) -> float:
