@@ -34,9 +34,10 @@ class Table:
         """The grid's arc lengths."""
         return self.co.s
 
-    def at(self, s: Array, before: bool = False) -> tuple[Array, Array]:
+    def at(self, s: Array, before: bool | Array = False) -> tuple[Array, Array]:
         """The columns at arc lengths ``s`` (n,) and their slopes, (n, 18) each; at a grid
-        point, those of the segment after it (``before``: the one before it)."""
+        point, those of the segment after it (``before``: the one before it; an array (n,):
+        for each point)."""
         return segments(self.co.s, self.lo, self.hi, s, before)
 
     @cached_property
@@ -144,11 +145,16 @@ def interp(grid: Array, values: Array, s: Array) -> tuple[Array, Array]:
     return segments(grid, values[:-1], values[1:], s)
 
 
-def segments(grid: Array, lo: Array, hi: Array, s: Array, before: bool = False
-              ) -> tuple[Array, Array]:
+def segments(grid: Array, lo: Array, hi: Array, s: Array, before: bool | Array = False
+             ) -> tuple[Array, Array]:
     """Linear on each segment from ``lo`` to ``hi`` (N, p): the values at ``s`` (n,) and the
-    slopes, two arrays (n, p) (at a grid point the segment after it, or ``before`` it)."""
-    k = np.searchsorted(grid, s, side="left" if before else "right") - 1
+    slopes, two arrays (n, p) (at a grid point the segment after it, or ``before`` it; an
+    array (n,): for each point)."""
+    if np.ndim(before):
+        k = np.where(before, np.searchsorted(grid, s, side="left"),
+                     np.searchsorted(grid, s, side="right")) - 1
+    else:
+        k = np.searchsorted(grid, s, side="left" if before else "right") - 1
     k = np.clip(k, 0, len(grid) - 2)
     ds = grid[k + 1] - grid[k]
     w = ((np.clip(s, grid[0], grid[-1]) - grid[k]) / ds)[:, None]
