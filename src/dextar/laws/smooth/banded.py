@@ -356,15 +356,17 @@ class _Chunk:
         self.u1 = min(int(base[-1]) + top, nb) if self.n else 0
         self.kept: tuple[Any, Any, Any, Any] | None = None
         if keep and self.n:
+            # (each row's entries are a column of the band's and the border's matrices, a
+            # row of G: compressed storage made directly, no sorting)
             xi, bi, prod, ui = self._arrays()
-            n, nx = self.n, int(xi.max()) + 1
-            one = np.repeat(np.arange(n), NR)
-            g = sparse.csr_matrix((ra.reshape(-1), (one, xi.reshape(-1))), shape=(n, nx))
-            self.kept = (g, g.T.tocsr(),
-                         sparse.csr_matrix((prod.reshape(-1), (bi, np.repeat(np.arange(n),
-                                                                              len(pa)))),
+            n, nx, npair = self.n, int(xi.max()) + 1, len(pa)
+            g = sparse.csr_matrix((ra.reshape(-1), xi.reshape(-1),
+                                   np.arange(0, NR * n + 1, NR)), shape=(n, nx))
+            self.kept = (g, g.T,
+                         sparse.csc_matrix((prod.reshape(-1), bi,
+                                            np.arange(0, npair * n + 1, npair)),
                                            shape=((self.u1 - self.u0) * nrow, n)),
-                         sparse.csr_matrix((ra.reshape(-1), (ui, one)),
+                         sparse.csc_matrix((ra.reshape(-1), ui, np.arange(0, NR * n + 1, NR)),
                                            shape=(self.u1 - self.u0, n)))
 
     def _arrays(self) -> tuple[Array, Array, Array, Array]:
@@ -416,5 +418,5 @@ class _Chunk:
 
 def _to_bound(v: Array, dv: Array) -> float:
     """The largest step ``a`` with ``v + a dv >= 0`` (``inf`` when none is limited)."""
-    with np.errstate(divide="ignore"):
-        return float(np.min(np.where(dv < 0, -v / dv, np.inf), initial=np.inf))
+    neg = dv < 0
+    return float(np.min(-v[neg] / dv[neg], initial=np.inf))
