@@ -81,9 +81,10 @@ def make_table(dynamics: PathDynamics, s: Array) -> Table:
     s = np.asarray(s, float)
     length = float(s[-1])
     for _ in range(TABLE_ROUNDS):
-        co, lo, hi, joint = _columns(dynamics, s, length)
         mid = 0.5 * (s[1:] + s[:-1])
-        m = _columns(dynamics, mid, length, central_only=True)[1]
+        both = _coefficients(dynamics, [s, mid], length)  # (one evaluation of the model)
+        co, lo, hi, joint = _columns(s, *both[0])
+        m = _columns(mid, *both[1], central_only=True)[1]
         scale = np.abs(np.concatenate([lo, hi])).max(axis=0) + 1e-300
         err = (np.abs(m - 0.5 * (lo + hi)) / scale).max(axis=1)
         bad = err > TABLE_TOL
@@ -92,7 +93,7 @@ def make_table(dynamics: PathDynamics, s: Array) -> Table:
         pieces = np.where(bad, np.clip(np.ceil(np.sqrt(err / TABLE_TOL)), 2, 8), 1)
         s = _split(s, pieces.astype(int))
     else:
-        co, lo, hi, joint = _columns(dynamics, s, length)
+        co, lo, hi, joint = _columns(s, *_coefficients(dynamics, [s], length)[0])
     return Table(co, lo, hi, co.s[joint])
 
 
@@ -105,14 +106,37 @@ def _split(s: Array, pieces: Array) -> Array:
     return np.sort(np.concatenate([s, s[k] + (s[k + 1] - s[k]) * j / np.repeat(n, n - 1)]))
 
 
-def _columns(dynamics: PathDynamics, s: Array, length: float, central_only: bool = False
-             ) -> tuple[PathCoefficients, Array, Array, Array]:
-    """The coefficients at ``s`` (N + 1,), and the table's columns (see :class:`Table`) at
-    the starts and the ends of the segments (two arrays (N, 18)) and the joints (indices);
-    with ``central_only``, the columns at the points themselves (N + 1, 18), twice."""
+def _coefficients(dynamics: PathDynamics, grids: list[Array], length: float
+                  ) -> list[tuple[PathCoefficients, PathCoefficients, PathCoefficients,
+                                  Array, Array]]:
+    """For each grid of arc lengths: the coefficients there and a short step
+    (:data:`DERIVATIVE_STEP`) before and after it (within the path), and those points, from
+    one evaluation of the dynamics (its cost is mostly per call)."""
     step = DERIVATIVE_STEP * length
-    left, right = np.maximum(s - step, 0.0), np.minimum(s + step, length)
-    co, cl, cr = (dynamics.coefficients(x) for x in (s, left, right))
+    sets = [(x, np.maximum(x - step, 0.0), np.minimum(x + step, length)) for x in grids]
+    flat = [p for three in sets for p in three]
+    co = dynamics.coefficients(np.concatenate(flat))
+    ends = np.cumsum([0] + [len(p) for p in flat])
+    parts = [_rows_of(co, slice(int(i), int(j))) for i, j in zip(ends[:-1], ends[1:],
+                                                                  strict=True)]
+    return [(parts[3 * n], parts[3 * n + 1], parts[3 * n + 2], sets[n][1], sets[n][2])
+            for n in range(len(grids))]
+
+
+def _rows_of(co: PathCoefficients, rows: slice) -> PathCoefficients:
+    """The coefficients of the points ``rows``."""
+    return PathCoefficients(co.s[rows], co.P[rows], co.a[rows], co.b[rows], co.g[rows],
+                            co.dq_ds[rows], co.coulomb, co.viscous,
+                            None if co.d2q_ds2 is None else co.d2q_ds2[rows], co.coulomb_speed)
+
+
+def _columns(s: Array, co: PathCoefficients, cl: PathCoefficients, cr: PathCoefficients,
+             left: Array, right: Array, central_only: bool = False
+             ) -> tuple[PathCoefficients, Array, Array, Array]:
+    """From the coefficients at ``s`` (N + 1,) and a step ``left`` and ``right`` of them
+    (:func:`_coefficients`), the table's columns (see :class:`Table`) at the starts and the
+    ends of the segments (two arrays (N, 18)) and the joints (indices); with
+    ``central_only``, the columns at the points themselves (N + 1, 18), twice."""
 
     def base(c: PathCoefficients) -> Array:  # the columns with derivatives
         return np.concatenate([c.ddq_ds, c.a, c.b, c.g], axis=1)
