@@ -130,10 +130,6 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
     residual may stall or grow: the best iterate met is returned, converged when it is
     within a hundred times those tolerances."""
     c, rk, ra, rg, rb, E, lo, hi = (lp.c, lp.rk, lp.ra, lp.rg, lp.rb, lp.E, lp.lo, lp.hi)
-    # the rows in the order of their intervals (so that a chunk of rows touches one stretch
-    # of the band; the rows' order is internal: the result is the states)
-    order = np.argsort(rk, kind="stable")
-    rk, ra, rg, rb = rk[order], ra[order], rg[order], rb[order]
     e = np.asarray(lp.e, float).reshape(-1)
     nx = len(c)
     K = (nx - P) // D
@@ -185,10 +181,16 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
     ab_eq[diag_y] -= REG
     # the rows by chunks (their temporaries bounded), each with its stretch of the band;
     # a small programme's index arrays and products kept (one chunk)
+    # (a large programme's chunks take the rows in the order of their intervals, so that
+    # each touches one stretch of the band; no copy of the rows)
     keep = R * len(pa) <= KEEP
-    step = R if keep else CHUNK
-    chunks = [_Chunk(ra[r0:r0 + step], xr[r0:r0 + step], base[r0:r0 + step], pa, pb,
-                     pair_off, nrow, nb, keep) for r0 in range(0, R, step)]
+    if keep:
+        parts: list[Array] = [np.arange(R)]
+    else:
+        order = np.argsort(rk, kind="stable")
+        parts = [order[r0:r0 + CHUNK] for r0 in range(0, R, CHUNK)]
+    chunks = [_Chunk(ra, xr, base, i, pa, pb, pair_off, nrow, nb, keep) for i in parts
+              if len(i)]
     iu, il = np.flatnonzero(hasu), np.flatnonzero(hasl)
     nu, nl = len(iu), len(il)
     m_all = R + nu + nl
@@ -200,20 +202,16 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
     def G(x: Array) -> Array:
         """Every inequality's ``g . x``."""
         out = np.concatenate([rg @ x[nk:], sgn * x[bnd]])
-        r0 = 0
         for ch in chunks:
-            out[r0:r0 + ch.n] += ch.times(x)
-            r0 += ch.n
+            out[ch.i] += ch.times(x)
         return out
 
     def GT(z: Array) -> Array:
         """``sum z g`` over the inequalities (fixed variables' entries zero)."""
         out = np.bincount(bnd, sgn * z[R:], minlength=nx)
         zr = z[:R]
-        r0 = 0
         for ch in chunks:
-            out[:nk] += ch.transposed(zr[r0:r0 + ch.n], nk)
-            r0 += ch.n
+            out[:nk] += ch.transposed(zr, nk)
         out[nk:] += rg.T @ zr
         out[fixed] = 0.0
         return np.asarray(out)
@@ -263,13 +261,10 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
         Dr = Dz[:R]
         ab = ab_eq.copy()
         U = np.zeros((nb, P))
-        r0 = 0
         for ch in chunks:
-            d = Dr[r0:r0 + ch.n]
-            ch.band(d, ab)
+            ch.band(Dr, ab)
             for p in range(P):
-                ch.border(d * rg[r0:r0 + ch.n, p], U[:, p])
-            r0 += ch.n
+                ch.border(Dr * rg[:, p], U[:, p])
         abT = ab.reshape(nb, nrow)
         ab[clear] = 0.0
         ab[diag_x] += diag[:nk]
@@ -342,77 +337,88 @@ class _Newton:
 
 
 class _Chunk:
-    """A chunk of a programme's rows (their coefficients ``ra``, first variables ``xr`` and
-    first band positions ``base``): their parts of ``G x``, ``G^T z``, the band and the
-    border. Kept (``keep``, a small programme), they are sparse matrices made once; else
-    index arrays and products made at each use (memory: the chunk's temporaries only)."""
+    """The rows ``i`` (n,) of a programme (of the coefficients ``ra``, first variables ``xr``
+    and first band positions ``base`` of all): their parts of ``G x``, ``G^T z``, the band
+    and the border. Kept (``keep``, a small programme: one chunk of all rows), they are
+    sparse matrices made once; else each use makes the index arrays and products it needs
+    (memory: the chunk's temporaries only)."""
 
-    def __init__(self, ra: Array, xr: Array, base: Array, pa: Array, pb: Array,
+    def __init__(self, ra: Array, xr: Array, base: Array, i: Array, pa: Array, pb: Array,
                  pair_off: Array, nrow: int, nb: int, keep: bool) -> None:
-        self.ra, self.xr, self.base, self.n = ra, xr, base, len(ra)
+        self.ra, self.xr, self.base, self.i, self.n = ra, xr, base, i, len(i)
         self.pa, self.pb, self.pair_off, self.nrow = pa, pb, pair_off, nrow
         top = BLOCK + int(ROW_POS.max()) + 1  # past a row's last band position
-        self.u0 = int(base[0]) if self.n else 0
-        self.u1 = min(int(base[-1]) + top, nb) if self.n else 0
+        b = base[i]
+        self.u0, self.u1 = int(b.min()), min(int(b.max()) + top, nb)
         self.kept: tuple[Any, Any, Any, Any] | None = None
-        if keep and self.n:
+        if keep:
             # (each row's entries are a column of the band's and the border's matrices, a
             # row of G: compressed storage made directly, no sorting)
-            xi, bi, prod, ui = self._arrays()
+            r, xi = ra[i], self._xi()
             n, nx, npair = self.n, int(xi.max()) + 1, len(pa)
-            g = sparse.csr_matrix((ra.reshape(-1), xi.reshape(-1),
+            g = sparse.csr_matrix((r.reshape(-1), xi.reshape(-1),
                                    np.arange(0, NR * n + 1, NR)), shape=(n, nx))
             self.kept = (g, g.T,
-                         sparse.csc_matrix((prod.reshape(-1), bi,
+                         sparse.csc_matrix((self._prod(r).reshape(-1), self._bi(),
                                             np.arange(0, npair * n + 1, npair)),
                                            shape=((self.u1 - self.u0) * nrow, n)),
-                         sparse.csc_matrix((ra.reshape(-1), ui, np.arange(0, NR * n + 1, NR)),
+                         sparse.csc_matrix((r.reshape(-1), self._ui(),
+                                            np.arange(0, NR * n + 1, NR)),
                                            shape=(self.u1 - self.u0, n)))
 
-    def _arrays(self) -> tuple[Array, Array, Array, Array]:
-        """The variables of each row (n, 6), the band indices of its pairs (n * pairs,),
-        the pairs' products (n, pairs) and each row's band positions (n * 6,)."""
-        ra, u0 = self.ra, self.u0
-        xi = self.xr[:, None] + ROW_X[None, :]
-        bi = ((self.base - u0) * self.nrow)[:, None] + self.pair_off[None, :]
-        prod = ra[:, self.pa] * ra[:, self.pb]
-        ui = self.base[:, None] + ROW_POS[None, :] - u0
-        return xi, bi.reshape(-1), prod, ui.reshape(-1)
+    def _xi(self) -> Array:
+        """The variables of each row (n, 6)."""
+        return np.asarray(self.xr[self.i][:, None] + ROW_X[None, :])
+
+    def _bi(self) -> Array:
+        """The band indices (from the chunk's stretch) of each row's pairs (n * pairs,)."""
+        bi = ((self.base[self.i] - self.u0) * self.nrow)[:, None] + self.pair_off[None, :]
+        return np.asarray(bi.reshape(-1))
+
+    def _prod(self, r: Array) -> Array:
+        """The products of each row's pairs of coefficients (n, pairs)."""
+        return np.asarray(r[:, self.pa] * r[:, self.pb])
+
+    def _ui(self) -> Array:
+        """Each row's band positions (from the chunk's stretch) (n * 6,)."""
+        return np.asarray((self.base[self.i][:, None] + ROW_POS[None, :] - self.u0)
+                          .reshape(-1))
 
     def times(self, x: Array) -> Array:
         """The rows' ``ra . x`` (n,)."""
         if self.kept is not None:
             g = self.kept[0]
             return np.asarray(g @ x[:g.shape[1]])
-        return np.asarray(np.einsum("ij,ij->i", self.ra, x[self._arrays()[0]]))
+        return np.asarray(np.einsum("ij,ij->i", self.ra[self.i], x[self._xi()]))
 
     def transposed(self, z: Array, nk: int) -> Array:
-        """``sum z ra`` over the rows, on the knots' states (nk,)."""
+        """``sum z ra`` over the rows (``z`` of all rows), on the knots' states (nk,)."""
         if self.kept is not None:
             out = np.zeros(nk)
             gt = self.kept[1]
-            out[:gt.shape[0]] = gt @ z
+            out[:gt.shape[0]] = gt @ z[self.i]
             return out
-        xi = self._arrays()[0]
-        return np.bincount(xi.reshape(-1), (self.ra * z[:, None]).reshape(-1),
-                           minlength=nk)[:nk]
+        return np.bincount(self._xi().reshape(-1),
+                           (self.ra[self.i] * z[self.i, None]).reshape(-1), minlength=nk)[:nk]
 
     def band(self, d: Array, ab: Array) -> None:
-        """Add the rows' ``ra^T diag(d) ra`` to the band ``ab`` (flat, LAPACK's storage)."""
+        """Add the rows' ``ra^T diag(d) ra`` (``d`` of all rows) to the band ``ab`` (flat,
+        LAPACK's storage)."""
         b0, b1 = self.u0 * self.nrow, self.u1 * self.nrow
         if self.kept is not None:
-            ab[b0:b1] += self.kept[2] @ d
+            ab[b0:b1] += self.kept[2] @ d[self.i]
             return
-        _, bi, prod, _ = self._arrays()
-        ab[b0:b1] += np.bincount(bi, (prod * d[:, None]).reshape(-1), minlength=b1 - b0)
+        w = self._prod(self.ra[self.i]) * d[self.i, None]
+        ab[b0:b1] += np.bincount(self._bi(), w.reshape(-1), minlength=b1 - b0)
 
     def border(self, d: Array, u: Array) -> None:
-        """Add the rows' ``ra^T d`` to the band's part ``u`` (nb,) of a border column."""
+        """Add the rows' ``ra^T d`` (``d`` of all rows) to the band's part ``u`` (nb,) of a
+        border column."""
         if self.kept is not None:
-            u[self.u0:self.u1] += self.kept[3] @ d
+            u[self.u0:self.u1] += self.kept[3] @ d[self.i]
             return
-        ui = self._arrays()[3]
-        u[self.u0:self.u1] += np.bincount(ui, (self.ra * d[:, None]).reshape(-1),
+        u[self.u0:self.u1] += np.bincount(self._ui(),
+                                          (self.ra[self.i] * d[self.i, None]).reshape(-1),
                                           minlength=self.u1 - self.u0)
 
 
