@@ -31,7 +31,6 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
@@ -66,12 +65,9 @@ REG = 1e-11
 ETA = 0.99
 #: The start's multipliers: on the central path of this complementarity.
 MU0 = 1e-3
-#: Rows whose terms of the Newton matrix are built at once (the temporaries of a chunk are
-#: a few hundred bytes a row; one chunk for the programmes of a move).
-CHUNK = 8192
 #: A programme whose rows' products with their pairs of variables are at most this many
 #: keeps them from iteration to iteration, as sparse matrices (memory: about 16 bytes
-#: each; larger programmes, by chunks, compute them in every iteration).
+#: each; a larger programme computes them in every iteration, a pair at a time).
 KEEP = 1 << 20
 
 
@@ -168,29 +164,28 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
     pair_off = (ROW_POS[pb] * nrow + KL + KU + ROW_POS[pa] - ROW_POS[pb])
     diag_x = xband * nrow + KL + KU
     diag_y = yband * nrow + KL + KU
-    # the equalities' part of the band (and the dual regularisation): the same in every
-    # iteration
-    ab_eq = np.zeros(nrow * nb)
-    abT_eq = ab_eq.reshape(nb, nrow)  # abT[j, KL + KU + i - j] = A[i, j]
-    for q in range(Q):  # the equalities and their transposes, interval by interval
-        i = D + q
-        for a in range(2 * D):
-            j = EQ_POS[a]
-            abT_eq[j:nb - BLOCK + j + 1:BLOCK, KL + KU + i - j] += Em[:, q, a]
-            abT_eq[i:nb - BLOCK + i + 1:BLOCK, KL + KU + j - i] += Em[:, q, a]
-    ab_eq[diag_y] -= REG
-    # the rows by chunks (their temporaries bounded), each with its stretch of the band;
-    # a small programme's index arrays and products kept (one chunk)
-    # (a large programme's chunks take the rows in the order of their intervals, so that
-    # each touches one stretch of the band; no copy of the rows)
-    keep = R * len(pa) <= KEEP
-    if keep:
-        parts: list[Array] = [np.arange(R)]
-    else:
-        order = np.argsort(rk, kind="stable")
-        parts = [order[r0:r0 + CHUNK] for r0 in range(0, R, CHUNK)]
-    chunks = [_Chunk(ra, xr, base, i, pa, pb, pair_off, nrow, nb, keep) for i in parts
-              if len(i)]
+    pairs = [(a, b) for a in used for b in used if a <= b]  # (the large programmes')
+
+    def eq_band() -> Array:
+        """The band with the equalities' part (and the dual regularisation): the same in
+        every iteration."""
+        ab = np.zeros(nrow * nb)
+        abT = ab.reshape(nb, nrow)  # abT[j, KL + KU + i - j] = A[i, j]
+        for q in range(Q):  # the equalities and their transposes, interval by interval
+            i = D + q
+            for a in range(2 * D):
+                j = EQ_POS[a]
+                abT[j:nb - BLOCK + j + 1:BLOCK, KL + KU + i - j] += Em[:, q, a]
+                abT[i:nb - BLOCK + i + 1:BLOCK, KL + KU + j - i] += Em[:, q, a]
+        ab[diag_y] -= REG
+        return ab
+
+    # a small programme keeps its rows' parts of G, G^T, the band and the border as sparse
+    # matrices and the equalities' part of the band, made once; a large one (whose memory
+    # they would double) builds them in every iteration, a pair of variables at a time
+    kept = _Kept(ra, xr, base, pa, pb, pair_off, nrow, nb) if R * len(pa) <= KEEP else None
+    ab_eq = eq_band() if kept is not None else None
+
     iu, il = np.flatnonzero(hasu), np.flatnonzero(hasl)
     nu, nl = len(iu), len(il)
     m_all = R + nu + nl
@@ -201,17 +196,24 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
 
     def G(x: Array) -> Array:
         """Every inequality's ``g . x``."""
-        out = np.concatenate([rg @ x[nk:], sgn * x[bnd]])
-        for ch in chunks:
-            out[ch.i] += ch.times(x)
-        return out
+        if kept is not None:
+            out = rg @ x[nk:] + kept.times(x)
+        else:
+            out = rg @ x[nk:]
+            for a in range(NR):
+                out += ra[:, a] * x[xr + ROW_X[a]]
+        return np.concatenate([out, sgn * x[bnd]])
 
     def GT(z: Array) -> Array:
         """``sum z g`` over the inequalities (fixed variables' entries zero)."""
         out = np.bincount(bnd, sgn * z[R:], minlength=nx)
         zr = z[:R]
-        for ch in chunks:
-            out[:nk] += ch.transposed(zr, nk)
+        if kept is not None:
+            out[:nk] += kept.transposed(zr, nk)
+        else:
+            for a in range(NR):
+                out[ROW_X[a]:nk] += np.bincount(xr, ra[:, a] * zr,
+                                                minlength=nk)[:nk - ROW_X[a]]
         out[nk:] += rg.T @ zr
         out[fixed] = 0.0
         return np.asarray(out)
@@ -259,12 +261,26 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
         diag = np.full(nx, REG) + np.bincount(bnd, Dz[R:], minlength=nx)
         diag[fixed] = 1.0
         Dr = Dz[:R]
-        ab = ab_eq.copy()
         U = np.zeros((nb, P))
-        for ch in chunks:
-            ch.band(Dr, ab)
+        if kept is not None and ab_eq is not None:
+            ab = ab_eq.copy()
+            kept.band(Dr, ab)
             for p in range(P):
-                ch.border(Dr * rg[:, p], U[:, p])
+                kept.border(Dr * rg[:, p], U[:, p])
+        else:
+            ab = eq_band()
+            abT = ab.reshape(nb, nrow)
+            for a, b in pairs:
+                add = np.bincount(base, Dr * ra[:, a] * ra[:, b], minlength=nb)
+                i, j = ROW_POS[a], ROW_POS[b]
+                abT[j:, KL + KU + i - j] += add[:nb - j]
+                if a != b:
+                    abT[i:, KL + KU + j - i] += add[:nb - i]
+            for p in range(P):
+                drg = Dr * rg[:, p]
+                for a in range(NR):
+                    U[ROW_POS[a]:, p] += np.bincount(base, drg * ra[:, a],
+                                                     minlength=nb)[:nb - ROW_POS[a]]
         abT = ab.reshape(nb, nrow)
         ab[clear] = 0.0
         ab[diag_x] += diag[:nk]
@@ -336,90 +352,50 @@ class _Newton:
         return dx, db[self.yband], dz, (-cc - self.s * dz) / self.z
 
 
-class _Chunk:
-    """The rows ``i`` (n,) of a programme (of the coefficients ``ra``, first variables ``xr``
-    and first band positions ``base`` of all): their parts of ``G x``, ``G^T z``, the band
-    and the border. Kept (``keep``, a small programme: one chunk of all rows), they are
-    sparse matrices made once; else each use makes the index arrays and products it needs
-    (memory: the chunk's temporaries only)."""
+class _Kept:
+    """A small programme's rows (coefficients ``ra``, first variables ``xr``, first band
+    positions ``base``) as sparse matrices made once: their parts of ``G x``, ``G^T z``, the
+    band and the border (each row's entries are a row of G and a column of the band's and
+    the border's matrices: compressed storage made directly, no sorting)."""
 
-    def __init__(self, ra: Array, xr: Array, base: Array, i: Array, pa: Array, pb: Array,
-                 pair_off: Array, nrow: int, nb: int, keep: bool) -> None:
-        self.ra, self.xr, self.base, self.i, self.n = ra, xr, base, i, len(i)
-        self.pa, self.pb, self.pair_off, self.nrow = pa, pb, pair_off, nrow
+    def __init__(self, ra: Array, xr: Array, base: Array, pa: Array, pb: Array,
+                 pair_off: Array, nrow: int, nb: int) -> None:
+        n, npair = len(ra), len(pa)
         top = BLOCK + int(ROW_POS.max()) + 1  # past a row's last band position
-        b = base[i]
-        self.u0, self.u1 = int(b.min()), min(int(b.max()) + top, nb)
-        self.kept: tuple[Any, Any, Any, Any] | None = None
-        if keep:
-            # (each row's entries are a column of the band's and the border's matrices, a
-            # row of G: compressed storage made directly, no sorting)
-            r, xi = ra[i], self._xi()
-            n, nx, npair = self.n, int(xi.max()) + 1, len(pa)
-            g = sparse.csr_matrix((r.reshape(-1), xi.reshape(-1),
-                                   np.arange(0, NR * n + 1, NR)), shape=(n, nx))
-            self.kept = (g, g.T,
-                         sparse.csc_matrix((self._prod(r).reshape(-1), self._bi(),
-                                            np.arange(0, npair * n + 1, npair)),
-                                           shape=((self.u1 - self.u0) * nrow, n)),
-                         sparse.csc_matrix((r.reshape(-1), self._ui(),
-                                            np.arange(0, NR * n + 1, NR)),
-                                           shape=(self.u1 - self.u0, n)))
-
-    def _xi(self) -> Array:
-        """The variables of each row (n, 6)."""
-        return np.asarray(self.xr[self.i][:, None] + ROW_X[None, :])
-
-    def _bi(self) -> Array:
-        """The band indices (from the chunk's stretch) of each row's pairs (n * pairs,)."""
-        bi = ((self.base[self.i] - self.u0) * self.nrow)[:, None] + self.pair_off[None, :]
-        return np.asarray(bi.reshape(-1))
-
-    def _prod(self, r: Array) -> Array:
-        """The products of each row's pairs of coefficients (n, pairs)."""
-        return np.asarray(r[:, self.pa] * r[:, self.pb])
-
-    def _ui(self) -> Array:
-        """Each row's band positions (from the chunk's stretch) (n * 6,)."""
-        return np.asarray((self.base[self.i][:, None] + ROW_POS[None, :] - self.u0)
-                          .reshape(-1))
+        self.u0 = int(base.min(initial=0))
+        self.u1 = min(int(base.max(initial=0)) + top, nb)
+        self.nrow = nrow
+        xi = xr[:, None] + ROW_X[None, :]
+        bi = ((base - self.u0) * nrow)[:, None] + pair_off[None, :]
+        ui = base[:, None] + ROW_POS[None, :] - self.u0
+        nx = int(xi.max(initial=0)) + 1
+        self.g = sparse.csr_matrix((ra.reshape(-1), xi.reshape(-1),
+                                    np.arange(0, NR * n + 1, NR)), shape=(n, nx))
+        self.gt = self.g.T
+        self.bandm = sparse.csc_matrix(((ra[:, pa] * ra[:, pb]).reshape(-1), bi.reshape(-1),
+                                        np.arange(0, npair * n + 1, npair)),
+                                       shape=((self.u1 - self.u0) * nrow, n))
+        self.borderm = sparse.csc_matrix((ra.reshape(-1), ui.reshape(-1),
+                                          np.arange(0, NR * n + 1, NR)),
+                                         shape=(self.u1 - self.u0, n))
 
     def times(self, x: Array) -> Array:
         """The rows' ``ra . x`` (n,)."""
-        if self.kept is not None:
-            g = self.kept[0]
-            return np.asarray(g @ x[:g.shape[1]])
-        return np.asarray(np.einsum("ij,ij->i", self.ra[self.i], x[self._xi()]))
+        return np.asarray(self.g @ x[:self.g.shape[1]])
 
     def transposed(self, z: Array, nk: int) -> Array:
-        """``sum z ra`` over the rows (``z`` of all rows), on the knots' states (nk,)."""
-        if self.kept is not None:
-            out = np.zeros(nk)
-            gt = self.kept[1]
-            out[:gt.shape[0]] = gt @ z[self.i]
-            return out
-        return np.bincount(self._xi().reshape(-1),
-                           (self.ra[self.i] * z[self.i, None]).reshape(-1), minlength=nk)[:nk]
+        """``sum z ra`` over the rows, on the knots' states (nk,)."""
+        out = np.zeros(nk)
+        out[:self.gt.shape[0]] = self.gt @ z
+        return out
 
     def band(self, d: Array, ab: Array) -> None:
-        """Add the rows' ``ra^T diag(d) ra`` (``d`` of all rows) to the band ``ab`` (flat,
-        LAPACK's storage)."""
-        b0, b1 = self.u0 * self.nrow, self.u1 * self.nrow
-        if self.kept is not None:
-            ab[b0:b1] += self.kept[2] @ d[self.i]
-            return
-        w = self._prod(self.ra[self.i]) * d[self.i, None]
-        ab[b0:b1] += np.bincount(self._bi(), w.reshape(-1), minlength=b1 - b0)
+        """Add the rows' ``ra^T diag(d) ra`` to the band ``ab`` (flat, LAPACK's storage)."""
+        ab[self.u0 * self.nrow:self.u1 * self.nrow] += self.bandm @ d
 
     def border(self, d: Array, u: Array) -> None:
-        """Add the rows' ``ra^T d`` (``d`` of all rows) to the band's part ``u`` (nb,) of a
-        border column."""
-        if self.kept is not None:
-            u[self.u0:self.u1] += self.kept[3] @ d[self.i]
-            return
-        u[self.u0:self.u1] += np.bincount(self._ui(),
-                                          (self.ra[self.i] * d[self.i, None]).reshape(-1),
-                                          minlength=self.u1 - self.u0)
+        """Add the rows' ``ra^T d`` to the band's part ``u`` (nb,) of a border column."""
+        u[self.u0:self.u1] += self.borderm @ d
 
 
 def _to_bound(v: Array, dv: Array) -> float:
