@@ -38,6 +38,7 @@ from ..._arrays import Array
 from ..._lazy import lazy_module
 
 lapack = lazy_module("scipy.linalg.lapack")
+sparse = lazy_module("scipy.sparse")
 
 #: States per knot (arc length, speed, acceleration, duration), equalities per interval
 #: (the exact integration and the duration's continuity), border variables (the slack).
@@ -64,6 +65,10 @@ REG = 1e-11
 ETA = 0.99
 #: The start's multipliers: on the central path of this complementarity.
 MU0 = 1e-3
+#: A programme whose rows' products with their pairs of variables are at most this many
+#: keeps them from iteration to iteration, as sparse matrices (memory: about 16 bytes
+#: each; a larger programme computes them in every iteration, a pair at a time).
+KEEP = 1 << 20
 
 
 @dataclass(frozen=True)
@@ -151,12 +156,35 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
     # that LAPACK takes it as it is): flat index j * nrow + KL + KU + i - j
     nrow = 2 * KL + KU + 1
     clear = (cols * nrow + KL + KU + fpos[:, None] - cols)[ok]
-    # the rows' terms of the matrix, by pairs of their variables (a <= b): each pair's sum
-    # over the rows of an interval lands on one diagonal of the band
-    pairs = [(a, b) for a in range(NR) for b in range(a, NR)
-             if ra[:, a].any() and ra[:, b].any()]
+    # the rows' terms of the matrix, by ordered pairs of their variables (both triangles):
+    # the term of row r and pair (a, b) lands at band index base[r] * nrow + offset
+    used = [a for a in range(NR) if ra[:, a].any()]
+    pa = np.array([a for a in used for b in used], int)
+    pb = np.array([b for a in used for b in used], int)
+    pair_off = (ROW_POS[pb] * nrow + KL + KU + ROW_POS[pa] - ROW_POS[pb])
     diag_x = xband * nrow + KL + KU
     diag_y = yband * nrow + KL + KU
+    pairs = [(a, b) for a in used for b in used if a <= b]  # (the large programmes')
+
+    def eq_band() -> Array:
+        """The band with the equalities' part (and the dual regularisation): the same in
+        every iteration."""
+        ab = np.zeros(nrow * nb)
+        abT = ab.reshape(nb, nrow)  # abT[j, KL + KU + i - j] = A[i, j]
+        for q in range(Q):  # the equalities and their transposes, interval by interval
+            i = D + q
+            for a in range(2 * D):
+                j = EQ_POS[a]
+                abT[j:nb - BLOCK + j + 1:BLOCK, KL + KU + i - j] += Em[:, q, a]
+                abT[i:nb - BLOCK + i + 1:BLOCK, KL + KU + j - i] += Em[:, q, a]
+        ab[diag_y] -= REG
+        return ab
+
+    # a small programme keeps its rows' parts of G, G^T, the band and the border as sparse
+    # matrices and the equalities' part of the band, made once; a large one (whose memory
+    # they would double) builds them in every iteration, a pair of variables at a time
+    kept = _Kept(ra, xr, base, pa, pb, pair_off, nrow, nb) if R * len(pa) <= KEEP else None
+    ab_eq = eq_band() if kept is not None else None
 
     iu, il = np.flatnonzero(hasu), np.flatnonzero(hasl)
     nu, nl = len(iu), len(il)
@@ -168,21 +196,27 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
 
     def G(x: Array) -> Array:
         """Every inequality's ``g . x``."""
-        out = rg @ x[nk:]
-        for a in range(NR):
-            out += ra[:, a] * x[xr + ROW_X[a]]
+        if kept is not None:
+            out = rg @ x[nk:] + kept.times(x)
+        else:
+            out = rg @ x[nk:]
+            for a in range(NR):
+                out += ra[:, a] * x[xr + ROW_X[a]]
         return np.concatenate([out, sgn * x[bnd]])
 
     def GT(z: Array) -> Array:
         """``sum z g`` over the inequalities (fixed variables' entries zero)."""
-        out = np.zeros(nx)
+        out = np.bincount(bnd, sgn * z[R:], minlength=nx)
         zr = z[:R]
-        for a in range(NR):
-            out[ROW_X[a]:nk] += np.bincount(xr, ra[:, a] * zr, minlength=nk)[:nk - ROW_X[a]]
-        out[nk:] = rg.T @ zr
-        out += np.bincount(bnd, sgn * z[R:], minlength=nx)
+        if kept is not None:
+            out[:nk] += kept.transposed(zr, nk)
+        else:
+            for a in range(NR):
+                out[ROW_X[a]:nk] += np.bincount(xr, ra[:, a] * zr,
+                                                minlength=nk)[:nk - ROW_X[a]]
+        out[nk:] += rg.T @ zr
         out[fixed] = 0.0
-        return out
+        return np.asarray(out)
 
     def Ex(x: Array) -> Array:
         return np.asarray(np.einsum("kqj,kj->kq", E, x[exi]).reshape(-1) - e)
@@ -227,29 +261,29 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
         diag = np.full(nx, REG) + np.bincount(bnd, Dz[R:], minlength=nx)
         diag[fixed] = 1.0
         Dr = Dz[:R]
-        ab = np.zeros(nrow * nb)
-        abT = ab.reshape(nb, nrow)  # abT[j, KL + KU + i - j] = A[i, j]
-        for q in range(Q):  # the equalities and their transposes, interval by interval
-            i = D + q
-            for a in range(2 * D):
-                j = EQ_POS[a]
-                abT[j:nb - BLOCK + j + 1:BLOCK, KL + KU + i - j] += Em[:, q, a]
-                abT[i:nb - BLOCK + i + 1:BLOCK, KL + KU + j - i] += Em[:, q, a]
-        ab[diag_y] -= REG
-        for a, b in pairs:
-            add = np.bincount(base, Dr * ra[:, a] * ra[:, b], minlength=nb)
-            i, j = ROW_POS[a], ROW_POS[b]
-            abT[j:, KL + KU + i - j] += add[:nb - j]
-            if a != b:
-                abT[i:, KL + KU + j - i] += add[:nb - i]
+        U = np.zeros((nb, P))
+        if kept is not None and ab_eq is not None:
+            ab = ab_eq.copy()
+            kept.band(Dr, ab)
+            for p in range(P):
+                kept.border(Dr * rg[:, p], U[:, p])
+        else:
+            ab = eq_band()
+            abT = ab.reshape(nb, nrow)
+            for a, b in pairs:
+                add = np.bincount(base, Dr * ra[:, a] * ra[:, b], minlength=nb)
+                i, j = ROW_POS[a], ROW_POS[b]
+                abT[j:, KL + KU + i - j] += add[:nb - j]
+                if a != b:
+                    abT[i:, KL + KU + j - i] += add[:nb - i]
+            for p in range(P):
+                drg = Dr * rg[:, p]
+                for a in range(NR):
+                    U[ROW_POS[a]:, p] += np.bincount(base, drg * ra[:, a],
+                                                     minlength=nb)[:nb - ROW_POS[a]]
+        abT = ab.reshape(nb, nrow)
         ab[clear] = 0.0
         ab[diag_x] += diag[:nk]
-        U = np.zeros((nb, P))
-        for p in range(P):
-            drg = Dr * rg[:, p]
-            for a in range(NR):
-                U[ROW_POS[a]:, p] += np.bincount(base, drg * ra[:, a],
-                                                 minlength=nb)[:nb - ROW_POS[a]]
         U[fpos] = 0.0
         corner = (rg * Dr[:, None]).T @ rg + np.diag(diag[nk:])
         lu, piv, info = lapack.dgbtrf(abT.T, KL, KU, overwrite_ab=1)
@@ -318,7 +352,53 @@ class _Newton:
         return dx, db[self.yband], dz, (-cc - self.s * dz) / self.z
 
 
+class _Kept:
+    """A small programme's rows (coefficients ``ra``, first variables ``xr``, first band
+    positions ``base``) as sparse matrices made once: their parts of ``G x``, ``G^T z``, the
+    band and the border (each row's entries are a row of G and a column of the band's and
+    the border's matrices: compressed storage made directly, no sorting)."""
+
+    def __init__(self, ra: Array, xr: Array, base: Array, pa: Array, pb: Array,
+                 pair_off: Array, nrow: int, nb: int) -> None:
+        n, npair = len(ra), len(pa)
+        top = BLOCK + int(ROW_POS.max()) + 1  # past a row's last band position
+        self.u0 = int(base.min(initial=0))
+        self.u1 = min(int(base.max(initial=0)) + top, nb)
+        self.nrow = nrow
+        xi = xr[:, None] + ROW_X[None, :]
+        bi = ((base - self.u0) * nrow)[:, None] + pair_off[None, :]
+        ui = base[:, None] + ROW_POS[None, :] - self.u0
+        nx = int(xi.max(initial=0)) + 1
+        self.g = sparse.csr_matrix((ra.reshape(-1), xi.reshape(-1),
+                                    np.arange(0, NR * n + 1, NR)), shape=(n, nx))
+        self.gt = self.g.T
+        self.bandm = sparse.csc_matrix(((ra[:, pa] * ra[:, pb]).reshape(-1), bi.reshape(-1),
+                                        np.arange(0, npair * n + 1, npair)),
+                                       shape=((self.u1 - self.u0) * nrow, n))
+        self.borderm = sparse.csc_matrix((ra.reshape(-1), ui.reshape(-1),
+                                          np.arange(0, NR * n + 1, NR)),
+                                         shape=(self.u1 - self.u0, n))
+
+    def times(self, x: Array) -> Array:
+        """The rows' ``ra . x`` (n,)."""
+        return np.asarray(self.g @ x[:self.g.shape[1]])
+
+    def transposed(self, z: Array, nk: int) -> Array:
+        """``sum z ra`` over the rows, on the knots' states (nk,)."""
+        out = np.zeros(nk)
+        out[:self.gt.shape[0]] = self.gt @ z
+        return out
+
+    def band(self, d: Array, ab: Array) -> None:
+        """Add the rows' ``ra^T diag(d) ra`` to the band ``ab`` (flat, LAPACK's storage)."""
+        ab[self.u0 * self.nrow:self.u1 * self.nrow] += self.bandm @ d
+
+    def border(self, d: Array, u: Array) -> None:
+        """Add the rows' ``ra^T d`` to the band's part ``u`` (nb,) of a border column."""
+        u[self.u0:self.u1] += self.borderm @ d
+
+
 def _to_bound(v: Array, dv: Array) -> float:
     """The largest step ``a`` with ``v + a dv >= 0`` (``inf`` when none is limited)."""
-    with np.errstate(divide="ignore"):
-        return float(np.min(np.where(dv < 0, -v / dv, np.inf), initial=np.inf))
+    neg = dv < 0
+    return float(np.min(-v[neg] / dv[neg], initial=np.inf))

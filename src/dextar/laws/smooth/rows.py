@@ -189,17 +189,20 @@ class RowModel:
                             np.zeros(n2), np.zeros(n2)))
         ks.append(k)
         names.append("w>=0")
+        # the third-order rows at every interval's start, middle and end (at its end, the
+        # table's segment before the point), all at once
         kM = np.arange(k0, k1)
-        for th3, before in zip((np.zeros(k1 - k0), h[kM] / 2, h[kM]), (False, False, True),
-                               strict=True):
-            sig, w, al = mo.at(mesh, kM, th3)
-            v, d = tab.at(sig, before)
-            F3, C3, k3, n3 = self._third_at(mo, kM, th3, v, d, w, al)
-            norms.append(n3)
-            Fs.append(F3)
-            Cs.append(C3)
-            ks.append(k3)
-            names.append("third")
+        n1 = k1 - k0
+        k3 = np.concatenate([kM, kM, kM])
+        th3 = np.concatenate([np.zeros(n1), h[kM] / 2, h[kM]])
+        sig, w, al = mo.at(mesh, k3, th3)
+        v, d = tab.at(sig, np.arange(3 * n1) >= 2 * n1)
+        F3, C3, kk3, n3 = self._third_at(mo, k3, th3, v, d, w, al)
+        norms.append(n3)
+        Fs.append(F3)
+        Cs.append(C3)
+        ks.append(kk3)
+        names.append("third")
         C = np.concatenate([c[:, :5] for c in Cs])
         sizes = np.concatenate([c[:, 5:].astype(np.float32) for c in Cs])
         del Cs
@@ -225,11 +228,12 @@ class RowModel:
             if isinstance(c, JerkLimit):
                 lim = np.asarray(c.max_jerk, float)
                 val = q1 * jj + 3 * q2 * ww * aa + q3 * ww**3
-                gs = dq1 * jj + 3 * dq2 * ww * aa + dq3 * ww**3
-                gw = 3 * q2 * aa + 3 * q3 * ww * ww
-                ga = 3 * q2 * ww
-                gj = q1
-                gT = np.zeros_like(val)
+                if self._grad:
+                    gs = dq1 * jj + 3 * dq2 * ww * aa + dq3 * ww**3
+                    gw = 3 * q2 * aa + 3 * q3 * ww * ww
+                    ga = 3 * q2 * ww
+                    gj = q1
+                    gT = np.zeros_like(val)
             elif isinstance(c, TorqueRateLimit):
                 lim = np.asarray(c.max_torque_rate, float)
                 a, b = v[:, A], v[:, B]
@@ -243,13 +247,15 @@ class RowModel:
                 acc = q1 * aa + q2 * ww * ww  # T^2 qddot
                 val = (a * jj + (da + 2 * b) * ww * aa + db * ww**3 + dg * ww * T * T
                        + cf * acc * T)
-                gs = (d[:, A] * jj + (d[:, DA] + 2 * d[:, B]) * ww * aa
-                      + d[:, DB] * ww**3 + d[:, DG] * ww * T * T
-                      + cf * (dq1 * aa + dq2 * ww * ww) * T)
-                gw = (da + 2 * b) * aa + 3 * db * ww * ww + dg * T * T + cf * 2 * q2 * ww * T
-                ga = (da + 2 * b) * ww + cf * q1 * T
-                gj = a
-                gT = 2 * dg * ww * T + cf * acc
+                if self._grad:
+                    gs = (d[:, A] * jj + (d[:, DA] + 2 * d[:, B]) * ww * aa
+                          + d[:, DB] * ww**3 + d[:, DG] * ww * T * T
+                          + cf * (dq1 * aa + dq2 * ww * ww) * T)
+                    gw = ((da + 2 * b) * aa + 3 * db * ww * ww + dg * T * T
+                          + cf * 2 * q2 * ww * T)
+                    ga = (da + 2 * b) * ww + cf * q1 * T
+                    gj = a
+                    gT = 2 * dg * ww * T + cf * acc
             else:
                 continue
             scale = lim * T**3
@@ -257,6 +263,9 @@ class RowModel:
             for sign in (1.0, -1.0):
                 Fs.append(((sign * val - scale) / scale).reshape(-1))
                 Ns.append(np.broadcast_to(scale, val.shape).reshape(-1))
+                if not self._grad:
+                    Cs.append(np.zeros((0, 10)))
+                    continue
                 g_s, g_w, g_a, g_j = ((sign * x / scale).reshape(-1) for x in (gs, gw, ga, gj))
                 Cs.append(self._loc(h, kk, tt, g_s, g_w, g_a, g_j,
                                     ((sign * gT - 3 * lim * T * T) / scale).reshape(-1)))

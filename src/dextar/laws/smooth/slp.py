@@ -54,6 +54,8 @@ PROGRESS = 1e-4
 #: inside the trust region. Near the solution the SLP converges fast (the programmes'
 #: solutions are near vertices), so the next step would be far smaller still.
 STEP_TOL = 1e-4
+#: The largest mesh (intervals) whose trial steps' rows are built with their gradients.
+TRIAL_GRADIENTS = 2048
 FEAS_TOL = 1e-4
 
 
@@ -312,7 +314,10 @@ def slp(model: RowModel, J: Array, Tk: Array, budget: int, delta: float) -> Run:
         eps = float(res.x[-1])
         pred = phi - res.fun
         mn = lp.motion(res.x, S)
-        new = model.rows(mn, gradients=False)  # (with them once the step is taken)
+        # the rows at the step; with their gradients when the mesh is small (most steps
+        # are taken, and then they serve the next programme), else once it is taken (two
+        # sets of gradients at once would raise the peak memory of a long path)
+        new = model.rows(mn, gradients=mesh.M <= TRIAL_GRADIENTS)
         phin = merit(mn.T, T_ref, new.F, lp.ahead(mn))
         actual = phi - phin
         ratio = actual / pred if pred > 0 else (1.0 if actual >= 0 else -1.0)
@@ -344,7 +349,7 @@ def slp(model: RowModel, J: Array, Tk: Array, budget: int, delta: float) -> Run:
         if ratio > 0.1:
             T_prev, delta_prev = mo.T, delta
             del rows
-            mo, rows, phi = mn, model.rows(mn), phin
+            mo, rows, phi = mn, (new if len(new.C) == len(new.F) else model.rows(mn)), phin
             if ratio > 0.75 and step > 0.5 * delta:
                 delta = min(2 * delta, 2.0)
             elif ratio < 0.25 or step < 0.5 * delta_prev:

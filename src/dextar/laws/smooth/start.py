@@ -28,6 +28,7 @@ from ..constraints import (
 )
 from .mesh import Mesh, make_mesh, projected
 from .table import DB, DG, Q1, Q2, Q3, A, B, Table
+from .table import segments as linear_in
 
 
 def jumps(base: Any) -> tuple[Array, Array]:
@@ -147,7 +148,8 @@ def fractions(start: Start, table: Table, cons: Sequence[Constraint], segments: 
     points ``h / 2`` apart by up to ``c h^2 / 32`` between them, so the density is
     ``sqrt(c / (32 tol))`` intervals per unit time."""
     t, s, v, a = start.t, start.s, start.v, start.a
-    vals = table.at(s)[0]
+    used = max(c.stop for c in (Q1, Q2, Q3, A, B))  # (the columns it needs, first)
+    vals = linear_in(table.s, table.lo[:, :used], table.hi[:, :used], s)[0]
     q1, q2, q3, b = vals[:, Q1], vals[:, Q2], vals[:, Q3], vals[:, B]
     vv, aa = v[:, None], a[:, None]
     parts: list[Array] = []

@@ -34,9 +34,10 @@ class Table:
         """The grid's arc lengths."""
         return self.co.s
 
-    def at(self, s: Array, before: bool = False) -> tuple[Array, Array]:
+    def at(self, s: Array, before: bool | Array = False) -> tuple[Array, Array]:
         """The columns at arc lengths ``s`` (n,) and their slopes, (n, 18) each; at a grid
-        point, those of the segment after it (``before``: the one before it)."""
+        point, those of the segment after it (``before``: the one before it; an array (n,):
+        for each point)."""
         return segments(self.co.s, self.lo, self.hi, s, before)
 
     @cached_property
@@ -80,9 +81,10 @@ def make_table(dynamics: PathDynamics, s: Array) -> Table:
     s = np.asarray(s, float)
     length = float(s[-1])
     for _ in range(TABLE_ROUNDS):
-        co, lo, hi, joint = _columns(dynamics, s, length)
         mid = 0.5 * (s[1:] + s[:-1])
-        m = _columns(dynamics, mid, length, central_only=True)[1]
+        both = _coefficients(dynamics, [s, mid], length)  # (one evaluation of the model)
+        co, lo, hi, joint = _columns(s, *both[0])
+        m = _columns(mid, *both[1], central_only=True)[1]
         scale = np.abs(np.concatenate([lo, hi])).max(axis=0) + 1e-300
         err = (np.abs(m - 0.5 * (lo + hi)) / scale).max(axis=1)
         bad = err > TABLE_TOL
@@ -91,7 +93,7 @@ def make_table(dynamics: PathDynamics, s: Array) -> Table:
         pieces = np.where(bad, np.clip(np.ceil(np.sqrt(err / TABLE_TOL)), 2, 8), 1)
         s = _split(s, pieces.astype(int))
     else:
-        co, lo, hi, joint = _columns(dynamics, s, length)
+        co, lo, hi, joint = _columns(s, *_coefficients(dynamics, [s], length)[0])
     return Table(co, lo, hi, co.s[joint])
 
 
@@ -104,14 +106,37 @@ def _split(s: Array, pieces: Array) -> Array:
     return np.sort(np.concatenate([s, s[k] + (s[k + 1] - s[k]) * j / np.repeat(n, n - 1)]))
 
 
-def _columns(dynamics: PathDynamics, s: Array, length: float, central_only: bool = False
-             ) -> tuple[PathCoefficients, Array, Array, Array]:
-    """The coefficients at ``s`` (N + 1,), and the table's columns (see :class:`Table`) at
-    the starts and the ends of the segments (two arrays (N, 18)) and the joints (indices);
-    with ``central_only``, the columns at the points themselves (N + 1, 18), twice."""
+def _coefficients(dynamics: PathDynamics, grids: list[Array], length: float
+                  ) -> list[tuple[PathCoefficients, PathCoefficients, PathCoefficients,
+                                  Array, Array]]:
+    """For each grid of arc lengths: the coefficients there and a short step
+    (:data:`DERIVATIVE_STEP`) before and after it (within the path), and those points, from
+    one evaluation of the dynamics (its cost is mostly per call)."""
     step = DERIVATIVE_STEP * length
-    left, right = np.maximum(s - step, 0.0), np.minimum(s + step, length)
-    co, cl, cr = (dynamics.coefficients(x) for x in (s, left, right))
+    sets = [(x, np.maximum(x - step, 0.0), np.minimum(x + step, length)) for x in grids]
+    flat = [p for three in sets for p in three]
+    co = dynamics.coefficients(np.concatenate(flat))
+    ends = np.cumsum([0] + [len(p) for p in flat])
+    parts = [_rows_of(co, slice(int(i), int(j))) for i, j in zip(ends[:-1], ends[1:],
+                                                                  strict=True)]
+    return [(parts[3 * n], parts[3 * n + 1], parts[3 * n + 2], sets[n][1], sets[n][2])
+            for n in range(len(grids))]
+
+
+def _rows_of(co: PathCoefficients, rows: slice) -> PathCoefficients:
+    """The coefficients of the points ``rows``."""
+    return PathCoefficients(co.s[rows], co.P[rows], co.a[rows], co.b[rows], co.g[rows],
+                            co.dq_ds[rows], co.coulomb, co.viscous,
+                            None if co.d2q_ds2 is None else co.d2q_ds2[rows], co.coulomb_speed)
+
+
+def _columns(s: Array, co: PathCoefficients, cl: PathCoefficients, cr: PathCoefficients,
+             left: Array, right: Array, central_only: bool = False
+             ) -> tuple[PathCoefficients, Array, Array, Array]:
+    """From the coefficients at ``s`` (N + 1,) and a step ``left`` and ``right`` of them
+    (:func:`_coefficients`), the table's columns (see :class:`Table`) at the starts and the
+    ends of the segments (two arrays (N, 18)) and the joints (indices); with
+    ``central_only``, the columns at the points themselves (N + 1, 18), twice."""
 
     def base(c: PathCoefficients) -> Array:  # the columns with derivatives
         return np.concatenate([c.ddq_ds, c.a, c.b, c.g], axis=1)
@@ -144,11 +169,16 @@ def interp(grid: Array, values: Array, s: Array) -> tuple[Array, Array]:
     return segments(grid, values[:-1], values[1:], s)
 
 
-def segments(grid: Array, lo: Array, hi: Array, s: Array, before: bool = False
-              ) -> tuple[Array, Array]:
+def segments(grid: Array, lo: Array, hi: Array, s: Array, before: bool | Array = False
+             ) -> tuple[Array, Array]:
     """Linear on each segment from ``lo`` to ``hi`` (N, p): the values at ``s`` (n,) and the
-    slopes, two arrays (n, p) (at a grid point the segment after it, or ``before`` it)."""
-    k = np.searchsorted(grid, s, side="left" if before else "right") - 1
+    slopes, two arrays (n, p) (at a grid point the segment after it, or ``before`` it; an
+    array (n,): for each point)."""
+    if np.ndim(before):
+        k = np.where(before, np.searchsorted(grid, s, side="left"),
+                     np.searchsorted(grid, s, side="right")) - 1
+    else:
+        k = np.searchsorted(grid, s, side="left" if before else "right") - 1
     k = np.clip(k, 0, len(grid) - 2)
     ds = grid[k + 1] - grid[k]
     w = ((np.clip(s, grid[0], grid[-1]) - grid[k]) / ds)[:, None]
