@@ -71,6 +71,28 @@ vector = [0.0, -9810.0]
 units = "si"
 """
 
+#: The fuzz's case whose power balance read 1.05e-5 (the optimal law's boundary layer at the
+#: end of a 90 s motion under the differences' step h = 1e-3 T; 5.4e-10 at h / 16).
+OPTIMAL_DRY_90S = """
+[path]
+type = "spline"
+waypoints = [[-50.0, 100.0], [0.0, 130.0], [50.0, 100.0]]
+[law]
+type = "optimal"
+duration = 90.0
+[inertia]
+effector_mass = 0.01
+[friction]
+coulomb = 0.02
+viscous = 0.001
+coulomb_speed_deg_s = 1.0
+[gravity]
+vector = [0.0, 0.0]
+[output]
+units = "si"
+samples = 201
+"""
+
 
 def named_cases() -> dict[str, str]:
     ex = ROOT / "examples"
@@ -82,7 +104,8 @@ def named_cases() -> dict[str, str]:
             "20-turn arc, dry friction, paper units": ARC_TURNS.format(end=7200, units="paper"),
             "2 s line, dry friction, gravity": DRY_LINE.format(duration=2.0),
             "60 s line, dry friction, gravity": DRY_LINE.format(duration=60.0),
-            "trapezoid, gravity": TRAPEZOID}
+            "trapezoid, gravity": TRAPEZOID,
+            "optimal law, 90 s, dry friction 0.02 N m": OPTIMAL_DRY_90S}
 
 
 def random_case(rng: np.random.Generator) -> str:

@@ -248,11 +248,13 @@ def power_balance_residual(an: Analysis, *, interior: int = 201,
     tr = sample_trajectory(sc.robot, sc.path, law, mode=sc.mode, times=t)
     power = np.sum(inverse_dynamics(torque_model, tr.q, tr.dq, tr.ddq) * tr.dq, axis=-1)
     scale = np.abs(power).max()
-    # the differences' own error falls as h^8: of h and h / 4, the smaller residual (a torque
-    # error does not depend on h; an optimal law's boundary layers, a tenth of a 90 s motion,
-    # left 1e-5 at h alone)
+    # the differences' own error falls as h^8: of h, h / 4 and h / 16, the smallest residual
+    # (a torque error does not depend on h). An optimal law with dry friction over 90 s has a
+    # boundary layer of a few tenths of a second at its end: 4.9 at h = 0.09 s, 1.05e-5 at
+    # h / 4 (the run said 'the torques do not match'), 5.4e-10 at h / 16, 2e-9 and 8e-9 at
+    # h / 64 and h / 256 (rounding)
     best = np.inf
-    for step in (h, 0.25 * h):
+    for step in (h, 0.25 * h, 0.0625 * h):
         rate = np.zeros_like(t)
         for k, c in enumerate(_FD8):
             if c:
