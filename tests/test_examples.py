@@ -29,6 +29,7 @@ def test_example_configs_plan(name):
 
 
 # (a design task's motors come from its catalogue: tests/design/test_motors.py sweeps it)
+@pytest.mark.slow
 @pytest.mark.parametrize("name", [n for n, doc in CONFIGS.items()
                                   if "move" in doc and "design" not in doc])
 def test_example_programs_plan_their_moves(name):

@@ -183,6 +183,7 @@ def test_a_plugin_path_type_and_law_plan_a_run(site, tmp_path):
     assert "stroke" in r.stdout and "steady" in r.stdout and "nudge" in r.stdout
 
 
+@pytest.mark.slow
 def test_a_broken_plugin_is_named(tmp_path):
     (tmp_path / "dextar_broken.py").write_text("raise ImportError('no such thing')\n")
     info = tmp_path / "dextar_broken-0.1.dist-info"

@@ -80,6 +80,7 @@ def test_bad_requests_are_refused():
 SMALL = dx.calibration.KinematicModel(dx.FiveBar(90.0, 90.0, 120.0, 120.0, 70.0).scaled(1e-3))
 
 
+@pytest.mark.slow
 def test_every_working_mode_asked_for_gets_its_share():
     """At least max(1, 40 // 16) = 2 poses of each mode (all of a mode's candidates when it
     has fewer): 14 / 13 / 2 / 11 here, O1 0.508 against 0.513 for the determinant alone."""

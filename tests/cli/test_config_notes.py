@@ -45,6 +45,7 @@ def test_one_place_computes_the_notes_of_both_configs(files):
         assert cfg.notes == ()
 
 
+@pytest.mark.slow
 def test_ik_fk_and_workspace_say_the_notes(files, tmp_path, capsys):
     code, err = _cli(capsys, "ik", "0", "0.12", "--robot", files["metres"])
     assert code == 0 and err.startswith("dextar ik: note: ") and SAID in err
@@ -64,6 +65,7 @@ def test_ik_fk_and_workspace_say_the_notes(files, tmp_path, capsys):
         assert code == 0 and "note" not in err, (argv, err)
 
 
+@pytest.mark.slow
 def test_poses_and_calibrate_say_the_notes(files, tmp_path, capsys):
     poses = tmp_path / "p.csv"
     code, err = _cli(capsys, "poses", files["metres"], "--count", "20", "--out", poses)
@@ -85,6 +87,7 @@ def test_poses_and_calibrate_say_the_notes(files, tmp_path, capsys):
     assert code == 0 and "note" not in err
 
 
+@pytest.mark.slow
 def test_export_excite_and_identify_say_the_notes(files, tmp_path, capsys, excite_csv):
     code, err = _cli(capsys, "export", "mjcf", files["metres"], "--out", tmp_path / "m.xml")
     assert code == 2 and "out of reach" in err and SAID in err

@@ -47,6 +47,7 @@ def test_identify_without_config_says_what_it_assumed(tmp_path, capsys, excite_c
 
 
 # ---------------------------------------------------------------- no answer where there is one
+@pytest.mark.slow
 @pytest.mark.parametrize("limits", ['vmax = 300.0\namax = 3000.0\n', ''])
 def test_a_fitted_trapezoid_is_the_shortest_within_the_motors(tmp_path, limits):
     """pick_place.toml with move 6 a trapezoid fitted to the motors (with and without its own

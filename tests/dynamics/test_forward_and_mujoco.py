@@ -82,6 +82,7 @@ def test_mujoco_general_robot_and_rods():
     assert np.abs(got - ddq).max() / np.abs(ddq).max() < 1e-3
 
 
+@pytest.mark.slow
 def test_mujoco_replays_our_torques_open_loop(tmp_path):
     """The exported model (friction, gravity, payload, rotors; keyframe at the start) driven
     open loop by our torques follows the paper's motion within 1e-3 rad."""

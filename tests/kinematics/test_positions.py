@@ -41,6 +41,7 @@ def test_fk_ik_round_trip(p, mode):
     np.testing.assert_allclose(P, p, atol=1e-9)
 
 
+@pytest.mark.slow
 @settings(max_examples=300, deadline=None)
 @given(st.floats(-np.pi, np.pi), st.floats(-np.pi, np.pi), st.sampled_from(["up", "down"]))
 def test_ik_fk_round_trip(phi, psi, assembly):

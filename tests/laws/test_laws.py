@@ -102,6 +102,7 @@ def test_line_closed_form_is_the_hyperbolic_formula():
     assert abs(y[1][0]) < 1e-13 and abs(y[1][-1]) < 1e-13
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("path", [
     Spline(((0.0, 1.0), (0.3, 1.2), (0.6, 1.0), (1.0, 1.3))),
     ExpressionPath("0.3*cos(p)", "1.2 + 0.2*sin(2*p)", 0.0, 3.0),
@@ -239,6 +240,7 @@ def test_curvature_jump_is_left_to_mesh_refinement():
     assert _curvature_pieces(SPLINE, SPLINE.length, _breaks(SPLINE, SPLINE.length)) is not None
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("path", [
     SPLINE,  # Chebyshev elements on the spline's pieces
     ExpressionPath("p", "0.1*sqrt(p**2 + 1e-4)**3", -1.0, 1.0),  # solve_bvp (not smooth enough)

@@ -51,6 +51,7 @@ def _lp(obj_x, obj_u, Gu, Gx, h, ds, lo, hi, x=None):
     return r.x if r.status == 0 else None
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", range(8))
 def test_passes_agree_with_linear_programmes_also_where_a_least_speed_is_needed(seed):
     rng = np.random.default_rng(seed)

@@ -184,6 +184,7 @@ def test_the_rows_linear_model_matches_finite_differences(setup):
     assert errs[1][0] < errs[0][0] / 30
 
 
+@pytest.mark.slow
 def test_a_coarse_start_grid_that_finds_no_motion_is_retried_on_the_whole_grid(
         chain, monkeypatch):
     """Where the start's coarse second-order grid reports no motion (it can step over a

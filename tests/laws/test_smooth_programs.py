@@ -52,6 +52,7 @@ def example(tmp_path_factory):
     return out
 
 
+@pytest.mark.slow
 def test_the_example_plans_within_its_limits_on_every_setpoint(example):
     """Eight moves (lines blended within 8 mm, dwells, an arc through a via point) with
     ``max_jerk = 3000``: the joint jerk by finite differences of the written accelerations
@@ -66,6 +67,7 @@ def test_the_example_plans_within_its_limits_on_every_setpoint(example):
     assert all("jerk-limited" in m["law_message"] for m in laws)
 
 
+@pytest.mark.slow
 def test_a_longer_chain_plans_within_its_limits(tmp_path):
     """Five lines blended into one motion (four blends; the example's chain has two; eight
     and more are in ``benchmarks/bench_smooth.py programs``): every written setpoint within
@@ -149,6 +151,7 @@ def _cpu(pid):
     return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="/proc: Linux")
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
 def test_an_interrupt_ends_the_planning_within_a_second(tmp_path, sig):

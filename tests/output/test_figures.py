@@ -48,6 +48,7 @@ def test_pixels_are_packed_as_one_integer_a_colour():
     assert np.array_equal(_packed(rgba[:, ::2]), want[:, ::2])  # a view that is not contiguous
 
 
+@pytest.mark.slow
 def test_a_laid_out_figure_saves_the_same_bytes_without_its_layout_engine():
     def figure():
         fig = Figure(figsize=(3, 2))

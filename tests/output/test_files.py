@@ -32,6 +32,7 @@ def test_files_follow_the_umask(tmp_path, umask022):
     assert mode(tmp_path / "c.csv") == 0o600
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("argv, name", [
     (["plan", "--out", "{d}/plan.csv"], "plan.csv"),
     (["workspace", "--out", "{d}/ws.png", "--resolution", "41"], "ws.png"),

@@ -23,6 +23,7 @@ def limit_lines(ax):
                    if ln.get_linestyle() == "--" and len(set(ln.get_ydata())) == 1})
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kw, panels", [
     ({}, ["angle", "speed", "torque"]),
     ({"max_acceleration": (60.0, 50.0)}, ["angle", "speed", "acceleration", "torque"]),

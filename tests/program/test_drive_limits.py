@@ -69,6 +69,7 @@ def check_limits(sp, amax, jmax, peak, wmax, moves):
         assert np.abs(ddq[near]).max() <= jmax * dt * 1.02
 
 
+@pytest.mark.slow
 def test_jerk_limits_hold_on_every_written_sample(smooth):
     sp = columns(smooth / "setpoints.csv")
     s = json.loads((smooth / "summary.json").read_text())

@@ -267,6 +267,7 @@ def test_a_chain_takes_the_law_of_its_first_move(tmp_path, capsys):
     assert "blend makes it one motion" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_the_docs_program_plans_within_the_motors(tmp_path):
     """The task file the docs' programs guide shows (examples/program_tour.toml: a tight
     blended turn, time-optimal under a steep torque-speed envelope) plans, and its setpoints
