@@ -18,7 +18,7 @@ import numpy as np
 from .._arrays import Array
 from ..geometry import FiveBar
 from ..kinematics import workspace_map
-from ..program import MoveTiming, ProgramResult, RmsFit, Sizing
+from ..program import ModeChoice, MoveTiming, ProgramResult, RmsFit, Sizing
 from ..program.drive import DriveUnits, PvtPoints, csp_columns, pvt_points
 from .figures import new_figure, plot_workspace, png_bytes, svg_bytes, tight_layout, warm_up
 from .files import OutputDir
@@ -57,6 +57,8 @@ class ProgramSummary:
     encoder_offset_deg : (float, float)
         ``[robot].encoder_offset_deg``: the setpoints' angles are encoder readings, the
         geometric angles minus these.
+    mode_choice : ModeChoice, optional
+        The working modes the planner chose (``working_mode = "auto"``).
     """
 
     config: str
@@ -67,6 +69,7 @@ class ProgramSummary:
     rms_fit: RmsFit | None = None
     drive: dict[str, Any] | None = None
     encoder_offset_deg: tuple[float, float] = (0.0, 0.0)
+    mode_choice: ModeChoice | None = None
 
     @property
     def units(self) -> str:
@@ -89,6 +92,8 @@ class ProgramSummary:
                "units": self.units}
         if self.rms_fit is not None:
             out["rms_fit"] = self.rms_fit.as_dict()
+        if self.mode_choice is not None:
+            out["mode_choice"] = self.mode_choice.as_dict()
         if self.drive is not None:
             out["drive"] = self.drive
         return out
@@ -96,10 +101,12 @@ class ProgramSummary:
     def lines(self, out: str, samples: int) -> list[str]:
         """The summary in words."""
         return [
-            f"program: cycle time {self.cycle_time_s:.6g} s, {len(self.moves)} moves; "
-            f"{self.status} the motors",
-            *(f"  move {m.index} ({m.type}): {m.law or 'dwell'} {m.duration_s:.4g} s from "
-              f"{m.start_s:.4g} s" + (", blended into the next" if m.blended_with_next else "")
+            f"program: cycle time {self.cycle_time_s:.6g} s, "
+            f"{sum(not m.mode_change for m in self.moves)} moves; {self.status} the motors",
+            *self._mode_lines(),
+            *(f"  move {m.index} ({m.type}{self._mode_words(m)}): {m.law or 'dwell'} "
+              f"{m.duration_s:.4g} s from {m.start_s:.4g} s"
+              + (", blended into the next" if m.blended_with_next else "")
               for m in self.moves),
             *(crossing_line(m.index, c) for m in self.moves for c in m.crossings),
             *(f"  motor {m.motor}: peak {m.peak_torque_Nm:.4g} N m, RMS {m.rms_torque_Nm:.4g} "
@@ -118,6 +125,21 @@ class ProgramSummary:
             f"{self.servo_rate_hz:g} Hz{self._angles_note()})"
             + (f", {Path(out) / 'csp.csv'}, {Path(out) / 'pvt.csv'}" if self.drive else "")
             + f" and {Path(out) / 'summary.json'}"]
+
+    def _mode_lines(self) -> list[str]:
+        c = self.mode_choice
+        if c is None:
+            return []
+        changes = (f"; a change of mode before move{'s' if len(c.changes) > 1 else ''} "
+                   + ", ".join(str(i) for i in c.changes)) if c.changes else ""
+        return [f"  working modes chosen by the planner: start {c.start_mode}, then "
+                + " ".join(c.modes) + f" (the shortest cycle of {c.plans} motions "
+                f"planned{changes})"]
+
+    def _mode_words(self, m: MoveTiming) -> str:
+        if m.mode_change:
+            return f", change of working mode to {m.working_mode}"
+        return f", {m.working_mode}" if self.mode_choice is not None else ""
 
     def _angles_note(self) -> str:
         if self.encoder_offset_deg == (0.0, 0.0):
