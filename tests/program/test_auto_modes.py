@@ -169,3 +169,15 @@ def test_the_command_reports_the_modes_it_chose(tmp_path, capsys):
         assert main(["program", "--no-figures", str(cfg), "--out",
                      str(tmp_path / cfg.stem)]) == 2
         assert f"working mode {mode}" in capsys.readouterr().err
+
+
+def test_a_line_with_its_own_mode_is_the_hand_written_change_and_line(setup):
+    """working_mode = "++" on a line in a +- program: the planner changes the mode at the
+    line's start by a joint move, the cycle the hand-written joint move and line's."""
+    own = plan(setup, [Move("line", {"to": mm(20, 110), "working_mode": "++"})], HOME, "+-")
+    hand = plan(setup, [Move("joint", {"to": HOME, "working_mode": "++"}),
+                        Move("line", {"to": mm(20, 110)})], HOME, "+-")
+    assert [(m.index, m.type, m.mode_change, m.working_mode) for m in own.timeline()] == [
+        (0, "joint", True, "++"), (0, "line", False, "++")]
+    assert own.cycle_time_s == pytest.approx(hand.cycle_time_s, abs=TOL)
+    assert own.mode_choice.changes == (0,) and (own.move_index == 0).all()

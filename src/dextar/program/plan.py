@@ -1204,6 +1204,8 @@ def _no_mode(group: list[tuple[int, Move]],
     seen: dict[str | None, DextarError] = {}
     for _, mode, exc in fails:
         seen.setdefault(mode, exc)
+    if len(seen) == 1:  # one mode tried: its own error (it names the move)
+        return fails[0][2]
     why = "; ".join(f"in {mode or 'its own mode'}: {exc}" for mode, exc in seen.items())
     first = fails[0][2]
     return type(first)(f"{move_name(i, mv)}: working_mode = \"auto\": no working mode plans "
