@@ -103,7 +103,7 @@ class ProgramSummary:
         return [
             f"program: cycle time {self.cycle_time_s:.6g} s, "
             f"{sum(not m.mode_change for m in self.moves)} moves; {self.status} the motors",
-            *self._mode_lines(),
+            *self.mode_lines(),
             *(f"  move {m.index} ({m.type}{self._mode_words(m)}): {m.law or 'dwell'} "
               f"{m.duration_s:.4g} s from {m.start_s:.4g} s"
               + (", blended into the next" if m.blended_with_next else "")
@@ -126,7 +126,8 @@ class ProgramSummary:
             + (f", {Path(out) / 'csp.csv'}, {Path(out) / 'pvt.csv'}" if self.drive else "")
             + f" and {Path(out) / 'summary.json'}"]
 
-    def _mode_lines(self) -> list[str]:
+    def mode_lines(self) -> list[str]:
+        """The working modes the planner chose, in words (none without auto)."""
         c = self.mode_choice
         if c is None:
             return []
@@ -400,9 +401,11 @@ def program_report(summary: ProgramSummary, pngs: dict[str, bytes]) -> str:
     esc = html.escape
     moves = grid(("move", "type", "law", "start [s]", "duration [s]", "min type-1 distance",
                   "min type-2 distance", "modes at its end"),
-                 [(m.index, m.type, m.law or "dwell", m.start_s, m.duration_s,
+                 [(m.index, f"{m.type} (change of working mode)" if m.mode_change else m.type,
+                   m.law or "dwell", m.start_s, m.duration_s,
                    m.min_type1_distance, m.min_type2_distance,
                    f"{m.working_mode} {m.assembly_mode}".strip()) for m in summary.moves])
+    modes = "".join(f"<p>{esc(line.strip())}</p>" for line in summary.mode_lines())
     keys = [("peak_torque_Nm", "peak torque [N m]"), ("rms_torque_Nm", "RMS torque [N m]"),
             ("peak_speed_rad_s", "peak speed [rad/s]"), ("peak_power_W", "peak power [W]"),
             ("energy_J", "energy delivered [J]"),
@@ -441,5 +444,5 @@ def program_report(summary: ProgramSummary, pngs: dict[str, bytes]) -> str:
         f"Program {name}: {summary.status} the motors",
         f"<p>Task file {esc(summary.config)}. Cycle time {summary.cycle_time_s:.4f} s; "
         f"setpoints at {summary.servo_rate_hz:g} Hz. Units: {esc(summary.units)}.</p>"
-        f"<h2>Moves</h2>{moves}{crossings}<h2>Motor sizing</h2>{sizing}<h2>Violations</h2>"
+        f"<h2>Moves</h2>{modes}{moves}{crossings}<h2>Motor sizing</h2>{sizing}<h2>Violations</h2>"
         f"<ul>{viol}</ul><h2>Figures</h2>{figures(pngs)}")
