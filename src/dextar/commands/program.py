@@ -33,7 +33,8 @@ def run(args: argparse.Namespace) -> Result:
     with noted(sc):
         job = jobs.program(sc)
     res, summary = job.result, job.summary
-    written.write_program(args.out, res, summary, sc.robot_mm, sc.program_mode,
+    written.write_program(args.out, res, summary, sc.robot_mm,
+                          job.start_mode or sc.program_mode,
                           force=args.force, with_figures=args.figures, drive=job.drive,
                           pvt=job.pvt)
     warnings = note_lines("program", sc)

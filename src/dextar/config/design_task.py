@@ -8,8 +8,10 @@ from typing import TYPE_CHECKING
 
 from ..design.evaluate import Task
 from ..design.space import DesignSpace
+from ..errors import ConfigError
 from ..laws import LawRequest
 from ..motors import Catalogue
+from ..program import AUTO
 from ..units import SI
 from .catalogue import read_catalogue
 
@@ -30,6 +32,10 @@ def design_task(sc: Scenario, *, samples: int | None = None,
                             counterweights=((c1.mass, c2.mass),
                                             (1e3 * c1.distance, 1e3 * c2.distance)))
     motors, rms = sc.si_motors, sc.motors_table.rms_torque
+    if sc.moves and sc.program_mode == AUTO:
+        raise ConfigError("config key [program].working_mode = \"auto\" is not for dextar "
+                          "design (a design's workspace metrics are a working mode's): set "
+                          "the working mode, or plan the program with dextar program")
     if sc.moves:  # a program task
         return Task(sc.moves, sc.program_start, sc.program_mode, sc.assembly, motors, rms,
                     inertia, space.mass_per_length, sc.design.grid, sc.tolerances,

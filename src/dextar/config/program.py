@@ -26,7 +26,13 @@ class ProgramTable(Table):
     PARAMS: ClassVar[dict[str, Param]] = {
         "start": Param("point", "", None, "start point [x, y] in mm (at rest)"),
         "working_mode": Param("text", "", None, "working mode at the start (default "
-                              "[robot].working_mode)"),
+                              "[robot].working_mode), or auto: the planner chooses the start's "
+                              "mode and the mode of every move that sets none (joint moves to "
+                              "a point end in it; a line or an arc runs in it, after a joint "
+                              "move at its start that changes the mode through serial "
+                              "singularities where needed), the modes that make the cycle "
+                              "shortest within the motors (exact: dynamic programming over "
+                              "the moves; a blended chain keeps one mode)"),
         "law": Param("text", "", "time-optimal", "default law of every move"),
         "blend": Param("number", "", 0.0, "default corner blend radius, mm", minimum=0.0),
         "grid": Param("integer", "", 400, "time-optimal segments per motion (blended moves "
@@ -49,11 +55,12 @@ class ProgramTable(Table):
         """Read ``[program]``."""
         t = cls(**read_params(cls.NAME, raw, cls.PARAMS))
         law_type(t.law, "config key [program].law")
-        if t.working_mode is not None:
+        if t.working_mode is not None and t.working_mode != "auto":
             try:
                 canonical_working_mode(t.working_mode)
             except DextarError as exc:
-                raise ConfigError(f"config key [program].working_mode: {exc}") from None
+                raise ConfigError(f"config key [program].working_mode: {exc} (or "
+                                  "\"auto\")") from None
         return t
 
 

@@ -40,6 +40,13 @@ class ProgramJob:
     warnings: tuple[str, ...] = ()
 
     @property
+    def start_mode(self) -> str | None:
+        """The working mode the planner chose at the start (``working_mode = "auto"``), or
+        None (the configured one)."""
+        c = self.result.mode_choice
+        return None if c is None else c.start_mode
+
+    @property
     def fits(self) -> bool:
         """Every motor within every limit, every move ending where it was sent."""
         return self.summary.sizing.fits
@@ -63,5 +70,5 @@ def program(sc: Scenario) -> ProgramJob:
         sized = replace(sized, violations=(*sized.violations, *over))
     summary = ProgramSummary(sc.source, res.cycle_time_s, sc.output.servo_rate_hz,
                              tuple(res.timeline()), sized, res.rms_fit, report,
-                             sc.robot_table.encoder_offset_deg)
+                             sc.robot_table.encoder_offset_deg, res.mode_choice)
     return ProgramJob(res, summary, drive, pvt, tuple(notes))

@@ -18,7 +18,7 @@ import numpy as np
 from .._arrays import Array
 from ..geometry import FiveBar
 from ..kinematics import workspace_map
-from ..program import MoveTiming, ProgramResult, RmsFit, Sizing
+from ..program import ModeChoice, MoveTiming, ProgramResult, RmsFit, Sizing
 from ..program.drive import DriveUnits, PvtPoints, csp_columns, pvt_points
 from .figures import new_figure, plot_workspace, png_bytes, svg_bytes, tight_layout, warm_up
 from .files import OutputDir
@@ -57,6 +57,8 @@ class ProgramSummary:
     encoder_offset_deg : (float, float)
         ``[robot].encoder_offset_deg``: the setpoints' angles are encoder readings, the
         geometric angles minus these.
+    mode_choice : ModeChoice, optional
+        The working modes the planner chose (``working_mode = "auto"``).
     """
 
     config: str
@@ -67,6 +69,7 @@ class ProgramSummary:
     rms_fit: RmsFit | None = None
     drive: dict[str, Any] | None = None
     encoder_offset_deg: tuple[float, float] = (0.0, 0.0)
+    mode_choice: ModeChoice | None = None
 
     @property
     def units(self) -> str:
@@ -89,6 +92,8 @@ class ProgramSummary:
                "units": self.units}
         if self.rms_fit is not None:
             out["rms_fit"] = self.rms_fit.as_dict()
+        if self.mode_choice is not None:
+            out["mode_choice"] = self.mode_choice.as_dict()
         if self.drive is not None:
             out["drive"] = self.drive
         return out
@@ -96,10 +101,12 @@ class ProgramSummary:
     def lines(self, out: str, samples: int) -> list[str]:
         """The summary in words."""
         return [
-            f"program: cycle time {self.cycle_time_s:.6g} s, {len(self.moves)} moves; "
-            f"{self.status} the motors",
-            *(f"  move {m.index} ({m.type}): {m.law or 'dwell'} {m.duration_s:.4g} s from "
-              f"{m.start_s:.4g} s" + (", blended into the next" if m.blended_with_next else "")
+            f"program: cycle time {self.cycle_time_s:.6g} s, "
+            f"{sum(not m.mode_change for m in self.moves)} moves; {self.status} the motors",
+            *self.mode_lines(),
+            *(f"  move {m.index} ({m.type}{self._mode_words(m)}): {m.law or 'dwell'} "
+              f"{m.duration_s:.4g} s from {m.start_s:.4g} s"
+              + (", blended into the next" if m.blended_with_next else "")
               for m in self.moves),
             *(crossing_line(m.index, c) for m in self.moves for c in m.crossings),
             *(f"  motor {m.motor}: peak {m.peak_torque_Nm:.4g} N m, RMS {m.rms_torque_Nm:.4g} "
@@ -118,6 +125,22 @@ class ProgramSummary:
             f"{self.servo_rate_hz:g} Hz{self._angles_note()})"
             + (f", {Path(out) / 'csp.csv'}, {Path(out) / 'pvt.csv'}" if self.drive else "")
             + f" and {Path(out) / 'summary.json'}"]
+
+    def mode_lines(self) -> list[str]:
+        """The working modes the planner chose, in words (none without auto)."""
+        c = self.mode_choice
+        if c is None:
+            return []
+        changes = (f"; a change of mode before move{'s' if len(c.changes) > 1 else ''} "
+                   + ", ".join(str(i) for i in c.changes)) if c.changes else ""
+        return [f"  working modes chosen by the planner: start {c.start_mode}, then "
+                + " ".join(c.modes) + f" (the shortest cycle of {c.plans} motions "
+                f"planned{changes})"]
+
+    def _mode_words(self, m: MoveTiming) -> str:
+        if m.mode_change:
+            return f", change of working mode to {m.working_mode}"
+        return f", {m.working_mode}" if self.mode_choice is not None else ""
 
     def _angles_note(self) -> str:
         if self.encoder_offset_deg == (0.0, 0.0):
@@ -378,9 +401,11 @@ def program_report(summary: ProgramSummary, pngs: dict[str, bytes]) -> str:
     esc = html.escape
     moves = grid(("move", "type", "law", "start [s]", "duration [s]", "min type-1 distance",
                   "min type-2 distance", "modes at its end"),
-                 [(m.index, m.type, m.law or "dwell", m.start_s, m.duration_s,
+                 [(m.index, f"{m.type} (change of working mode)" if m.mode_change else m.type,
+                   m.law or "dwell", m.start_s, m.duration_s,
                    m.min_type1_distance, m.min_type2_distance,
                    f"{m.working_mode} {m.assembly_mode}".strip()) for m in summary.moves])
+    modes = "".join(f"<p>{esc(line.strip())}</p>" for line in summary.mode_lines())
     keys = [("peak_torque_Nm", "peak torque [N m]"), ("rms_torque_Nm", "RMS torque [N m]"),
             ("peak_speed_rad_s", "peak speed [rad/s]"), ("peak_power_W", "peak power [W]"),
             ("energy_J", "energy delivered [J]"),
@@ -419,5 +444,5 @@ def program_report(summary: ProgramSummary, pngs: dict[str, bytes]) -> str:
         f"Program {name}: {summary.status} the motors",
         f"<p>Task file {esc(summary.config)}. Cycle time {summary.cycle_time_s:.4f} s; "
         f"setpoints at {summary.servo_rate_hz:g} Hz. Units: {esc(summary.units)}.</p>"
-        f"<h2>Moves</h2>{moves}{crossings}<h2>Motor sizing</h2>{sizing}<h2>Violations</h2>"
+        f"<h2>Moves</h2>{modes}{moves}{crossings}<h2>Motor sizing</h2>{sizing}<h2>Violations</h2>"
         f"<ul>{viol}</ul><h2>Figures</h2>{figures(pngs)}")

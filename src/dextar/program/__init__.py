@@ -3,6 +3,8 @@
 from . import move_types as _builtin  # noqa: F401 - registers line, arc, dwell, joint
 from .moves import MOVE_TYPES, Move, MoveType, move_type, register_move
 from .plan import (
+    AUTO,
+    ModeChoice,
     MovePlan,
     MoveTiming,
     PlanContext,
@@ -16,7 +18,7 @@ from .plan import (
 )
 from .sizing import MotorSizing, Sizing, Violation, sizing
 
-__all__ = ["MOVE_TYPES", "MotorSizing", "Move", "MovePlan", "MoveTiming", "MoveType",
+__all__ = ["AUTO", "MOVE_TYPES", "ModeChoice", "MotorSizing", "Move", "MovePlan", "MoveTiming", "MoveType",
            "PlanContext", "PlanState", "PlannedMove", "ProgramRequest", "ProgramResult", "RmsFit",
            "Sizing", "Violation", "fit_rms", "move_type", "plan_program", "register_move",
            "sizing"]

@@ -135,21 +135,27 @@ def _plan_joint(ctx: PlanContext, mv: Move, state: PlanState) -> MovePlan:
     return MovePlan(law, law.duration, sample, end, float(d1.min()), float(d2.min()))
 
 
+def _check_mode(v: Mapping[str, Any]) -> str | None:
+    if v.get("working_mode") is not None and v["working_mode"] != "auto":
+        try:
+            canonical_working_mode(v["working_mode"])
+        except DextarError as exc:
+            return f"working_mode: {exc} (or \"auto\")"
+    return None
+
+
 def _check_arc(v: Mapping[str, Any]) -> str | None:
     if ("via" in v) == ("center" in v):
         return "an arc needs exactly one of 'via' and 'center'"
-    return None
+    return _check_mode(v)
 
 
 def _check_joint(v: Mapping[str, Any]) -> str | None:
     if ("to" in v) == ("to_deg" in v):
         return "a joint move needs exactly one of 'to' and 'to_deg'"
-    if v.get("working_mode") is not None:
-        try:
-            canonical_working_mode(v["working_mode"])
-        except DextarError as exc:
-            return f"working_mode: {exc}"
-    return None
+    if v.get("working_mode") == "auto" and "to_deg" in v:
+        return "working_mode = \"auto\" needs a target point 'to' (angles fix the mode)"
+    return _check_mode(v)
 
 
 _TO = Param("point", "mm", REQUIRED, "target point [x, y] in mm")
@@ -158,15 +164,23 @@ _ASSEMBLY = Param("choice", "", None, "the assembly mode at the move's end, up o
                   "parallel (type 2) singularity curve under the degeneracy condition "
                   "(law time-optimal)", choices=("up", "down"))
 
-register_move(MoveType("line", {"to": _TO, "assembly_mode": _ASSEMBLY}, _plan_path_move,
-                       path=line_path, help="a straight segment to a point"))
+_PATH_MODE = Param("text", "", None, "the working mode the path runs in: ++, +-, -+, -- or "
+                   "auto (the planner chooses; see [program].working_mode); another than the "
+                   "current one makes the planner change to it first, by a joint move at "
+                   "the path's start point (through serial singularities). Default: the "
+                   "current mode (auto when [program].working_mode = \"auto\"); a blended "
+                   "chain keeps its first move's")
+
+register_move(MoveType("line", {"to": _TO, "assembly_mode": _ASSEMBLY,
+                                "working_mode": _PATH_MODE}, _plan_path_move,
+                       path=line_path, check=_check_mode, help="a straight segment to a point"))
 register_move(MoveType(
     "arc", {"to": _TO,
             "via": Param("point", "mm", None, "an intermediate point [x, y] in mm"),
             "center": Param("point", "mm", None, "the centre [x, y] in mm"),
             "direction": Param("choice", "", "ccw", "ccw or cw (about a centre)",
                                choices=("ccw", "cw")),
-            "assembly_mode": _ASSEMBLY},
+            "assembly_mode": _ASSEMBLY, "working_mode": _PATH_MODE},
     _plan_path_move, path=arc_path, check=_check_arc,
     help="an arc through 'via' to a point, or about 'center'"))
 register_move(MoveType(
@@ -176,7 +190,10 @@ register_move(MoveType(
     "joint", {"to": Param("point", "mm", None, "target point [x, y] in mm"),
               "to_deg": Param("point", "deg", None, "target angles [phi, psi] in deg (encoder "
                               "readings: geometric angle - [robot].encoder_offset_deg)"),
-              "working_mode": Param("text", "", None, "the target's working mode"),
+              "working_mode": Param("text", "", None, "the target's working mode: ++, +-, -+, "
+                                    "-- or auto (the planner chooses the one that makes the "
+                                    "cycle shortest; needs 'to'). Default: the current mode "
+                                    "(auto when [program].working_mode = \"auto\")"),
               "assembly_mode": Param("choice", "", None, "up or down: a joint move keeps "
                                      "the assembly mode (refused if another)",
                                      choices=("up", "down"))},

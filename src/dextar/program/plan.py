@@ -184,6 +184,9 @@ class PlannedMove:
         The move's own feedforward torques (:attr:`MovePlan.torques`).
     crossings : tuple of CrossingMargin
         Its crossings of the parallel singularity curve (local times).
+    mode_change : bool
+        A joint move the mode planner put before move ``index`` (a path move) to change the
+        working mode there (``working_mode = "auto"``, :func:`plan_program`).
     """
 
     index: int
@@ -203,6 +206,7 @@ class PlannedMove:
     mode: str = ""
     torques: Callable[[Array], Array] | None = None
     crossings: tuple[CrossingMargin, ...] = ()
+    mode_change: bool = False
 
 
 @dataclass(frozen=True)
@@ -225,6 +229,9 @@ class MoveTiming:
         The modes the move ends in.
     crossings : tuple of dict
         Its crossings of the parallel singularity curve, JSON-ready (:func:`crossing_dict`).
+    mode_change : bool
+        A joint move the mode planner put before move ``index`` to change the working mode
+        (to ``working_mode``) at the point where that move starts.
     """
 
     index: int
@@ -240,6 +247,7 @@ class MoveTiming:
     working_mode: str = ""
     assembly_mode: str = ""
     crossings: tuple[dict[str, Any], ...] = ()
+    mode_change: bool = False
 
 
 @dataclass(frozen=True)
@@ -271,6 +279,8 @@ class ProgramResult:
     servo_rate_hz : float, optional
         The setpoints' rate: ``t = arange(n) / servo_rate_hz`` (None: samples of another
         kind, a sweep's run task).
+    mode_choice : ModeChoice, optional
+        The working modes the planner chose (``working_mode = "auto"``), or None.
     """
 
     moves: list[PlannedMove]
@@ -287,6 +297,7 @@ class ProgramResult:
     move_types: tuple[str, ...] = ()
     rms_fit: RmsFit | None = None
     servo_rate_hz: float | None = None
+    mode_choice: ModeChoice | None = None
 
     def timeline(self) -> list[MoveTiming]:
         """Every move of the program in order, each move of a blended chain on its own."""
@@ -299,13 +310,14 @@ class ProgramResult:
                 mine = tuple(crossing_dict(c, pm.start_s, peak) for c in pm.crossings
                              if start <= pm.start_s + c.t <= start + dur)
                 out.append(MoveTiming(
-                    idx, self.move_types[idx] if self.move_types else pm.move.type,
+                    idx, pm.move.type if pm.mode_change or not self.move_types
+                    else self.move_types[idx],
                     law.name if law else None, int(law.status) if law else 0,
                     law.message if law else "holding still", start, dur,
                     bool(pm.members) and idx != pm.members[-1][0], pm.min_type1_distance,
                     pm.min_type2_distance, pm.mode,
                     pm.end_assembly if idx == members[-1][0] else _assembly_at(pm, start + dur),
-                    mine))
+                    mine, pm.mode_change))
         return out
 
 
@@ -546,7 +558,10 @@ def plan_program(robot: FiveBar, inertia: Inertia, moves: Sequence[Move], *,
         In SI (points in m, angles in rad, times in s); a move's index is its position.
     start : (float, float)
         The start point (m), at rest.
-    working_mode, assembly : str
+    working_mode : str
+        The working mode at the start, or ``"auto"``: the planner chooses it and the mode of
+        every move that sets none (see :func:`chooses_modes`).
+    assembly : str
     motors : MotorLimits, optional
         Joint-side limits in SI; required by laws planned under the motors and by ``"fit"``.
     rms_limit : (float, float), optional
@@ -573,6 +588,8 @@ def plan_program(robot: FiveBar, inertia: Inertia, moves: Sequence[Move], *,
     if not (math.isfinite(servo_rate_hz) and servo_rate_hz > 0):
         raise ParameterError(f"servo rate {servo_rate_hz!r} must be positive")
     ctx = PlanContext(robot, inertia, assembly, motors, grid, tolerances)
+    if chooses_modes(moves, working_mode):
+        return _plan_modes(ctx, moves, start, working_mode, rms_limit, servo_rate_hz)
     mode = canonical_working_mode(working_mode)
     P0 = np.asarray(start, float)
     check_reach(robot, P0[None, :], lambda i: "the start", SI.point_text,
@@ -583,26 +600,32 @@ def plan_program(robot: FiveBar, inertia: Inertia, moves: Sequence[Move], *,
     planned: list[PlannedMove] = []
     t0 = 0.0
     for group in _chains(moves):
-        i, mv = group[0]
-        try:
-            if len(group) == 1:
-                mp = move_type(mv.type).plan(ctx, mv, state)
-                end = mp.end if mp.end.assembly else replace(mp.end, assembly=state.assembly)
-                pm = PlannedMove(i, mv, mp.law, t0, mp.duration_s, state.q, mp.end.q,
-                                 mp.sample, mp.min_type1_distance, mp.min_type2_distance,
-                                 assembly=state.assembly, end_assembly=end.assembly,
-                                 mode=end.mode, torques=mp.torques, crossings=mp.crossings)
-                state = end
-            else:
-                pm, state = _plan_chain(ctx, group, state, t0)
-        except DextarError as exc:
-            raise type(exc)(f"{_chain_name(group, exc)}: {exc}") from None
+        pm, state = _plan_group(ctx, group, state, t0)
         planned.append(pm)
         t0 += pm.duration_s
     res = _setpoints(ctx, planned, t0, rms_limit, servo_rate_hz,
                      tuple(mv.type for mv in moves))
     _check_ends(ctx, res, moves)
     return res
+
+
+def _plan_group(ctx: PlanContext, group: list[tuple[int, Move]], state: PlanState,
+                t0: float) -> tuple[PlannedMove, PlanState]:
+    """One motion (a move, or a blended chain) from ``state`` at the cycle time ``t0``; errors
+    named with the move."""
+    i, mv = group[0]
+    try:
+        if len(group) > 1:
+            return _plan_chain(ctx, group, state, t0)
+        mp = move_type(mv.type).plan(ctx, mv, state)
+    except DextarError as exc:
+        raise type(exc)(f"{_chain_name(group, exc)}: {exc}") from None
+    end = mp.end if mp.end.assembly else replace(mp.end, assembly=state.assembly)
+    pm = PlannedMove(i, mv, mp.law, t0, mp.duration_s, state.q, mp.end.q,
+                     mp.sample, mp.min_type1_distance, mp.min_type2_distance,
+                     assembly=state.assembly, end_assembly=end.assembly,
+                     mode=end.mode, torques=mp.torques, crossings=mp.crossings)
+    return pm, end
 
 
 def _check_ends(ctx: PlanContext, res: ProgramResult, moves: Sequence[Move]) -> None:
@@ -973,3 +996,217 @@ def _setpoints(ctx: PlanContext, planned: list[PlannedMove], cycle: float,
                                      q[past], dq[past], ddq[past])
     return ProgramResult(planned, cycle, t, move, P, q, dq, ddq, tau, ctx.motors, rms_limit,
                          types, servo_rate_hz=rate)
+
+
+# ---------------------------------------------------------------- working modes chosen
+#: ``working_mode = "auto"`` (``[program]`` or a move): the planner chooses the mode.
+AUTO = "auto"
+
+#: The four working modes, in the order the mode planner tries them (a tie keeps the first).
+MODES = ("++", "+-", "-+", "--")
+
+
+@dataclass(frozen=True)
+class ModeChoice:
+    """The working modes the planner chose (``working_mode = "auto"``, :func:`plan_program`).
+
+    Attributes
+    ----------
+    start_mode : str
+        The working mode at the start.
+    modes : tuple of str
+        The working mode each move of the program ends in, in program order.
+    changes : tuple of int
+        The path moves before which the planner put a joint move that changes the working
+        mode at the point where they start.
+    plans : int
+        Motions planned by the search (each candidate move once per mode it may start in).
+    """
+
+    start_mode: str
+    modes: tuple[str, ...]
+    changes: tuple[int, ...]
+    plans: int
+
+    def as_dict(self) -> dict[str, object]:
+        """JSON-ready."""
+        return {"start_mode": self.start_mode, "modes": list(self.modes),
+                "changes_before_moves": list(self.changes), "plans": self.plans}
+
+
+def _asked_mode(mv: Move) -> str | None:
+    """A move's own ``working_mode``: a canonical mode, :data:`AUTO` or None."""
+    wm = mv.get("working_mode")
+    if wm is None:
+        return None
+    return AUTO if wm == AUTO else canonical_working_mode(wm)
+
+
+def chooses_modes(moves: Sequence[Move], working_mode: str) -> bool:
+    """Whether the mode planner plans the program: ``working_mode = "auto"`` for the program
+    or a move, or a path move (line, arc) with its own ``working_mode``."""
+    return working_mode == AUTO or any(
+        _asked_mode(mv) == AUTO
+        or (mv.get("working_mode") is not None and move_type(mv.type).path is not None)
+        for mv in moves)
+
+
+#: A move of the concrete program the mode planner builds: the index of the program's move
+#: it stands for, the move, and whether it is a change of working mode the planner put there.
+Step = tuple[int, Move, bool]
+
+
+@dataclass(frozen=True)
+class _Node:
+    """The shortest way found to a (working mode, assembly mode) after some moves."""
+
+    cost: float
+    state: PlanState
+    start_mode: str
+    steps: tuple[Step, ...]
+
+
+def _options(group: list[tuple[int, Move]], state: PlanState, auto: bool) -> list[str | None]:
+    """The working modes a motion may run in (a path) or end in (a joint move to a point) from
+    ``state``; ``[None]``: the move decides (a dwell, a joint move to angles)."""
+    i, mv = group[0]
+    kind = move_type(mv.type)
+    if kind.path is not None:
+        asked = _asked_mode(mv)
+        for j, other in group[1:]:
+            if _asked_mode(other) not in (None, asked):
+                raise ParameterError(
+                    f"{move_name(j, other)} sets working_mode = \"{other.get('working_mode')}\" "
+                    f"but a blend makes it one motion with move {i}, which keeps one working "
+                    "mode along its path: set working_mode in the first move of the chain only")
+    elif "working_mode" in kind.params and mv.get("to") is not None:
+        asked = _asked_mode(mv)
+    else:
+        return [None]
+    if asked is None:
+        asked = AUTO if auto else state.mode
+    return list(MODES) if asked == AUTO else [asked]
+
+
+def _without_mode(mv: Move) -> Move:
+    return replace(mv, values={k: v for k, v in mv.values.items() if k != "working_mode"})
+
+
+def _realise(ctx: PlanContext, group: list[tuple[int, Move]], state: PlanState,
+             mode: str | None) -> list[list[Step]]:
+    """The concrete motions that run ``group`` in ``mode`` from ``state``: a joint move to a
+    point ends in it; a path runs in it, after a joint move at its start point from the
+    state's mode when they differ (time-optimal within the motors; without motors, with the
+    path's law and duration)."""
+    i, mv = group[0]
+    if mode is None:
+        return [[(j, _without_mode(m) if _asked_mode(m) == AUTO else m, False)
+                 for j, m in group]]
+    if move_type(mv.type).path is None:
+        return [[(i, replace(mv, values={**mv.values, "working_mode": mode}), False)]]
+    out: list[list[Step]] = []
+    if mode != state.mode:
+        to = {"to": (float(state.P[0]), float(state.P[1])), "working_mode": mode}
+        change = (Move("joint", to) if ctx.motors is not None
+                  else Move("joint", to, law=mv.law, duration=mv.duration,
+                            law_params=mv.law_params))
+        out.append([(i, change, True)])
+    out.append([(j, _without_mode(m), False) for j, m in group])
+    return out
+
+
+def _plan_modes(ctx: PlanContext, moves: Sequence[Move], start: tuple[float, float],
+                working_mode: str, rms_limit: tuple[float, float] | None,
+                rate: float) -> ProgramResult:
+    """The program with the working modes chosen: dynamic programming over the motions, the
+    state the (working, assembly) mode at each motion's end, the cost the planned durations;
+    each candidate motion planned once per mode it may start in. The best sequence is then
+    planned as a program of its own and its moves numbered as the program's."""
+    auto = working_mode == AUTO
+    robot, asm = ctx.robot, ctx.assembly
+    P0 = np.asarray(start, float)
+    check_reach(robot, P0[None, :], lambda i: "the start", SI.point_text,
+                lambda v: f"{SI.mm(v):.6g} mm")
+    layer: dict[tuple[str, str], _Node] = {}
+    failed: list[tuple[str, DextarError]] = []
+    for m in MODES if auto else (canonical_working_mode(working_mode),):
+        try:
+            q0 = inverse_kinematics(robot, P0, m)
+            check_assembly(robot, q0, P0, m, asm, "the start")
+        except DextarError as exc:
+            failed.append((m, exc))
+            continue
+        layer[(m, asm)] = _Node(0.0, PlanState(P0, q0, m, asm), m, ())
+    if not layer:
+        if len(failed) == 1:
+            raise failed[0][1]
+        raise AssemblyError(f"working_mode = \"auto\": no working mode reaches the start "
+                            f"{SI.point_text(P0)} in assembly mode {asm} ("
+                            + "; ".join(f"{m}: {e}" for m, e in failed) + ")")
+    plans = 0
+    for group in _chains(moves):
+        nxt: dict[tuple[str, str], _Node] = {}
+        fails: list[tuple[str, str | None, DextarError]] = []
+        for node in layer.values():
+            for mode in _options(group, node.state, auto):
+                parts = _realise(ctx, group, node.state, mode)
+                state, cost = node.state, node.cost
+                try:
+                    for part in parts:
+                        pm, state = _plan_group(ctx, [(j, m) for j, m, _ in part], state, 0.0)
+                        plans += 1
+                        cost += pm.duration_s
+                except DextarError as exc:
+                    fails.append((node.state.mode, mode, exc))
+                    continue
+                key = (state.mode, state.assembly)
+                if key not in nxt or cost < nxt[key].cost:
+                    nxt[key] = _Node(cost, state, node.start_mode,
+                                     node.steps + tuple(s for part in parts for s in part))
+        if not nxt:
+            raise _no_mode(group, fails)
+        layer = nxt
+    best = min(layer.values(), key=lambda n: n.cost)
+    concrete = [m for _, m, _ in best.steps]
+    res = plan_program(robot, ctx.inertia, concrete, start=start, working_mode=best.start_mode,
+                       assembly=asm, motors=ctx.motors, rms_limit=rms_limit,
+                       servo_rate_hz=rate, grid=ctx.grid, tolerances=ctx.tolerances)
+    origin = np.array([i for i, _, _ in best.steps])
+    planned = [_renumbered(pm, origin, best.steps[pm.index][2]) for pm in res.moves]
+    res = replace(res, moves=planned, move_index=origin[res.move_index],
+                  move_types=tuple(mv.type for mv in moves))
+    ends = {t.index: t.working_mode for t in res.timeline() if not t.mode_change}
+    choice = ModeChoice(best.start_mode, tuple(ends[i] for i in range(len(moves))),
+                        tuple(i for i, _, inserted in best.steps if inserted), plans)
+    return replace(res, mode_choice=choice)
+
+
+def _renumbered(pm: PlannedMove, origin: Array, inserted: bool) -> PlannedMove:
+    """A motion of the concrete program numbered as the program's move it stands for."""
+    owner = pm.owner
+    if owner is not None:
+        inner = owner
+
+        def owner(t: Array) -> Array:
+            return np.asarray(origin[inner(t)])
+
+    return replace(pm, index=int(origin[pm.index]), owner=owner, mode_change=inserted,
+                   members=tuple((int(origin[k]), s, d) for k, s, d in pm.members))
+
+
+def _no_mode(group: list[tuple[int, Move]],
+             fails: Sequence[tuple[str, str | None, DextarError]]) -> DextarError:
+    """The error of a motion that no working mode plans: the move, its target (mm) and, per
+    mode tried, the first reason."""
+    i, mv = group[-1] if move_type(group[0][1].type).path is not None else group[0]
+    target = move_target(mv)
+    what = "" if target is None else f" to its target {SI.point_text(target)}"
+    seen: dict[str | None, DextarError] = {}
+    for _, mode, exc in fails:
+        seen.setdefault(mode, exc)
+    if len(seen) == 1:  # one mode tried: its own error (it names the move)
+        return fails[0][2]
+    why = "; ".join(f"in {mode or 'its own mode'}: {exc}" for mode, exc in seen.items())
+    first = fails[0][2]
+    return type(first)(f"{move_name(i, mv)}: working_mode = \"auto\": no working mode plans "
+                       f"it{what} from where the moves before it can leave the robot ({why})")
