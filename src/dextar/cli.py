@@ -201,9 +201,19 @@ def _restore(previous: dict[int, Any]) -> None:
         signal.signal(sig, h if h is not None else signal.SIG_DFL)
 
 
+def _is_number_list(text: str) -> bool:
+    """True for comma-separated numbers (``-150,150,50,250``)."""
+    try:
+        [float(v) for v in text.split(",")]
+    except ValueError:
+        return False
+    return True
+
+
 def _protect_negatives(argv: list[str]) -> list[str]:
     """Let values that look like options through argparse: ``dextar ik -10 120`` (a negative
-    number gets a leading space, which argparse reads as a value) and the working modes
+    number, or a list of numbers such as ``--region -150,150,50,250``, gets a leading space,
+    which argparse reads as a value) and the working modes
     ``--mode --``, ``--mode=-+`` (rewritten to their aliases: argparse would drop ``--``),
     ``--modes --,-+`` (joined as ``--modes=--,-+``)."""
     out: list[str] = []
@@ -221,7 +231,10 @@ def _protect_negatives(argv: list[str]) -> list[str]:
             float(a)
             out.append(" " + a if a.startswith("-") else a)
         except ValueError:
-            out.append(a)
+            if a.startswith("-") and "," in a and _is_number_list(a):  # --region -150,150,..
+                out.append(" " + a)
+            else:
+                out.append(a)
     return out
 
 

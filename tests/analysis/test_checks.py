@@ -86,6 +86,45 @@ def test_the_power_balance_passes_right_torques_and_catches_a_mass_one_percent_o
     assert power_balance_residual(line_si, torques=wrong) > 1e3 * POWER_BALANCE_TOL
 
 
+def test_the_power_balance_tells_wrong_torques_from_a_motion_too_fast_to_measure(tmp_path,
+                                                                                 line_si):
+    """Wrong torques (masses 1 % off) give the same residual at every step of the
+    differences (measured 1e-2 at h, h/4, h/16): "the torques do not match". An expression
+    path of 1e11 turns in 2 s (p1 = 1e12) read 31.2 and the run said the torques do not
+    match; the residual changes with the step (31.2, 142, 504): the check could not measure,
+    said so (and still exit 1: a check that did not pass)."""
+    from dextar.analysis import STEP_DEPENDENCE, power_balance_residuals
+
+    wrong = power_balance_residuals(line_si, torques=line_si.model.inertia.scaled_masses(1.01))
+    assert min(wrong) > 1e3 * POWER_BALANCE_TOL and max(wrong) < 1.1 * min(wrong), wrong
+    text = FAST_EXPRESSION
+    an = _analysis(tmp_path, text)
+    steps = power_balance_residuals(an)
+    assert min(steps) > POWER_BALANCE_TOL and max(steps) > STEP_DEPENDENCE * min(steps), steps
+    v = validation(an)
+    said = [f for f in v["failed"] if f.startswith("power balance")]
+    assert len(said) == 1 and "the torques are not shown wrong" in said[0], v["failed"]
+
+
+FAST_EXPRESSION = """
+[law]
+type = "min-jerk"
+duration = 2.0
+[friction]
+coulomb = 0.002
+[output]
+units = "si"
+figures = []
+samples = 201
+[path]
+type = "expression"
+x = "40*cos(p)"
+y = "110 + 20*sin(p)"
+p0 = 0
+p1 = 1e12
+"""
+
+
 def test_a_fast_long_motion_is_checked_in_windows_not_as_a_whole(tmp_path):
     """Before: `forward dynamics at t = 0.819: parallel (type 2) singularity`, exit 2. The
     torques are right; in windows anchored to the plan the drift stays at rounding."""

@@ -517,8 +517,9 @@ def test_poses_in_the_region_of_the_instrument(tmp_path, capsys):
     assert s["region_mm"] == [-150.0, 150.0, 0.0, 230.0] and s["missing_modes"] == []
     # --region wins over the config's; from y = 40 mm up mode -+ has no pose: exit 1, the
     # file written, the mode named
+    # (written with a space as the help writes it: a negative XMIN is a value, not an option)
     code, out, err = cli(["poses", cfg, "--count", "40", "--out", tmp_path / "q.csv",
-                          "--region=-150,150,40,230"], capsys)
+                          "--region", "-150,150,40,230"], capsys)
     assert code == 1 and err.count("\n") == 1, err
     assert "working mode -+ asked for but without a pose in the region x -150 to 150 mm, " \
            "y 40 to 230 mm (robot frame)" in err and "choose --modes" in err

@@ -3,6 +3,7 @@
 from .core import (
     POWER_BALANCE_TOL,
     REPLAY_TOL,
+    STEP_DEPENDENCE,
     Analysis,
     PaperComparison,
     RunInputs,
@@ -10,13 +11,15 @@ from .core import (
     forward_error,
     forward_replay,
     power_balance_residual,
+    power_balance_residuals,
     power_balance_times,
     replay_windows,
     torque_limit_ratio,
 )
 from .summary import is_paper_example, law_summary, run_summary, validation
 
-__all__ = ["POWER_BALANCE_TOL", "REPLAY_TOL", "Analysis", "PaperComparison", "RunInputs",
+__all__ = ["POWER_BALANCE_TOL", "REPLAY_TOL", "STEP_DEPENDENCE", "Analysis", "PaperComparison", "RunInputs",
            "analyze", "forward_error", "forward_replay", "replay_windows",
-           "is_paper_example", "law_summary", "power_balance_residual", "power_balance_times",
+           "is_paper_example", "law_summary", "power_balance_residual", "power_balance_residuals",
+           "power_balance_times",
            "run_summary", "torque_limit_ratio", "validation"]

@@ -82,8 +82,8 @@ _BUILTIN = (
     ("program", "plan a robot program under the motors: setpoints and sizing (exit 1 when a "
      "motor limit is exceeded)", False),
     ("excite", "an exciting trajectory for identification (a Fourier series per motor, "
-     "regressor condition number minimised, coverage floors checked) to CSV (exit 1 below "
-     "its floors)", False),
+     "regressor condition number minimised, coverage floors checked: a warning below "
+     "them) to CSV", False),
     ("identify", "identify the base parameters from measured motion and write a config with "
      "them (exit 1 when poorly determined, not physical or a poor fit)", False),
     ("poses", "measurement poses for a kinematic calibration (D-optimal over the working "
