@@ -234,6 +234,7 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
     width = np.where(hasu & hasl, hi - lo, np.abs(x) + 1.0)
     floor = np.concatenate([1e-2 * (1.0 + np.abs(rb)), 1e-3 * width[iu], 1e-3 * width[il]])
     sl = np.maximum(h_all - G(x), floor)
+    del floor, width
     z = MU0 / sl
     y = np.zeros(Q * M)
     scale_p = 1.0 + float(np.abs(rb).max(initial=0.0))
@@ -276,11 +277,13 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
                 abT[j:, KL + KU + i - j] += add[:nb - j]
                 if a != b:
                     abT[i:, KL + KU + j - i] += add[:nb - i]
+            del add
             for p in range(P):
                 drg = Dr * rg[:, p]
                 for a in range(NR):
                     U[ROW_POS[a]:, p] += np.bincount(base, drg * ra[:, a],
                                                      minlength=nb)[:nb - ROW_POS[a]]
+                del drg
         abT = ab.reshape(nb, nrow)
         ab[clear] = 0.0
         ab[diag_x] += diag[:nk]
@@ -297,13 +300,19 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
         ap = min(1.0, _to_bound(sl, ads))
         ad = min(1.0, _to_bound(z, adz))
         mu_aff = float((sl + ap * ads) @ (z + ad * adz)) / m_all
-        dx, dy, dz, ds = newton.step(sl * z + ads * adz - (mu_aff / mu) ** 3 * mu)
+        cc = sl * z + ads * adz - (mu_aff / mu) ** 3 * mu
+        del adz, ads
+        dx, dy, dz, ds = newton.step(cc)
+        del cc
         ap = min(1.0, ETA * _to_bound(sl, ds))
         ad = min(1.0, ETA * _to_bound(z, dz))
         x += ap * dx
         sl += ap * ds
         y += ad * dy
         z += ad * dz
+        # (the band, its factors and the steps are not kept into the next iteration: at
+        # 16k knots each of them is tens of megabytes)
+        del newton, lu, ab, abT, dx, dy, dz, ds, Dz, Dr, rp
     if status != 0 and best[0] <= 100.0:
         status, x = 0, best[1]
     return LPResult(x, float(c @ x), status, it)
