@@ -45,11 +45,6 @@ class Rows:
     sizes: Array  # (R, 5) float32: |d/d sigma|, |d/d w|, |d/d alpha|, |d/d J|, |d/d T|
     kinds: tuple[tuple[str, int], ...] = ()  # (what, how many) per block (development)
 
-    def values(self) -> Rows:
-        """The rows without their gradients (``C`` and ``sizes`` empty)."""
-        return Rows(self.F, self.k, np.zeros((0, 5)), self.norm,
-                    np.zeros((0, 5), np.float32), self.kinds)
-
     def kind_of(self, i: int) -> str:
         """The block row ``i`` belongs to (for the log)."""
         for name, n in self.kinds:

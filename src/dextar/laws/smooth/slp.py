@@ -304,11 +304,11 @@ def slp(model: RowModel, J: Array, Tk: Array, budget: int, delta: float) -> Run:
         res = None
         for _ in range(5):  # a row left out and crossed (rounding only) joins
             prog = lp.build(rows, use, mo, T_ref, delta, scale, jscale)
-            if lean:  # the rows' gradients are in the programme: not kept while it is solved
-                rows = rows.values()
+            if lean:  # the rows are in the programme: not kept while it is solved
+                del rows
             res = solve_staged(*prog)
             del prog
-            if lean:  # (the same gradients again, for the rows left out)
+            if lean:  # (the same rows again, for those left out)
                 rows = model.rows(mo)
             n += 1
             if res.status != 0:
