@@ -54,7 +54,8 @@ PROGRESS = 1e-4
 #: inside the trust region. Near the solution the SLP converges fast (the programmes'
 #: solutions are near vertices), so the next step would be far smaller still.
 STEP_TOL = 1e-4
-#: The largest mesh (intervals) whose trial steps' rows are built with their gradients.
+#: The largest mesh (intervals) whose trial steps' rows are built with their gradients and
+#: whose rows are kept while a programme is solved (a larger one makes them again after).
 TRIAL_GRADIENTS = 2048
 FEAS_TOL = 1e-4
 
