@@ -184,13 +184,19 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
     # matrices and the equalities' part of the band, made once; a large one (whose memory
     # they would double) builds them in every iteration, a pair of variables at a time
     kept = _Kept(ra, xr, base, pa, pb, pair_off, nrow, nb) if R * len(pa) <= KEEP else None
+    del base  # (a large programme's band makes it again: not kept through its steps)
     ab_eq = eq_band() if kept is not None else None
 
     iu, il = np.flatnonzero(hasu), np.flatnonzero(hasl)
     nu, nl = len(iu), len(il)
     m_all = R + nu + nl
     # every inequality as g . x <= h: the rows, then x <= hi, then -x <= -lo
-    h_all = np.concatenate([rb, hi[iu], -lo[il]])
+
+    def h_all() -> Array:
+        """Every inequality's right-hand side (made when needed: one more array of every
+        row's kept through the steps otherwise)."""
+        return np.concatenate([rb, hi[iu], -lo[il]])
+
     bnd = np.concatenate([iu, il])
     sgn = np.concatenate([np.ones(nu), -np.ones(nl)])
 
@@ -233,7 +239,8 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
     x = np.where(fixed, lo, np.asarray(x0, float))
     width = np.where(hasu & hasl, hi - lo, np.abs(x) + 1.0)
     floor = np.concatenate([1e-2 * (1.0 + np.abs(rb)), 1e-3 * width[iu], 1e-3 * width[il]])
-    sl = np.maximum(h_all - G(x), floor)
+    sl = np.maximum(h_all() - G(x), floor)
+    del floor, width
     z = MU0 / sl
     y = np.zeros(Q * M)
     scale_p = 1.0 + float(np.abs(rb).max(initial=0.0))
@@ -243,7 +250,7 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
     for it in range(maxiter + 1):
         rd = c + GT(z) + ETy(y)
         rd[fixed] = 0.0
-        rp = G(x) + sl - h_all
+        rp = G(x) + sl - h_all()
         re = Ex(x)
         gap = float(sl @ z)
         miss = max(max(float(np.abs(rp).max(initial=0.0)), float(np.abs(re).max(initial=0.0)))
@@ -270,17 +277,21 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
         else:
             ab = eq_band()
             abT = ab.reshape(nb, nrow)
+            base = BLOCK * rk
             for a, b in pairs:
                 add = np.bincount(base, Dr * ra[:, a] * ra[:, b], minlength=nb)
                 i, j = ROW_POS[a], ROW_POS[b]
                 abT[j:, KL + KU + i - j] += add[:nb - j]
                 if a != b:
                     abT[i:, KL + KU + j - i] += add[:nb - i]
+            del add
             for p in range(P):
                 drg = Dr * rg[:, p]
                 for a in range(NR):
                     U[ROW_POS[a]:, p] += np.bincount(base, drg * ra[:, a],
                                                      minlength=nb)[:nb - ROW_POS[a]]
+                del drg
+            del base
         abT = ab.reshape(nb, nrow)
         ab[clear] = 0.0
         ab[diag_x] += diag[:nk]
@@ -297,13 +308,19 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
         ap = min(1.0, _to_bound(sl, ads))
         ad = min(1.0, _to_bound(z, adz))
         mu_aff = float((sl + ap * ads) @ (z + ad * adz)) / m_all
-        dx, dy, dz, ds = newton.step(sl * z + ads * adz - (mu_aff / mu) ** 3 * mu)
+        cc = sl * z + ads * adz - (mu_aff / mu) ** 3 * mu
+        del adz, ads
+        dx, dy, dz, ds = newton.step(cc)
+        del cc
         ap = min(1.0, ETA * _to_bound(sl, ds))
         ad = min(1.0, ETA * _to_bound(z, dz))
         x += ap * dx
         sl += ap * ds
         y += ad * dy
         z += ad * dz
+        # (the band, its factors and the steps are not kept into the next iteration: at
+        # 16k knots each of them is tens of megabytes)
+        del newton, lu, ab, abT, dx, dy, dz, ds, Dz, Dr, rp
     if status != 0 and best[0] <= 100.0:
         status, x = 0, best[1]
     return LPResult(x, float(c @ x), status, it)
@@ -349,7 +366,12 @@ class _Newton:
         dx = np.concatenate([db[self.xband], dp])
         dx[self.fixed] = 0.0
         dz = self.Dz * (self.G(dx) + t)
-        return dx, db[self.yband], dz, (-cc - self.s * dz) / self.z
+        del t
+        ds = self.s * dz  # (-cc - s dz) / z, in place
+        ds += cc
+        ds /= self.z
+        np.negative(ds, out=ds)
+        return dx, db[self.yband], dz, ds
 
 
 class _Kept:

@@ -54,7 +54,8 @@ PROGRESS = 1e-4
 #: inside the trust region. Near the solution the SLP converges fast (the programmes'
 #: solutions are near vertices), so the next step would be far smaller still.
 STEP_TOL = 1e-4
-#: The largest mesh (intervals) whose trial steps' rows are built with their gradients.
+#: The largest mesh (intervals) whose trial steps' rows are built with their gradients and
+#: whose rows are kept while a programme is solved (a larger one makes them again after).
 TRIAL_GRADIENTS = 2048
 FEAS_TOL = 1e-4
 
@@ -164,7 +165,12 @@ class Programme:
               scale: float, jscale: float) -> LPResult:
         """The programme on the rows ``use`` (a mask) about the motion ``mo``, within the
         trust region: the accelerations within ``delta * scale`` of the motion's, the
-        durations within ``T_SHARE * delta`` (relative) of theirs."""
+        durations within ``T_SHARE * delta`` (relative) of theirs (:meth:`build`), solved."""
+        return solve_staged(*self.build(rows, use, mo, T_ref, delta, scale, jscale))
+
+    def build(self, rows: Rows, use: Array, mo: Motion, T_ref: float, delta: float,
+              scale: float, jscale: float) -> tuple[StagedLP, Array]:
+        """The programme of :meth:`solve` and its start (the motion's variables)."""
         M, mesh = self.M, self.mesh
         sel = np.flatnonzero(use)
         R = len(sel)
@@ -179,6 +185,7 @@ class Programme:
         self._local(rows.C[sel], k[:R], mo, ra[:R])
         x0 = self.x0(mo)
         rb[:R] = -rows.F[sel]
+        del sel
         for j, off in enumerate((0, 1, 2, 3, 6, 7)):
             rb[:R] += ra[:R, j] * x0[4 * k[:R] + off]
         rg[:R] = -1.0
@@ -222,10 +229,9 @@ class Programme:
         hi[:, 3] = Tn * (1 + T_SHARE * delta)
         c = self.c.copy()
         c[3:4 * M:4] = mesh.h / T_ref
-        lp = StagedLP(c, k, ra, rg, rb, E, np.zeros((M, 3)),
-                      np.concatenate([lo.reshape(-1), [0.0]]),
-                      np.concatenate([hi.reshape(-1), [np.inf]]))
-        return solve_staged(lp, x0)
+        return StagedLP(c, k, ra, rg, rb, E, np.zeros((M, 3)),
+                        np.concatenate([lo.reshape(-1), [0.0]]),
+                        np.concatenate([hi.reshape(-1), [np.inf]])), x0
 
     def model(self, rows: Rows, x: Array, mo: Motion) -> Array:
         """Every row's linear model at the programme's variables ``x``."""
@@ -291,11 +297,20 @@ def slp(model: RowModel, J: Array, Tk: Array, budget: int, delta: float) -> Run:
     scale = max(float(np.abs(mo.alpha).max()), 1e-300)
     jscale = max(float(np.abs(mo.J).max()), 1e-300)
     debug = log.isEnabledFor(logging.DEBUG)
+    # a large mesh holds one set of rows' gradients at a time (each is tens of megabytes at
+    # 16k knots): a trial step's rows without them, and none while a programme is solved
+    lean = mesh.M > TRIAL_GRADIENTS
     while n < budget:
         use = rows.F + lp.reach(rows, mo, delta, scale, jscale) > -1e-9
         res = None
         for _ in range(5):  # a row left out and crossed (rounding only) joins
-            res = lp.solve(rows, use, mo, T_ref, delta, scale, jscale)
+            prog = lp.build(rows, use, mo, T_ref, delta, scale, jscale)
+            if lean:  # the rows are in the programme: not kept while it is solved
+                del rows
+            res = solve_staged(*prog)
+            del prog
+            if lean:  # (the same rows again, for those left out)
+                rows = model.rows(mo)
             n += 1
             if res.status != 0:
                 break
@@ -317,7 +332,7 @@ def slp(model: RowModel, J: Array, Tk: Array, budget: int, delta: float) -> Run:
         # the rows at the step; with their gradients when the mesh is small (most steps
         # are taken, and then they serve the next programme), else once it is taken (two
         # sets of gradients at once would raise the peak memory of a long path)
-        new = model.rows(mn, gradients=mesh.M <= TRIAL_GRADIENTS)
+        new = model.rows(mn, gradients=not lean)
         phin = merit(mn.T, T_ref, new.F, lp.ahead(mn))
         actual = phi - phin
         ratio = actual / pred if pred > 0 else (1.0 if actual >= 0 else -1.0)
@@ -346,10 +361,12 @@ def slp(model: RowModel, J: Array, Tk: Array, budget: int, delta: float) -> Run:
                     mn, new, phin, pred, ratio = mp, rp, php, pp, rp_ratio
                     step *= part
                     break
+            del lin1, rp
         if ratio > 0.1:
             T_prev, delta_prev = mo.T, delta
             del rows
             mo, rows, phi = mn, (new if len(new.C) == len(new.F) else model.rows(mn)), phin
+            del new
             if ratio > 0.75 and step > 0.5 * delta:
                 delta = min(2 * delta, 2.0)
             elif ratio < 0.25 or step < 0.5 * delta_prev:
@@ -361,6 +378,7 @@ def slp(model: RowModel, J: Array, Tk: Array, budget: int, delta: float) -> Run:
                 break
         else:
             delta = 0.3 * min(delta, step)
+            del new
         if delta < 1e-9:
             break
     return Run(mo.J, mo.Tk, n, converged, float(rows.F.max()))
