@@ -181,3 +181,27 @@ def test_a_line_with_its_own_mode_is_the_hand_written_change_and_line(setup):
         (0, "joint", True, "++"), (0, "line", False, "++")]
     assert own.cycle_time_s == pytest.approx(hand.cycle_time_s, abs=TOL)
     assert own.mode_choice.changes == (0,) and (own.move_index == 0).all()
+
+
+@pytest.mark.slow
+def test_a_robot_of_unequal_rods_plans_with_auto_where_no_single_mode_does(tmp_path, capsys):
+    """Issue 31's robot of unequal rods (80/75/95/92/58 mm) on auto_modes.toml's cycle: auto
+    plans it (measured 1.8429 s: start --, then -- -+ -+ -+ -- +- +- +-), every fixed working
+    mode is refused (exit 2: a parallel singularity on the way in ++, +-, --; the start in the
+    other assembly mode in -+)."""
+    text = (EXAMPLES / "auto_modes.toml").read_text().replace(
+        '[robot]\npreset = "dextar"\n',
+        "[robot]\nl1 = 80.0\nl2 = 75.0\nL1 = 95.0\nL2 = 92.0\nd = 58.0\n")
+    assert "l2 = 75.0" in text
+    cfg = tmp_path / "u.toml"
+    cfg.write_text(text)
+    assert main(["program", str(cfg), "--out", str(tmp_path / "auto"), "--no-figures",
+                 "--quiet"]) == 0
+    s = json.loads((tmp_path / "auto" / "summary.json").read_text())
+    modes = {m["working_mode"] for m in s["moves"]}
+    assert len(modes) >= 3, modes  # the cycle needs three working modes
+    for mode in ("++", "+-", "-+", "--"):
+        cfg.write_text(text.replace('working_mode = "auto"', f'working_mode = "{mode}"'))
+        assert main(["program", str(cfg), "--out", str(tmp_path / mode.replace("+", "p")),
+                     "--no-figures", "--quiet"]) == 2, mode
+    capsys.readouterr()
