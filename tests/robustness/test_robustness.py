@@ -41,7 +41,7 @@ pytestmark = pytest.mark.slow
 PICK_PLACE = str(Path(__file__).resolve().parents[2] / "examples" / "pick_place.toml")
 
 # (a sample of each shape for CI; the long run is benchmarks/fuzz.py --cases 10000)
-SETTINGS = settings(max_examples=50, deadline=None, derandomize=True,
+SETTINGS = settings(max_examples=30, deadline=None, derandomize=True,
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
 
 
@@ -127,7 +127,7 @@ def test_a_parameter_held_at_its_bound_gives_a_summary_not_an_error():
                 assert isinstance(p["rel_std"], float), p
 
 
-SHAPES = settings(max_examples=5, deadline=None, derandomize=True,
+SHAPES = settings(max_examples=3, deadline=None, derandomize=True,
                   suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
 
 
