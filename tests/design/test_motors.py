@@ -204,7 +204,7 @@ def test_bad_motor_and_counterweight_keys_exit_2(tmp_path, capsys, change, messa
 def test_objectives_on_motors_need_a_catalogue(tmp_path, capsys):
     from .test_design import TASK
 
-    text = TASK.replace("samples = 64", 'objectives = ["motor_price"]\nsamples = 4')
+    text = TASK.replace("samples = 32", 'objectives = ["motor_price"]\nsamples = 4')
     code, err = run_design(tmp_path, text, capsys)
     assert code == 2 and "'motor_price' needs a motor catalogue ([design].motors)" in err
 

@@ -32,7 +32,8 @@ from .test_design import TASK, rows_of, write_task
 pytest.importorskip("distributed")
 pytest.importorskip("pymoo")
 
-SEARCH = TASK.replace("samples = 64\n", 'search = "nsga2"\npopulation = 8\nevaluations = 32\n')
+SEARCH = TASK.replace("samples = 32\n", 'search = "nsga2"\npopulation = 8\nevaluations = 32\n')
+assert "nsga2" in SEARCH  # (the replace must hit test_design.TASK)
 
 
 def lengths(rows):
