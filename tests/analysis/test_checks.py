@@ -106,17 +106,8 @@ def test_the_power_balance_tells_wrong_torques_from_a_motion_too_fast_to_measure
     assert len(said) == 1 and "the torques are not shown wrong" in said[0], v["failed"]
 
 
-FAST_EXPRESSION = """
-[law]
-type = "min-jerk"
-duration = 2.0
-[friction]
-coulomb = 0.002
-[output]
-units = "si"
-figures = []
-samples = 201
-[path]
+#: The arc's law, friction and output along an expression path of 1e11 turns (p1 = 1e12).
+FAST_EXPRESSION = ARC_20_TURNS[ARC_20_TURNS.index("[law]"):] + """[path]
 type = "expression"
 x = "40*cos(p)"
 y = "110 + 20*sin(p)"

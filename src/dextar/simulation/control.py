@@ -56,6 +56,24 @@ MAX_STEPS = 100_000
 FOLLOWED, SINGULARITY_MET, LEFT_TOLERANCE, INCOMPLETE = 0, 1, 2, 3
 
 
+def checked_loop(plant: Model, natural_frequency: float, damping: float,
+                 torque_limit: float | None, tolerance: float | None
+                 ) -> tuple[float, float, float]:
+    """A tracking loop's settings checked (each positive and finite; exit 2 naming it): its
+    gains ``(kp, kd)`` and the tracking tolerance (default :func:`tracking_tolerance`)."""
+    if not (natural_frequency > 0 and np.isfinite(natural_frequency)):
+        raise ParameterError(f"natural frequency {natural_frequency!r} must be positive")
+    if not (damping > 0 and np.isfinite(damping)):
+        raise ParameterError(f"damping ratio {damping!r} must be positive")
+    if torque_limit is not None and not (torque_limit > 0):
+        raise ParameterError(f"torque limit {torque_limit!r} must be positive")
+    if tolerance is None:
+        tolerance = tracking_tolerance(plant.robot)
+    if not (tolerance > 0 and np.isfinite(tolerance)):
+        raise ParameterError(f"tracking tolerance {tolerance!r} must be positive")
+    return natural_frequency**2, 2.0 * damping * natural_frequency, tolerance
+
+
 def tracking_tolerance(robot: FiveBar) -> float:
     """The default tracking tolerance (the robot's length unit):
     :data:`TRACKING_TOLERANCE` of its reach."""
@@ -141,18 +159,9 @@ def simulate_computed_torque(trajectory: Trajectory, controller: Model, plant: M
     time_s, length_mm : float
         A run time unit in seconds and a run length unit in mm, for the message.
     """
-    if not (natural_frequency > 0 and np.isfinite(natural_frequency)):
-        raise ParameterError(f"natural frequency {natural_frequency!r} must be positive")
-    if not (damping > 0 and np.isfinite(damping)):
-        raise ParameterError(f"damping ratio {damping!r} must be positive")
-    if torque_limit is not None and not (torque_limit > 0):
-        raise ParameterError(f"torque limit {torque_limit!r} must be positive")
-    if tolerance is None:
-        tolerance = tracking_tolerance(plant.robot)
-    if not (tolerance > 0 and np.isfinite(tolerance)):
-        raise ParameterError(f"tracking tolerance {tolerance!r} must be positive")
+    kp, kd, tolerance = checked_loop(plant, natural_frequency, damping, torque_limit,
+                                     tolerance)
     tr = trajectory
-    kp, kd = natural_frequency**2, 2.0 * damping * natural_frequency
     q_d = interpolate.CubicHermiteSpline(tr.t, tr.q, tr.dq, axis=0)
     dq_d = interpolate.CubicHermiteSpline(tr.t, tr.dq, tr.ddq, axis=0)
     ddq_d = dq_d.derivative()

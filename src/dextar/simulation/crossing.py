@@ -47,7 +47,7 @@ from ..kinematics import (
 )
 from ..paths import Path
 from ..trajectory import Trajectory, path_motion
-from .control import ControlResult, tracking_tolerance
+from .control import ControlResult, checked_loop
 
 #: The damped least-squares inverse's damping, a fraction of ``E``'s largest singular value:
 #: the feedback along the rods' normal is halved where the normalised distance to the
@@ -117,19 +117,10 @@ def simulate_crossing(trajectory: Trajectory, controller: Model, plant: Model, *
     if not isinstance(tr.path, Path):
         raise ParameterError("a crossing is tracked along a task-space path (a joint line "
                              "crosses no parallel singularity)")
-    if not (natural_frequency > 0 and np.isfinite(natural_frequency)):
-        raise ParameterError(f"natural frequency {natural_frequency!r} must be positive")
-    if not (damping > 0 and np.isfinite(damping)):
-        raise ParameterError(f"damping ratio {damping!r} must be positive")
-    if torque_limit is not None and not (torque_limit > 0):
-        raise ParameterError(f"torque limit {torque_limit!r} must be positive")
-    if tolerance is None:
-        tolerance = tracking_tolerance(plant.robot)
-    if not (tolerance > 0 and np.isfinite(tolerance)):
-        raise ParameterError(f"tracking tolerance {tolerance!r} must be positive")
+    kp, kd, tolerance = checked_loop(plant, natural_frequency, damping, torque_limit,
+                                     tolerance)
     signs = parse_working_mode(tr.mode)
     step = MAX_STEP / time_s if max_step is None else max_step
-    kp, kd = natural_frequency**2, 2.0 * damping * natural_frequency
     # the control periods: the trajectory's sample intervals, each cut to the rate
     per_s = CONTROL_RATE * time_s if rate is None else rate
     sub = np.maximum(np.ceil(np.diff(tr.t) * per_s - 1e-9), 1).astype(int)
