@@ -70,12 +70,13 @@ def test_torque_above_the_rating_is_named_beyond_the_drive_limit_a_violation(pla
     assert over == []
 
 
-def _run(tmp_path, capsys, drive, name="o"):
+def _run(tmp_path, capsys, drive, name="o", extra=("--quiet",)):
     cfg = tmp_path / "pp.toml"
     cfg.write_text(task("", drive))
     out = tmp_path / name
-    code = main(["program", "--no-figures", str(cfg), "--out", str(out), "--quiet"])
-    return code, capsys.readouterr().err, out
+    code = main(["program", "--no-figures", str(cfg), "--out", str(out), *extra])
+    text = capsys.readouterr()
+    return code, text.err + text.out, out
 
 
 def test_the_program_exits_1_beyond_the_drive_limit(tmp_path, capsys):
@@ -86,12 +87,17 @@ def test_the_program_exits_1_beyond_the_drive_limit(tmp_path, capsys):
     assert code == 1 and s["status"] == "exceeds", err
     assert s["violations"][0]["motor"] == "D" and s["violations"][0]["value"] == 1568
     assert "motor D torque feedforward (per-mille of the rated torque 0.0035 N m) 1568 " \
-           "above its limit 1200" in err
+           "above the drive's limit 1200 ([drive].max_torque_permille)" in err
     assert s["drive"]["motors"][1]["max_torque_permille"] == 1200
     assert (out / "csp.csv").exists() and (out / "pvt.csv").exists()
+    # the headline said "exceeds the motors": the motors' own limits hold, the drive's does not
+    code, said, _ = _run(tmp_path, capsys, weak + "max_torque_permille = 1200\n", "o3", ())
+    assert code == 1 and "exceeds the drives" in said and "exceeds the motors" not in said
     # within the rating and without a limit: exit 0, a warning only above the rating
     code, err, _ = _run(tmp_path, capsys, weak, "o2")
     assert code == 0 and "warning: motor D's torque feedforward reaches 1568 per-mille" in err
+    code, said, _ = _run(tmp_path, capsys, weak, "o4", ())
+    assert code == 0 and "fits the motors and the drives" in said
 
 
 def test_whole_numbers_are_written_as_whole_numbers(tmp_path, capsys):

@@ -79,8 +79,16 @@ class ProgramSummary:
 
     @property
     def status(self) -> str:
-        """``"fits"`` or ``"exceeds"`` (the motors)."""
+        """``"fits"`` or ``"exceeds"`` (the motors, or the drives: :attr:`verdict`)."""
         return "fits" if self.sizing.fits else "exceeds"
+
+    @property
+    def verdict(self) -> str:
+        """The status with whose limits it is about: ``"fits the motors"`` (``"... and the
+        drives"`` with ``[drive]``), ``"exceeds the drives"``, ..."""
+        if self.sizing.fits:
+            return "fits the motors" + (" and the drives" if self.drive is not None else "")
+        return f"exceeds {self.sizing.exceeded}"
 
     def as_json(self) -> dict[str, Any]:
         """``summary.json``."""
@@ -102,7 +110,7 @@ class ProgramSummary:
         """The summary in words."""
         return [
             f"program: cycle time {self.cycle_time_s:.6g} s, "
-            f"{sum(not m.mode_change for m in self.moves)} moves; {self.status} the motors",
+            f"{sum(not m.mode_change for m in self.moves)} moves; {self.verdict}",
             *self.mode_lines(),
             *(f"  move {m.index} ({m.type}{self._mode_words(m)}): {m.law or 'dwell'} "
               f"{m.duration_s:.4g} s from {m.start_s:.4g} s"
@@ -441,7 +449,7 @@ def program_report(summary: ProgramSummary, pngs: dict[str, bytes]) -> str:
                rows))
     name = Path(summary.config).name
     return page(
-        f"Program {name}: {summary.status} the motors",
+        f"Program {name}: {summary.verdict}",
         f"<p>Task file {esc(summary.config)}. Cycle time {summary.cycle_time_s:.4f} s; "
         f"setpoints at {summary.servo_rate_hz:g} Hz. Units: {esc(summary.units)}.</p>"
         f"<h2>Moves</h2>{modes}{moves}{crossings}<h2>Motor sizing</h2>{sizing}<h2>Violations</h2>"

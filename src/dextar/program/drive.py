@@ -218,7 +218,8 @@ def torque_checks(res: ProgramResult, drive: DriveUnits) -> tuple[list[Violation
         if limit is not None and peak > limit:
             violations.append(Violation(
                 name, f"torque feedforward (per-mille of the rated torque {rated:g} N m)",
-                peak, limit, int(res.move_index[k]), float(res.t[k])))
+                peak, limit, int(res.move_index[k]), float(res.t[k]),
+                note=" ([drive].max_torque_permille)", limit_of="drive"))
         elif peak > RATED_PERMILLE:
             within = f", within the drive's {limit:g}" if limit is not None else ""
             warnings.append(

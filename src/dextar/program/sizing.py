@@ -73,6 +73,8 @@ class Violation:
     t_s: float | None
     #: Where the limit comes from when it is not the plain one (the torque-speed envelope).
     note: str = ""
+    #: Whose limit it is: ``"motor"`` (``[motors]``) or ``"drive"`` (``[drive]``).
+    limit_of: str = "motor"
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready."""
@@ -88,7 +90,8 @@ class Violation:
         where = (f" at t = {self.t_s:.4g} s in move {self.move}" if self.t_s is not None
                  else "")
         u = f" {self.unit}" if self.unit else ""
-        return (f"motor {self.motor} {self.quantity} {self.value:.4g}{u} above its limit "
+        whose = "its limit" if self.limit_of == "motor" else "the drive's limit"
+        return (f"motor {self.motor} {self.quantity} {self.value:.4g}{u} above {whose} "
                 f"{self.limit:.4g}{u}{self.note}{where}")
 
 
@@ -108,6 +111,13 @@ class Sizing:
     def fits(self) -> bool:
         """True when no limit is exceeded."""
         return not self.violations
+
+    @property
+    def exceeded(self) -> str:
+        """Whose limits the violations are, in words: ``"the motors"``, ``"the drives"``,
+        ``"the motors and the drives"`` (empty when it fits)."""
+        whose = {v.limit_of for v in self.violations}
+        return " and ".join(f"the {w}s" for w in ("motor", "drive") if w in whose)
 
 
 def sizing(res: ProgramResult) -> Sizing:
