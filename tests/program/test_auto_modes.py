@@ -205,3 +205,27 @@ def test_a_robot_of_unequal_rods_plans_with_auto_where_no_single_mode_does(tmp_p
         assert main(["program", str(cfg), "--out", str(tmp_path / mode.replace("+", "p")),
                      "--no-figures", "--quiet"]) == 2, mode
     capsys.readouterr()
+
+
+@pytest.mark.slow
+def test_the_moves_figure_draws_each_working_mode_it_runs_in(setup):
+    """The moves figure drew the start mode's workspace only, under moves run in other modes
+    (whose singularity curves and assembly regions differ): now a panel per mode visited,
+    each with the setpoints run in that mode."""
+    import numpy as np
+
+    from dextar.output.program import mode_samples, moves_figure
+
+    res = plan(setup, ACROSS, PLACE, AUTO)
+    c = res.mode_choice
+    visited = list(dict.fromkeys((c.start_mode, *c.modes)))
+    spans = mode_samples(res, c.start_mode)
+    assert list(spans) == visited and len(visited) >= 2
+    for pm in res.moves:  # every setpoint of a move in its mode's panel
+        inside = (res.t > pm.start_s) & (res.t < pm.start_s + pm.duration_s)
+        assert spans[pm.mode][inside].all()
+    assert np.logical_or.reduce(list(spans.values())).all()
+    fig = moves_figure(res, setup["robot"].scaled(1e3), c.start_mode)
+    titles = [ax.get_title() for ax in fig.axes]
+    assert [t for t in titles if t.startswith("the moves in")] == [
+        f"the moves in working mode {m}" for m in visited]

@@ -263,28 +263,66 @@ def mode_changes(res: ProgramResult, mode: str) -> Array:
     return np.array(out).reshape(-1, 2)
 
 
+def mode_samples(res: ProgramResult, mode: str) -> dict[str, Array]:
+    """The setpoints (masks (n,)) in each working mode the program visits, in the order
+    visited: a move's samples in its mode, a change of working mode's in both."""
+    out: dict[str, Array] = {mode: np.zeros(len(res.t), bool)}
+    prev = mode
+    for k, pm in enumerate(res.moves):
+        now = pm.mode or prev
+        end = res.moves[k + 1].start_s if k + 1 < len(res.moves) else np.inf  # the last: held
+        inside = (res.t >= pm.start_s - 1e-12) & (res.t <= end + 1e-12)
+        for m in {prev, now}:
+            out[m] = out.get(m, np.zeros(len(res.t), bool)) | inside
+        prev = now
+    return out
+
+
 def moves_figure(res: ProgramResult, robot_mm: FiveBar, mode: str) -> Figure:
-    """The end-effector's path over the workspace map of the starting working mode (its
-    assembly modes' regions and singularity curves), each move numbered at its middle, the
-    crossings of the parallel singularity curve (red stars) and the working-mode changes
-    (black diamonds) marked."""
-    ws = workspace_map(robot_mm, mode, resolution=241)
-    fig: Figure = plot_workspace(ws, path=res.P * 1e3, unit="mm",
-                                 crossings=crossing_points(res))
-    ax = fig.axes[0]
-    changes = mode_changes(res, mode)
-    if len(changes):
-        ax.plot(changes[:, 0], changes[:, 1], "D", color="black", mec="white", ms=8,
-                label="working-mode change")
-        ax.legend(loc="lower right", fontsize=8)
+    """The end-effector's path over the workspace map of each working mode it runs in (its
+    assembly modes' regions and singularity curves; a panel per working mode, the moves in
+    that mode drawn on it), each move numbered at its middle, the crossings of the parallel
+    singularity curve (red stars) and the working-mode changes (black diamonds) marked."""
+    spans = mode_samples(res, mode)
+    n = len(spans)
+    cols = min(n, 2)
+    rows = -(-n // cols)
+    fig: Figure = new_figure((7.0 * cols, 5.6 * rows))
+    axes = fig.subplots(rows, cols, squeeze=False).ravel()
+    for ax in axes[n:]:
+        ax.remove()
     pts = res.P * 1e3
     span = float(np.ptp(pts, axis=0).max()) or 1.0
     lo, hi = pts.min(axis=0) - 0.35 * span, pts.max(axis=0) + 0.35 * span  # the moves' region
-    ax.set_xlim(lo[0], hi[0])
-    ax.set_ylim(lo[1], hi[1])
+    changes = mode_changes(res, mode)
+    crossings = crossing_points(res)
+    for ax, (m, inside) in zip(axes[:n], spans.items(), strict=True):
+        ws = workspace_map(robot_mm, m, resolution=241)
+        path = pts if n == 1 else np.where(inside[:, None], pts, np.nan)
+        plot_workspace(ws, path=path, unit="mm", ax=ax, crossings=crossings)
+        if len(changes):
+            ax.plot(changes[:, 0], changes[:, 1], "D", color="black", mec="white", ms=8,
+                    label="working-mode change")
+            ax.legend(loc="lower right", fontsize=8)
+        ax.set_xlim(lo[0], hi[0])
+        ax.set_ylim(lo[1], hi[1])
+        _number_moves(ax, res, inside if n > 1 else np.ones(len(res.t), bool), span)
+        title = (f"Program: {len(res.move_types) or len(res.moves)} moves, cycle "
+                 f"{res.cycle_time_s:.3f} s")
+        if n == 1:
+            ax.set_title(f"{title} (working mode at the start: {mode})", fontsize=10)
+        else:
+            ax.set_title(f"the moves in working mode {m}", fontsize=10)
+    if n > 1:
+        fig.suptitle(f"{title}, in {n} working modes (start: {mode})", fontsize=11)
+    return fig
+
+
+def _number_moves(ax: Any, res: ProgramResult, inside: Array, span: float) -> None:
+    """Each move's number at its middle (of its samples in ``inside``)."""
     placed: list[Array] = []
-    for index in np.unique(res.move_index):
-        P = res.P[res.move_index == index] * 1e3
+    for index in np.unique(res.move_index[inside]):
+        P = res.P[(res.move_index == index) & inside] * 1e3
         at = P[len(P) // 2]
         # a label that would sit on another's (a move back over the same segment, a dwell
         # at a move's end) is moved aside, with a leader line to its move
@@ -295,10 +333,6 @@ def moves_figure(res: ProgramResult, robot_mm: FiveBar, mode: str) -> Figure:
                     bbox={"boxstyle": "circle,pad=0.2", "fc": "black", "alpha": 0.7},
                     arrowprops={"arrowstyle": "-", "color": "black", "lw": 0.6} if near
                     else None)
-    ax.set_title(f"Program: {len(res.move_types) or len(res.moves)} moves, cycle "
-                 f"{res.cycle_time_s:.3f} s "
-                 f"(working mode at the start: {mode})", fontsize=10)
-    return fig
 
 
 def motion_figure(res: ProgramResult) -> Figure:
