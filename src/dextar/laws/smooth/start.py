@@ -121,14 +121,19 @@ class Start:
 
 def filtered(base: Any, rho: float, length: float, n: int = 4001) -> Start:
     """``a(t) = (v2(t) - v2(t - rho)) / rho``, ``v(t) = (s2(t) - s2(t - rho)) / rho`` and
-    ``s`` its integral (``v2, s2`` the second-order law's speed and arc length)."""
+    ``s`` its integral (``v2, s2`` the second-order law's speed and arc length), the law
+    evaluated at ``t`` and at ``t - rho`` (not interpolated between the samples: where
+    ``t - rho`` falls between them, the interpolated speed at the law's end was not zero,
+    and the start's acceleration at its end jumped to zero within the last interval: a
+    jerk growing with the knots, 17 % of time lost to the start at 16k knots)."""
     T2 = float(base.duration)
     t = np.linspace(0.0, T2 + rho, n)
-    s2, v2 = base.evaluate(np.clip(t, 0.0, T2))[:2]
+    both = base.evaluate(np.concatenate([np.clip(t, 0.0, T2), np.clip(t - rho, 0.0, T2)]))
+    s2, v2, sb, vb = both[0][:n], both[1][:n], both[0][n:], both[1][n:]
     s2 = np.where(t > T2, length, s2)
     v2 = np.where(t > T2, 0.0, v2)
-    sb = np.interp(t - rho, t, s2, left=0.0)
-    vb = np.interp(t - rho, t, v2, left=0.0)
+    sb = np.where(t < rho, 0.0, sb)
+    vb = np.where(t < rho, 0.0, vb)
     v = (s2 - sb) / rho
     a = (v2 - vb) / rho
     s = np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) * np.diff(t))])
