@@ -306,21 +306,32 @@ static int newton_matrix(const Prog *p, Newton *nw, const double *Dz, double *di
     for (Py_ssize_t v = 0; v < p->nx; v++)
         if (p->fixed[v])
             diag[v] = 1.0;
+    /* the rows, sorted by interval (see solve): each interval's sum of d a a^T made apart
+     * and added to the band once, so that the band is written in one sweep */
     double corner = 0.0;
-    for (Py_ssize_t r = 0; r < R; r++) {
-        const double *a = p->ra + 6 * r;
-        const double d = Dz[r];
-        const Py_ssize_t base = BLOCK * p->rk[r];
-        for (int i = 0; i < 6; i++) {
-            if (a[i] == 0.0)
-                continue;
-            const Py_ssize_t pi = base + ROW_POS[i];
-            const double da = d * a[i];
-            for (int j = 0; j < 6; j++)
-                AT(L, pi, base + ROW_POS[j]) += da * a[j];
-            U[pi] += da * p->rg[r];
+    for (Py_ssize_t r = 0; r < R;) {
+        const long long k = p->rk[r];
+        const Py_ssize_t base = BLOCK * k;
+        double H[6][6] = {{0.0}}, u[6] = {0.0};
+        for (; r < R && p->rk[r] == k; r++) {
+            const double *a = p->ra + 6 * r;
+            const double d = Dz[r];
+            for (int i = 0; i < 6; i++) {
+                if (a[i] == 0.0)
+                    continue;
+                const double da = d * a[i];
+                for (int j = 0; j < 6; j++)
+                    H[i][j] += da * a[j];
+                u[i] += da * p->rg[r];
+            }
+            corner += d * p->rg[r] * p->rg[r];
         }
-        corner += d * p->rg[r] * p->rg[r];
+        for (int i = 0; i < 6; i++) {
+            const Py_ssize_t pi = base + ROW_POS[i];
+            for (int j = 0; j < 6; j++)
+                AT(L, pi, base + ROW_POS[j]) += H[i][j];
+            U[pi] += u[i];
+        }
     }
     for (Py_ssize_t k = 0; k < p->M; k++)
         for (int q = 0; q < Q; q++) {
@@ -526,6 +537,7 @@ static PyObject *solve(PyObject *self, PyObject *args)
     }
     unsigned char *fixed = NULL;
     Py_ssize_t *bnd = NULL;
+    double *sorted_rows = NULL;
     {
         Py_ssize_t nx = views[0].len / 8, R = rk_view.len / 8;
         Py_ssize_t K = (nx - 1) / D, M = K - 1;
@@ -561,9 +573,34 @@ static PyObject *solve(PyObject *self, PyObject *args)
         for (Py_ssize_t v = 0; v < nx; v++)
             if (!fixed[v] && isfinite(lo[v]))
                 bnd[nu + nl++] = v;
+        /* the rows sorted by interval (a counting sort, stable): the solve's passes over
+         * them then read the knots' states and write the band in order (on a long path,
+         * rows in the order of their kinds swept the band once per kind, out of cache) */
+        sorted_rows = malloc((size_t)R * 9 * sizeof(double) + (size_t)R * sizeof(long long)
+                             + (size_t)(M + 1) * sizeof(Py_ssize_t));
+        if (sorted_rows == NULL) {
+            PyErr_NoMemory();
+            goto done;
+        }
+        double *ra_s = sorted_rows, *rg_s = ra_s + 6 * R, *rb_s = rg_s + R;
+        long long *rk_s = (long long *)(rb_s + R);
+        Py_ssize_t *start = (Py_ssize_t *)(rk_s + R);
+        const double *ra = views[1].buf, *rg = views[2].buf, *rb = views[3].buf;
+        memset(start, 0, (size_t)(M + 1) * sizeof(Py_ssize_t));
+        for (Py_ssize_t r = 0; r < R; r++)
+            start[rk[r] + 1]++;
+        for (Py_ssize_t k = 0; k < M; k++)
+            start[k + 1] += start[k];
+        for (Py_ssize_t r = 0; r < R; r++) {
+            Py_ssize_t i = start[rk[r]]++;
+            memcpy(ra_s + 6 * i, ra + 6 * r, 6 * sizeof(double));
+            rg_s[i] = rg[r];
+            rb_s[i] = rb[r];
+            rk_s[i] = rk[r];
+        }
         Prog p = {M, D * K, nx, BLOCK * M + D, R, nu, nl, R + nu + nl,
-                  views[0].buf, views[1].buf, views[2].buf, views[3].buf, views[4].buf,
-                  views[5].buf, lo, hi, rk, fixed, bnd, bnd + nu};
+                  views[0].buf, ra_s, rg_s, rb_s, views[4].buf,
+                  views[5].buf, lo, hi, rk_s, fixed, bnd, bnd + nu};
         long nit = 0;
         int status = ipm(&p, views[8].buf, views[9].buf, tol, dual_tol, gap_tol, maxiter,
                          &nit);
@@ -573,6 +610,7 @@ static PyObject *solve(PyObject *self, PyObject *args)
 done:
     free(fixed);
     free(bnd);
+    free(sorted_rows);
     PyBuffer_Release(&rk_view);
     release_buffers(views, 10);
     return result;
