@@ -151,13 +151,15 @@ static void ETy_add(const Prog *p, const double *y, double *out)
 static Py_ssize_t xband(Py_ssize_t v) { return BLOCK * (v / D) + PERM[v % D]; }
 
 /* LU factorisation with partial pivoting within the band (rows j .. j + KL at column j),
- * in place: the multipliers below the diagonal, the pivots' rows in piv; -1 when a pivot is
- * zero */
-static int band_lu(double *L, Py_ssize_t n, Py_ssize_t *piv)
+ * in place: the multipliers below the diagonal, the pivots' rows in piv, the last column
+ * of each row of U in ext (as LAPACK's dgbtf2, the updates stop at the last column the
+ * pivots so far can have filled: without a row exchange, the band's own KU); -1 when a
+ * pivot is zero */
+static int band_lu(double *L, Py_ssize_t n, Py_ssize_t *piv, Py_ssize_t *ext)
 {
+    Py_ssize_t ju = 0;
     for (Py_ssize_t j = 0; j < n; j++) {
         Py_ssize_t last = j + KL < n - 1 ? j + KL : n - 1;
-        Py_ssize_t right = j + KL + KU < n - 1 ? j + KL + KU : n - 1;
         Py_ssize_t p = j;
         double best = fabs(AT(L, j, j));
         for (Py_ssize_t i = j + 1; i <= last; i++)
@@ -168,8 +170,12 @@ static int band_lu(double *L, Py_ssize_t n, Py_ssize_t *piv)
         piv[j] = p;
         if (best == 0.0 || !isfinite(best))
             return -1;
+        Py_ssize_t reach = p + KU < n - 1 ? p + KU : n - 1;
+        if (reach > ju)
+            ju = reach;
+        ext[j] = ju;
         if (p != j)
-            for (Py_ssize_t c = j; c <= right; c++) {
+            for (Py_ssize_t c = j; c <= ju; c++) {
                 double t = AT(L, j, c);
                 AT(L, j, c) = AT(L, p, c);
                 AT(L, p, c) = t;
@@ -179,7 +185,7 @@ static int band_lu(double *L, Py_ssize_t n, Py_ssize_t *piv)
             double l = AT(L, i, j) * inv;
             AT(L, i, j) = l;
             if (l != 0.0)
-                for (Py_ssize_t c = j + 1; c <= right; c++)
+                for (Py_ssize_t c = j + 1; c <= ju; c++)
                     AT(L, i, c) -= l * AT(L, j, c);
         }
     }
@@ -187,7 +193,8 @@ static int band_lu(double *L, Py_ssize_t n, Py_ssize_t *piv)
 }
 
 /* b := A^-1 b from band_lu's factors */
-static void band_solve(const double *L, Py_ssize_t n, const Py_ssize_t *piv, double *b)
+static void band_solve(const double *L, Py_ssize_t n, const Py_ssize_t *piv,
+                       const Py_ssize_t *ext, double *b)
 {
     for (Py_ssize_t j = 0; j < n; j++) {
         Py_ssize_t p = piv[j];
@@ -203,9 +210,8 @@ static void band_solve(const double *L, Py_ssize_t n, const Py_ssize_t *piv, dou
                 b[i] -= AT(L, i, j) * bj;
     }
     for (Py_ssize_t j = n - 1; j >= 0; j--) {
-        Py_ssize_t right = j + KL + KU < n - 1 ? j + KL + KU : n - 1;
         double s = b[j];
-        for (Py_ssize_t c = j + 1; c <= right; c++)
+        for (Py_ssize_t c = j + 1; c <= ext[j]; c++)
             s -= AT(L, j, c) * b[c];
         b[j] = s / AT(L, j, j);
     }
@@ -249,7 +255,7 @@ static double dot(const double *a, const double *b, Py_ssize_t n)
 /* One iteration's factorised Newton system and what a step needs. */
 typedef struct {
     double *L, *U, *BU, *full, *rhs, *dx, *dy;
-    Py_ssize_t *piv;
+    Py_ssize_t *piv, *ext;
     double schur;
 } Newton;
 
@@ -272,7 +278,7 @@ static void newton_step(const Prog *p, Newton *nw, const double *Dz, const doubl
     for (Py_ssize_t k = 0; k < p->M; k++)
         for (int q = 0; q < Q; q++)
             nw->full[BLOCK * k + D + q] = -re[k * Q + q];
-    band_solve(nw->L, nb, nw->piv, nw->full);
+    band_solve(nw->L, nb, nw->piv, nw->ext, nw->full);
     double r = nw->rhs[nk] - dot(nw->U, nw->full, nb);
     double dp = r / nw->schur;
     for (Py_ssize_t i = 0; i < nb; i++)
@@ -358,10 +364,10 @@ static int newton_matrix(const Prog *p, Newton *nw, const double *Dz, double *di
         AT(L, pos, pos) += diag[v];
     }
     corner += diag[nk];
-    if (band_lu(L, nb, nw->piv) < 0)
+    if (band_lu(L, nb, nw->piv, nw->ext) < 0)
         return -1;
     memcpy(nw->BU, U, (size_t)nb * sizeof(double));
-    band_solve(L, nb, nw->piv, nw->BU);
+    band_solve(L, nb, nw->piv, nw->ext, nw->BU);
     nw->schur = corner - dot(U, nw->BU, nb);
     return 0;
 }
@@ -378,7 +384,7 @@ static int ipm(Prog *p, const double *x0, double *x, double tol, double dual_tol
      * nb: U, BU, full; the band */
     double *work = malloc(((size_t)7 * m + 5 * nx + 3 * nE + 3 * nb + (size_t)nb * W)
                           * sizeof(double));
-    Py_ssize_t *piv = malloc((size_t)nb * sizeof(Py_ssize_t));
+    Py_ssize_t *piv = malloc((size_t)2 * nb * sizeof(Py_ssize_t));
     if (work == NULL || piv == NULL) {
         free(work);
         free(piv);
@@ -398,6 +404,7 @@ static int ipm(Prog *p, const double *x0, double *x, double tol, double dual_tol
     nw.full = nw.BU + nb;
     nw.L = nw.full + nb;
     nw.piv = piv;
+    nw.ext = piv + nb;
 
     /* the start: x0 (fixed variables at their values), the slacks at least a small margin,
      * the multipliers on the central path of MU0 */
