@@ -210,10 +210,19 @@ static void band_solve(const double *L, Py_ssize_t n, const Py_ssize_t *piv,
                 b[i] -= AT(L, i, j) * bj;
     }
     for (Py_ssize_t j = n - 1; j >= 0; j--) {
-        double s = b[j];
-        for (Py_ssize_t c = j + 1; c <= ext[j]; c++)
-            s -= AT(L, j, c) * b[c];
-        b[j] = s / AT(L, j, j);
+        /* four partial sums: the row's products are not a chain of dependent additions */
+        double s0 = b[j], s1 = 0.0, s2 = 0.0, s3 = 0.0;
+        const double *row = L + j * W - j + KL;  /* row[c] = A(j, c) */
+        Py_ssize_t c = j + 1, e = ext[j];
+        for (; c + 3 <= e; c += 4) {
+            s0 -= row[c] * b[c];
+            s1 -= row[c + 1] * b[c + 1];
+            s2 -= row[c + 2] * b[c + 2];
+            s3 -= row[c + 3] * b[c + 3];
+        }
+        for (; c <= e; c++)
+            s0 -= row[c] * b[c];
+        b[j] = ((s0 + s1) + (s2 + s3)) / row[j];
     }
 }
 
@@ -326,7 +335,7 @@ static int newton_matrix(const Prog *p, Newton *nw, const double *Dz, double *di
                 if (a[i] == 0.0)
                     continue;
                 const double da = d * a[i];
-                for (int j = 0; j < 6; j++)
+                for (int j = i; j < 6; j++)  /* (the upper triangle: H is symmetric) */
                     H[i][j] += da * a[j];
                 u[i] += da * p->rg[r];
             }
@@ -335,7 +344,7 @@ static int newton_matrix(const Prog *p, Newton *nw, const double *Dz, double *di
         for (int i = 0; i < 6; i++) {
             const Py_ssize_t pi = base + ROW_POS[i];
             for (int j = 0; j < 6; j++)
-                AT(L, pi, base + ROW_POS[j]) += H[i][j];
+                AT(L, pi, base + ROW_POS[j]) += j >= i ? H[i][j] : H[j][i];
             U[pi] += u[i];
         }
     }
