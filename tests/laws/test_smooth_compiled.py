@@ -1,6 +1,7 @@
 """The jerk-limited law's compiled interior point (``laws/smooth/_ipm.c``) against the numpy
 solver it replaces where it was built (the same programmes, the same answers to their
-tolerances, the same laws), and the start's end at rest whatever the number of knots."""
+tolerances, the same laws), the start's jerks whatever the number of knots, and the start's
+timing in two evaluations of the rows."""
 
 import signal
 from types import SimpleNamespace
@@ -171,19 +172,10 @@ def line_start():
     return along, tab, cons, solve._start(along, tab, second, third, base, None)
 
 
-def test_the_start_ends_at_rest(line_start):
-    """The filtered start's acceleration is zero at both ends (the law evaluated at
-    ``t - rho``, not interpolated between samples, where its speed at the end was not)."""
-    *_, st = line_start
-    a = np.abs(st.a)
-    assert a[0] <= 1e-12 * a.max() and a[-1] <= 1e-12 * a.max()
-    assert a[len(a) // 8] > 0.1 * a.max()  # (a motion that accelerates)
-
-
 def test_the_start_jerks_do_not_grow_with_the_knots(line_start):
-    """The start's largest jerk on 16000 knots within 1 % of that on 1000 (an end
-    acceleration left by the start jumped to zero within the last interval: a jerk growing
-    as the knots, 61 % over at 16000, and the start 17 % slower)."""
+    """The start's largest jerk on 16000 knots within 1 % of that on 1000 (the start's last
+    sample's acceleration, not quite zero, jumped to zero within the last interval: a jerk
+    growing as the knots, 61 % over at 16000, and the start 17 % slower)."""
     along, tab, cons, st = line_start
     jmax = []
     for n in (1000, 16000):
