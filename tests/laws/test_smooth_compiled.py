@@ -1,7 +1,6 @@
 """The jerk-limited law's compiled interior point (``laws/smooth/_ipm.c``) against the numpy
 solver it replaces where it was built (the same programmes, the same answers to their
-tolerances, the same laws), the start's jerks whatever the number of knots, and the start's
-timing in two evaluations of the rows."""
+tolerances, the same laws), and the start's jerks whatever the number of knots."""
 
 import signal
 from types import SimpleNamespace
@@ -183,23 +182,3 @@ def test_the_start_jerks_do_not_grow_with_the_knots(line_start):
         jmax.append(np.abs(start.start_jerks(st, me, along.length)).max())
     assert jmax[1] <= 1.01 * jmax[0]
 
-
-def test_a_start_beyond_its_rows_is_timed_in_two_evaluations(line_start, monkeypatch):
-    """The line's start (its rows 1 % beyond their limits on the mesh) is slowed by the
-    rows' own factor: within its rows and less than 1e-3 inside the binding one, after two
-    evaluations of the rows (a stretch of 1.5 first took four)."""
-    along, tab, cons, st = line_start
-    me = start.pinned(start.fractions(st, tab, cons, 32, solve.KNOT_TOL), st, tab.joints)
-    model = rows.RowModel(me, tab, [c for c in cons if c.order == 2],
-                          [c for c in cons if c.order == 3], along.length)
-    J = start.start_jerks(st, me, along.length)
-    Tk0 = np.full(me.M, st.T)
-    assert model.rows(mesh.motion(me, J, Tk0, along.length)).F.max() > 0.005
-    calls = []
-    real = rows.RowModel.rows
-    monkeypatch.setattr(rows.RowModel, "rows",
-                        lambda self, *a, **kw: calls.append(1) or real(self, *a, **kw))
-    Tk = slp.time_scaled(model, J, Tk0)
-    worst = real(model, mesh.motion(me, J, Tk, along.length)).F.max()
-    assert -1e-3 < worst <= 0.0
-    assert len(calls) == 2

@@ -263,11 +263,8 @@ def time_scaled(model: RowModel, J: Array, Tk: Array) -> Array:
     that is slower than the limits allow is sped up, one beyond them slowed down), all
     scaled alike: each row's use scales about as ``T^-p`` (:meth:`Rows.powers`); exact
     where it does, so a few rounds, then stretching while a row is still beyond its limit
-    (gravity or friction rows that scale more slowly): a motion beyond its rows is slowed
-    by their own factor first (exact for most rows: two rounds where the half-way
-    stretch of 1.5 took four), by at least 1.5 where it still is after that."""
+    (gravity or friction rows that scale more slowly)."""
     Tk = np.asarray(Tk, float)
-    over = 0
     for _ in range(40):
         rows = model.rows(motion(model.mesh, J, Tk, model.length), gradients=False)
         i = int(np.argmax(rows.F))
@@ -281,9 +278,7 @@ def time_scaled(model: RowModel, J: Array, Tk: Array) -> Array:
         if worst > 0.0:
             if p[i] == 0:
                 break  # a row the duration does not change
-            over += 1
-            if over > 1:  # (the rows did not scale as their powers say)
-                factor = max(factor, 1.5)
+            factor = max(factor, 1.5)
         Tk = Tk * (factor * (1 + 1e-4))
     return Tk
 
