@@ -97,6 +97,40 @@ static void G(const Prog *p, const double *x, double *out)
         out[p->R + p->nu + i] = -x[p->il[i]];
 }
 
+/* G(x) into gx and GT(z) into out in one pass over the rows */
+static void G_GT(const Prog *p, const double *x, double *gx, const double *z, double *out)
+{
+    memset(out, 0, p->nx * sizeof(double));
+    const double xb = x[p->nk];
+    double b = 0.0;
+    for (Py_ssize_t r = 0; r < p->R; r++) {
+        const double *a = p->ra + 6 * r;
+        const Py_ssize_t o = D * p->rk[r];
+        const double *xs = x + o;
+        double *os = out + o;
+        const double zr = z[r];
+        double s = p->rg[r] * xb;
+        for (int j = 0; j < 6; j++) {
+            s += a[j] * xs[ROW_X[j]];
+            os[ROW_X[j]] += a[j] * zr;
+        }
+        gx[r] = s;
+        b += p->rg[r] * zr;
+    }
+    out[p->nk] += b;
+    for (Py_ssize_t i = 0; i < p->nu; i++) {
+        gx[p->R + i] = x[p->iu[i]];
+        out[p->iu[i]] += z[p->R + i];
+    }
+    for (Py_ssize_t i = 0; i < p->nl; i++) {
+        gx[p->R + p->nu + i] = -x[p->il[i]];
+        out[p->il[i]] -= z[p->R + p->nu + i];
+    }
+    for (Py_ssize_t i = 0; i < p->nx; i++)
+        if (p->fixed[i])
+            out[i] = 0.0;
+}
+
 /* sum z g over the inequalities (the fixed variables' entries zero) */
 static void GT(const Prog *p, const double *z, double *out)
 {
@@ -226,6 +260,47 @@ static void band_solve(const double *L, Py_ssize_t n, const Py_ssize_t *piv,
     }
 }
 
+/* b := A^-1 b and c := A^-1 c in one sweep over the factors (band_solve twice) */
+static void band_solve2(const double *L, Py_ssize_t n, const Py_ssize_t *piv,
+                        const Py_ssize_t *ext, double *b, double *c)
+{
+    for (Py_ssize_t j = 0; j < n; j++) {
+        Py_ssize_t p = piv[j];
+        if (p != j) {
+            double t = b[j];
+            b[j] = b[p];
+            b[p] = t;
+            t = c[j];
+            c[j] = c[p];
+            c[p] = t;
+        }
+        const double bj = b[j], cj = c[j];
+        Py_ssize_t last = j + KL < n - 1 ? j + KL : n - 1;
+        for (Py_ssize_t i = j + 1; i <= last; i++) {
+            const double l = AT(L, i, j);
+            b[i] -= l * bj;
+            c[i] -= l * cj;
+        }
+    }
+    for (Py_ssize_t j = n - 1; j >= 0; j--) {
+        double s0 = b[j], s1 = 0.0, t0 = c[j], t1 = 0.0;
+        const double *row = L + j * W - j + KL;
+        Py_ssize_t k = j + 1, e = ext[j];
+        for (; k + 1 <= e; k += 2) {
+            s0 -= row[k] * b[k];
+            s1 -= row[k + 1] * b[k + 1];
+            t0 -= row[k] * c[k];
+            t1 -= row[k + 1] * c[k + 1];
+        }
+        for (; k <= e; k++) {
+            s0 -= row[k] * b[k];
+            t0 -= row[k] * c[k];
+        }
+        b[j] = (s0 + s1) / row[j];
+        c[j] = (t0 + t1) / row[j];
+    }
+}
+
 /* the largest a with v + a dv >= 0 (inf when none is limited) */
 static double to_bound(const double *v, const double *dv, Py_ssize_t n)
 {
@@ -265,16 +340,18 @@ static double dot(const double *a, const double *b, Py_ssize_t n)
 typedef struct {
     double *L, *U, *BU, *full, *rhs, *dx, *dy;
     Py_ssize_t *piv, *ext;
-    double schur;
+    double corner, schur;
 } Newton;
 
 /* The step (dx, dy, dz, ds) for the complementarity targets s z + ds z + s dz = -cc of
- * every inequality (banded._Newton.step); ds holds t = rp - cc / z on the way. */
-static void newton_step(const Prog *p, Newton *nw, const double *Dz, const double *rd,
-                        const double *rp, const double *re, const double *z,
-                        const double *s, const double *cc, double *dz, double *ds)
+ * every inequality (banded._Newton.step), in two halves around the band's solve:
+ * step_rhs makes its right-hand side in nw->full (ds holds t = rp - cc / z on the way),
+ * step_end takes the band's solution there to the step. */
+static void step_rhs(const Prog *p, Newton *nw, const double *Dz, const double *rd,
+                     const double *rp, const double *re, const double *z, const double *cc,
+                     double *dz, double *ds)
 {
-    const Py_ssize_t m = p->m, nk = p->nk, nb = p->nb;
+    const Py_ssize_t m = p->m, nk = p->nk;
     for (Py_ssize_t i = 0; i < m; i++) {
         ds[i] = rp[i] - cc[i] / z[i];
         dz[i] = Dz[i] * ds[i];
@@ -287,7 +364,12 @@ static void newton_step(const Prog *p, Newton *nw, const double *Dz, const doubl
     for (Py_ssize_t k = 0; k < p->M; k++)
         for (int q = 0; q < Q; q++)
             nw->full[BLOCK * k + D + q] = -re[k * Q + q];
-    band_solve(nw->L, nb, nw->piv, nw->ext, nw->full);
+}
+
+static void step_end(const Prog *p, Newton *nw, const double *Dz, const double *z,
+                     const double *s, const double *cc, double *dz, double *ds)
+{
+    const Py_ssize_t m = p->m, nk = p->nk, nb = p->nb;
     double r = nw->rhs[nk] - dot(nw->U, nw->full, nb);
     double dp = r / nw->schur;
     for (Py_ssize_t i = 0; i < nb; i++)
@@ -305,7 +387,8 @@ static void newton_step(const Prog *p, Newton *nw, const double *Dz, const doubl
     }
 }
 
-/* Assemble and factorise the Newton matrix at the barrier terms Dz; -1 when singular. */
+/* Assemble and factorise the Newton matrix at the barrier terms Dz (the border's column in
+ * U, its corner in corner); -1 when singular. */
 static int newton_matrix(const Prog *p, Newton *nw, const double *Dz, double *diag)
 {
     const Py_ssize_t nb = p->nb, nk = p->nk, R = p->R;
@@ -372,13 +455,8 @@ static int newton_matrix(const Prog *p, Newton *nw, const double *Dz, double *di
         }
         AT(L, pos, pos) += diag[v];
     }
-    corner += diag[nk];
-    if (band_lu(L, nb, nw->piv, nw->ext) < 0)
-        return -1;
-    memcpy(nw->BU, U, (size_t)nb * sizeof(double));
-    band_solve(L, nb, nw->piv, nw->ext, nw->BU);
-    nw->schur = corner - dot(U, nw->BU, nb);
-    return 0;
+    nw->corner = corner + diag[nk];
+    return band_lu(L, nb, nw->piv, nw->ext);
 }
 
 /* The solve (see the file's doc); -1 (a Python error set) when interrupted or out of
@@ -446,11 +524,10 @@ static int ipm(Prog *p, const double *x0, double *x, double tol, double dual_tol
         }
         int singular = 0, done = 0;
         Py_BEGIN_ALLOW_THREADS
-        GT(p, z, rd);
+        G_GT(p, x, rp, z, rd);
         for (Py_ssize_t v = 0; v < nx; v++)
             rd[v] += p->c[v];
         ETy_add(p, y, rd);
-        G(p, x, rp);
         for (Py_ssize_t i = 0; i < m; i++)
             rp[i] += sl[i] - h_of(p, i);
         Ex(p, x, re);
@@ -478,7 +555,13 @@ static int ipm(Prog *p, const double *x0, double *x, double tol, double dual_tol
                 /* the predictor (affine) step, then the corrector's targets */
                 for (Py_ssize_t i = 0; i < m; i++)
                     cc[i] = sl[i] * z[i];
-                newton_step(p, &nw, Dz, rd, rp, re, z, sl, cc, dz, ds);
+                step_rhs(p, &nw, Dz, rd, rp, re, z, cc, dz, ds);
+                /* the border's solve and the predictor's in one sweep, then the Schur
+                 * complement of the border */
+                memcpy(nw.BU, nw.U, (size_t)nb * sizeof(double));
+                band_solve2(nw.L, nb, nw.piv, nw.ext, nw.BU, nw.full);
+                nw.schur = nw.corner - dot(nw.U, nw.BU, nb);
+                step_end(p, &nw, Dz, z, sl, cc, dz, ds);
                 double ap = fmin(1.0, to_bound(sl, ds, m));
                 double ad = fmin(1.0, to_bound(z, dz, m));
                 double mu_aff = 0.0;
@@ -489,7 +572,9 @@ static int ipm(Prog *p, const double *x0, double *x, double tol, double dual_tol
                 double target = sigma * sigma * sigma * mu;
                 for (Py_ssize_t i = 0; i < m; i++)
                     cc[i] = sl[i] * z[i] + ds[i] * dz[i] - target;
-                newton_step(p, &nw, Dz, rd, rp, re, z, sl, cc, dz, ds);
+                step_rhs(p, &nw, Dz, rd, rp, re, z, cc, dz, ds);
+                band_solve(nw.L, nb, nw.piv, nw.ext, nw.full);
+                step_end(p, &nw, Dz, z, sl, cc, dz, ds);
                 ap = fmin(1.0, ETA * to_bound(sl, ds, m));
                 ad = fmin(1.0, ETA * to_bound(z, dz, m));
                 for (Py_ssize_t v = 0; v < nx; v++)
