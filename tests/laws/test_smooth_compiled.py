@@ -90,6 +90,7 @@ def test_the_compiled_interior_point_meets_the_programme(setup, monkeypatch):  #
     assert bad.status == 2
 
 
+@pytest.mark.slow
 def test_a_signal_ends_the_compiled_interior_point(line_start, monkeypatch):
     """A signal's handler runs between the compiled iterations: the exception it raised 10 ms
     into a programme of 3000 knots ends the solve in a fraction of the solve's CPU time (not
@@ -135,6 +136,7 @@ def test_a_signal_ends_the_compiled_interior_point(line_start, monkeypatch):
     assert stopped < 0.5 * full, (stopped, full)
 
 
+@pytest.mark.slow
 def test_the_law_is_the_same_with_either_solver(chain, monkeypatch):  # noqa: F811
     """The blended chain's law with the compiled and the numpy interior point: both within
     the limits, the same duration to 1e-3 (the programmes agree to their tolerances, but the
