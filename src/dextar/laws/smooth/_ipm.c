@@ -393,8 +393,6 @@ static int newton_matrix(const Prog *p, Newton *nw, const double *Dz, double *di
 {
     const Py_ssize_t nb = p->nb, nk = p->nk, R = p->R;
     double *L = nw->L, *U = nw->U;
-    memset(L, 0, (size_t)nb * W * sizeof(double));
-    memset(U, 0, (size_t)nb * sizeof(double));
     for (Py_ssize_t v = 0; v < p->nx; v++)
         diag[v] = REG;
     for (Py_ssize_t i = 0; i < p->nu; i++)
@@ -404,13 +402,16 @@ static int newton_matrix(const Prog *p, Newton *nw, const double *Dz, double *di
     for (Py_ssize_t v = 0; v < p->nx; v++)
         if (p->fixed[v])
             diag[v] = 1.0;
-    /* the rows, sorted by interval (see solve): each interval's sum of d a a^T made apart
-     * and added to the band once, so that the band is written in one sweep */
+    /* block by block (knot k's states and interval k's equalities: band rows 7k ..), each
+     * block's rows made whole while they are in cache (no pass over the band per kind of
+     * term): the sums of d a a^T of the rows of intervals k - 1 and k (the rows sorted by
+     * interval, see solve), the equalities of both intervals, the diagonal, the fixed
+     * variables' rows */
     double corner = 0.0;
-    for (Py_ssize_t r = 0; r < R;) {
-        const long long k = p->rk[r];
-        const Py_ssize_t base = BLOCK * k;
-        double H[6][6] = {{0.0}}, u[6] = {0.0};
+    double Hp[6][6] = {{0.0}}, up[6] = {0.0};  /* interval k - 1's sums */
+    Py_ssize_t r = 0;
+    for (Py_ssize_t k = 0; k <= p->M; k++) {
+        double Hc[6][6] = {{0.0}}, uc[6] = {0.0};
         for (; r < R && p->rk[r] == k; r++) {
             const double *a = p->ra + 6 * r;
             const double d = Dz[r];
@@ -419,41 +420,69 @@ static int newton_matrix(const Prog *p, Newton *nw, const double *Dz, double *di
                     continue;
                 const double da = d * a[i];
                 for (int j = i; j < 6; j++)  /* (the upper triangle: H is symmetric) */
-                    H[i][j] += da * a[j];
-                u[i] += da * p->rg[r];
+                    Hc[i][j] += da * a[j];
+                uc[i] += da * p->rg[r];
             }
             corner += d * p->rg[r] * p->rg[r];
         }
-        for (int i = 0; i < 6; i++) {
-            const Py_ssize_t pi = base + ROW_POS[i];
+        const Py_ssize_t b0 = BLOCK * k, bp = b0 - BLOCK;
+        const Py_ssize_t here = k < p->M ? BLOCK : D;
+        memset(L + b0 * W, 0, (size_t)here * W * sizeof(double));
+        memset(U + b0, 0, (size_t)here * sizeof(double));
+        for (int i = 0; i < 6; i++) {  /* interval k's rows on knot k's states */
+            if (ROW_POS[i] >= BLOCK)
+                continue;
+            const Py_ssize_t pi = b0 + ROW_POS[i];
             for (int j = 0; j < 6; j++)
-                AT(L, pi, base + ROW_POS[j]) += j >= i ? H[i][j] : H[j][i];
-            U[pi] += u[i];
+                AT(L, pi, b0 + ROW_POS[j]) += j >= i ? Hc[i][j] : Hc[j][i];
+            U[pi] += uc[i];
         }
-    }
-    for (Py_ssize_t k = 0; k < p->M; k++)
-        for (int q = 0; q < Q; q++) {
-            const Py_ssize_t i = BLOCK * k + D + q;
-            const double *Ek = p->E + (k * Q + q) * 2 * D;
-            for (int a = 0; a < 2 * D; a++) {
-                if (p->fixed[D * k + a])
+        if (k > 0)
+            for (int i = 0; i < 6; i++) {  /* interval k - 1's rows on knot k's states */
+                if (ROW_POS[i] < BLOCK)
                     continue;
-                const Py_ssize_t j = BLOCK * k + EQ_POS[a];
-                AT(L, j, i) += Ek[a];
-                AT(L, i, j) += Ek[a];
+                const Py_ssize_t pi = bp + ROW_POS[i];
+                for (int j = 0; j < 6; j++)
+                    AT(L, pi, bp + ROW_POS[j]) += j >= i ? Hp[i][j] : Hp[j][i];
+                U[pi] += up[i];
             }
-            AT(L, i, i) -= REG;
+        if (k < p->M)  /* interval k's equalities, and their columns on knot k's states */
+            for (int q = 0; q < Q; q++) {
+                const Py_ssize_t i = b0 + D + q;
+                const double *Ek = p->E + (k * Q + q) * 2 * D;
+                for (int a = 0; a < 2 * D; a++) {
+                    if (p->fixed[D * k + a])
+                        continue;
+                    const Py_ssize_t j = b0 + EQ_POS[a];
+                    AT(L, i, j) += Ek[a];
+                    if (EQ_POS[a] < BLOCK)
+                        AT(L, j, i) += Ek[a];
+                }
+                AT(L, i, i) -= REG;
+            }
+        if (k > 0)  /* interval k - 1's equalities' columns on knot k's states */
+            for (int q = 0; q < Q; q++) {
+                const Py_ssize_t i = bp + D + q;
+                const double *Ek = p->E + ((k - 1) * Q + q) * 2 * D;
+                for (int a = D; a < 2 * D; a++) {
+                    if (p->fixed[D * (k - 1) + a])
+                        continue;
+                    AT(L, bp + EQ_POS[a], i) += Ek[a];
+                }
+            }
+        for (int st = 0; st < D; st++) {  /* knot k's states: the diagonal, fixed rows */
+            const Py_ssize_t v = D * k + st, pos = b0 + PERM[st];
+            if (p->fixed[v]) {  /* the fixed variable's row: the identity's */
+                Py_ssize_t c0 = pos - KL > 0 ? pos - KL : 0;
+                Py_ssize_t c1 = pos + KU < nb - 1 ? pos + KU : nb - 1;
+                for (Py_ssize_t c = c0; c <= c1; c++)
+                    AT(L, pos, c) = 0.0;
+                U[pos] = 0.0;
+            }
+            AT(L, pos, pos) += diag[v];
         }
-    for (Py_ssize_t v = 0; v < nk; v++) {
-        const Py_ssize_t pos = xband(v);
-        if (p->fixed[v]) {  /* the fixed variable's row: the identity's */
-            Py_ssize_t c0 = pos - KL > 0 ? pos - KL : 0;
-            Py_ssize_t c1 = pos + KU < nb - 1 ? pos + KU : nb - 1;
-            for (Py_ssize_t c = c0; c <= c1; c++)
-                AT(L, pos, c) = 0.0;
-            U[pos] = 0.0;
-        }
-        AT(L, pos, pos) += diag[v];
+        memcpy(Hp, Hc, sizeof Hp);
+        memcpy(up, uc, sizeof up);
     }
     nw->corner = corner + diag[nk];
     return band_lu(L, nb, nw->piv, nw->ext);
