@@ -334,6 +334,13 @@ def section_scaling(repeats: int = 3) -> None:
         print(f"    {a['M']} -> {b['M']}: time M^{pt:.2f} (medians M^{pmed:.2f}; M log M: "
               f"M^{mlogm:.2f}: {'met' if pt <= mlogm + 0.05 else 'NOT met'}), per programme "
               f"M^{pp:.2f}, memory M^{pm:.2f}")
+    a, b = rows[0], rows[-1]
+    lm = np.log(b["M"] / a["M"])
+    mlogm = np.log(b["M"] * np.log(b["M"]) / (a["M"] * np.log(a["M"]))) / lm
+    pt = np.log(b["cpu"] / a["cpu"]) / lm
+    pmed = np.log(b["cpu_median"] / a["cpu_median"]) / lm
+    print(f"    over all sizes, {a['M']} -> {b['M']}: time M^{pt:.2f} (medians M^{pmed:.2f}; "
+          f"M log M: M^{mlogm:.2f}: {'met' if pt <= mlogm + 0.05 else 'NOT met'})")
     last = rows[-1]
     print(f"  peak memory at {last['M']} knots {last['peak_max']:.0f} MB (the largest of the "
           f"runs; floor 200 MB: {'met' if last['peak_max'] <= 200 else 'NOT met'})")
