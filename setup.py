@@ -6,7 +6,10 @@ pyproject.toml:
   (benchmarks/bench_dynamics.py);
 * the time-optimal law's reachability analysis (src/dextar/laws/_reach.c) of
   dextar.laws.time_optimal: without it the Python passes, the same law to the last bit,
-  slower (benchmarks/bench_time_optimal.py).
+  slower (benchmarks/bench_time_optimal.py);
+* the jerk-limited law's banded interior point (src/dextar/laws/smooth/_ipm.c) of
+  dextar.laws.smooth.banded: without it the numpy solver, the same solutions to the
+  programmes' tolerances, slower (benchmarks/bench_smooth.py).
 
 The extensions are optional: an install without a C compiler goes on without them. No
 contraction into fused multiply-adds: the same results on every instruction set.
@@ -23,4 +26,6 @@ SHARED = ["src/dextar/_buffers.h"]
 setup(ext_modules=[Extension("dextar.dynamics._kernel", ["src/dextar/dynamics/_kernel.c"],
                              depends=SHARED, optional=True, extra_compile_args=FLAGS),
                    Extension("dextar.laws._reach", ["src/dextar/laws/_reach.c"],
+                             depends=SHARED, optional=True, extra_compile_args=FLAGS),
+                   Extension("dextar.laws.smooth._ipm", ["src/dextar/laws/smooth/_ipm.c"],
                              depends=SHARED, optional=True, extra_compile_args=FLAGS)])

@@ -15,10 +15,14 @@ Floors (issue 29):
 * the issue's eight-move program (examples/jerk_pick_place.toml) planned in under 1 s; the
   issue's other programs plan (or name the user's limit) in seconds;
 * at M = 1k, 4k and 16k knots: peak memory at most 200 MB at 16k, time growing no faster
-  than M log M (each size in a new process; its peak resident memory above the process's
-  after a warm-up, its CPU time); one programme of about 1000 knots solved by the banded
-  interior point and by HiGHS (scipy's linprog, dual simplex and IPX) on the same rows,
-  which is why the programmes have their own solver.
+  than M log M (the CPU time's exponent between sizes at most M log M's + 0.05; each size
+  in a new process, three times; its peak resident memory above the process's after a
+  warm-up, its CPU time); one programme of about 1000 knots solved by the banded
+  interior point (compiled where built) and by HiGHS (scipy's linprog, dual simplex and
+  IPX) on the same rows, which is why the programmes have their own solver.
+
+The moves section also times the jerk-limited law with the numpy interior point (an install
+without a C compiler: laws/smooth/_ipm.c not built).
 """
 
 from __future__ import annotations
@@ -119,11 +123,14 @@ def section_moves(rounds: int = 15) -> None:
     assert limits is not None
     print(f"planning time per pick-and-place move (the law alone; {rounds} interleaved rounds, "
           f"CPU time best [median]; load {load()}):")
+    from dextar.laws.smooth import banded
+
     compiled = exact.USE_COMPILED, time_optimal.USE_COMPILED
+    ipm = banded.USE_COMPILED
     for a, b in (((-0.04, 0.11), (-0.04, 0.09)), ((0.04, 0.09), (0.04, 0.11))):
         mv = RobotAlongPath(sc.si_model, Line(a, b), sc.mode)
         solve_jerk_limited_law(mv, motors=jerky(limits), grid=400)  # (warm)
-        t2s, t22, t3s = [], [], []
+        t2s, t22, t3s, t3n = [], [], [], []
         for _ in range(rounds):  # a round each: the machine's load falls on all alike
             t0 = time.process_time()
             l2 = solve_time_optimal_law(mv, motors=limits, grid=400)
@@ -133,9 +140,14 @@ def section_moves(rounds: int = 15) -> None:
             exact.USE_COMPILED, time_optimal.USE_COMPILED = compiled
             t2 = time.process_time()
             l3 = solve_jerk_limited_law(mv, motors=jerky(limits), grid=400)
+            t3 = time.process_time()
+            banded.USE_COMPILED = False  # (the numpy interior point)
+            solve_jerk_limited_law(mv, motors=jerky(limits), grid=400)
+            banded.USE_COMPILED = ipm
+            t3n.append(time.process_time() - t3)
             t2s.append(t1 - t0)
             t22.append(t2 - t1)
-            t3s.append(time.process_time() - t2)
+            t3s.append(t3 - t2)
         assert abs(ref.duration - l2.duration) <= 1e-9 * l2.duration
         now = float(np.median(np.array(t3s) / np.array(t2s)))
         old = float(np.median(np.array(t3s) / np.array(t22)))
@@ -145,7 +157,10 @@ def section_moves(rounds: int = 15) -> None:
               f"    second order now {min(t2s) * 1e3:.1f} ms [{np.median(t2s) * 1e3:.1f}]: "
               f"{now:.2f}x (floor 2x: {'met' if now <= 2 else 'NOT met'}); as issue 22 "
               f"measured it {min(t22) * 1e3:.1f} ms [{np.median(t22) * 1e3:.1f}]: {old:.2f}x "
-              f"(floor 3x: {'met' if old <= 3 else 'NOT met'})")
+              f"(floor 3x: {'met' if old <= 3 else 'NOT met'})\n"
+              f"    jerk-limited with the numpy interior point {min(t3n) * 1e3:.1f} ms "
+              f"[{np.median(t3n) * 1e3:.1f}]: {np.median(np.array(t3n) / np.array(t2s)):.2f}x "
+              f"today's second order")
 
 
 def program_text(moves: str, extra: str = "", jerk: bool = True) -> str:
@@ -287,36 +302,54 @@ def highs(lp, x0) -> dict[str, float]:
     return out
 
 
-def section_scaling() -> None:
+def section_scaling(repeats: int = 3) -> None:
     print(f"scaling: the pick-and-place line {MOVE} m with at least M intervals (each size in "
-          f"a new process; load {load()} at the start):")
+          f"a new process, {repeats} times, interleaved; CPU time best [median]; load "
+          f"{load()} at the start):")
+    runs: dict[int, list[dict[str, float]]] = {n: [] for n in SIZES}
+    for _ in range(repeats):
+        for n in SIZES:
+            p = subprocess.run([sys.executable, __file__, "--one-size", str(n)], check=True,
+                               capture_output=True, text=True)
+            runs[n].append(json.loads(p.stdout.splitlines()[-1]))
     rows = []
     for n in SIZES:
-        p = subprocess.run([sys.executable, __file__, "--one-size", str(n)], check=True,
-                           capture_output=True, text=True)
-        rows.append(json.loads(p.stdout.splitlines()[-1]))
-    print("       M  CPU s  wall s  programmes  CPU s/programme  peak MB  duration s")
+        best = min(runs[n], key=lambda r: r["cpu"])
+        rows.append(dict(best, cpu_median=float(np.median([r["cpu"] for r in runs[n]])),
+                         peak_max=max(r["peak_MB"] for r in runs[n])))
+    print("       M  CPU s [median]  wall s  programmes  CPU s/programme  peak MB  duration s")
     for r in rows:
-        print(f"  {r['M']:6d} {r['cpu']:6.2f} {r['wall']:7.2f} {r['programmes']:11d} "
-              f"{r['cpu'] / r['programmes']:16.3f} {r['peak_MB']:8.1f}  {r['duration']:.7f}")
-    print("  growth (exponent p of M^p between sizes; M log M is about 1.1-1.2 here):")
+        print(f"  {r['M']:6d} {r['cpu']:6.2f} [{r['cpu_median']:6.2f}] {r['wall']:7.2f} "
+              f"{r['programmes']:11d} {r['cpu'] / r['programmes']:16.3f} "
+              f"{r['peak_max']:8.1f}  {r['duration']:.7f}")
+    print("  growth (exponent p of M^p between sizes, best CPU times; floor: the time's "
+          "exponent at most M log M's + 0.05, the spread of repeated runs under load):")
     for a, b in zip(rows, rows[1:], strict=False):
         lm = np.log(b["M"] / a["M"])
         mlogm = np.log(b["M"] * np.log(b["M"]) / (a["M"] * np.log(a["M"]))) / lm
         pt = np.log(b["cpu"] / a["cpu"]) / lm
+        pmed = np.log(b["cpu_median"] / a["cpu_median"]) / lm
         pp = np.log((b["cpu"] / b["programmes"]) / (a["cpu"] / a["programmes"])) / lm
         pm = np.log(b["peak_MB"] / a["peak_MB"]) / lm
-        print(f"    {a['M']} -> {b['M']}: time M^{pt:.2f}, per programme M^{pp:.2f} (M log M: "
-              f"M^{mlogm:.2f}; {'met' if pp <= mlogm + 0.05 else 'NOT met'} per programme), "
-              f"memory M^{pm:.2f}")
+        print(f"    {a['M']} -> {b['M']}: time M^{pt:.2f} (medians M^{pmed:.2f}; M log M: "
+              f"M^{mlogm:.2f}: {'met' if pt <= mlogm + 0.05 else 'NOT met'}), per programme "
+              f"M^{pp:.2f}, memory M^{pm:.2f}")
+    a, b = rows[0], rows[-1]
+    lm = np.log(b["M"] / a["M"])
+    mlogm = np.log(b["M"] * np.log(b["M"]) / (a["M"] * np.log(a["M"]))) / lm
+    pt = np.log(b["cpu"] / a["cpu"]) / lm
+    pmed = np.log(b["cpu_median"] / a["cpu_median"]) / lm
+    print(f"    over all sizes, {a['M']} -> {b['M']}: time M^{pt:.2f} (medians M^{pmed:.2f}; "
+          f"M log M: M^{mlogm:.2f}: {'met' if pt <= mlogm + 0.05 else 'NOT met'})")
     last = rows[-1]
-    print(f"  peak memory at {last['M']} knots {last['peak_MB']:.0f} MB (floor 200 MB: "
-          f"{'met' if last['peak_MB'] <= 200 else 'NOT met'})")
+    print(f"  peak memory at {last['M']} knots {last['peak_max']:.0f} MB (the largest of the "
+          f"runs; floor 200 MB: {'met' if last['peak_max'] <= 200 else 'NOT met'})")
     h = rows[0]
-    print(f"  one programme of {h['lp_M']} knots, {h['lp_rows']} rows: banded interior point "
-          f"{h['banded']:.3f} s, HiGHS dual simplex {h['highs-ds']:.3f} s, HiGHS IPX "
-          f"{h['highs-ipm']:.3f} s (CPU; objectives {h['banded_fun']:.9f}, "
-          f"{h['highs-ds_fun']:.9f}, {h['highs-ipm_fun']:.9f})")
+    if "banded" in h:
+        print(f"  one programme of {h['lp_M']} knots, {h['lp_rows']} rows: banded interior "
+              f"point {h['banded']:.3f} s, HiGHS dual simplex {h['highs-ds']:.3f} s, HiGHS "
+              f"IPX {h['highs-ipm']:.3f} s (CPU; objectives {h['banded_fun']:.9f}, "
+              f"{h['highs-ds_fun']:.9f}, {h['highs-ipm_fun']:.9f})")
 
 
 SECTIONS = {"ruckig": section_ruckig, "convergence": section_convergence,

@@ -32,7 +32,8 @@ modules, in the order of the solve:
   within a trust region; its variables are the states at the knots, ``T`` and the slack,
   its equalities the exact integration, so it is banded.
 * :mod:`.banded`: the programmes' solver, a primal-dual interior point whose Newton systems
-  are a band bordered by two columns: memory and work linear in the knots.
+  are a band bordered by one column: memory and work linear in the knots; compiled where
+  the install built it (``_ipm.c``), numpy and LAPACK's banded LU otherwise.
 * :mod:`.check`: the law sampled (nine points in every interval) through the exact model;
   an interval in which a limit is exceeded by more than its tolerance (``tol``: torque,
   speed, acceleration; ``rate_tol``: jerk and torque rate, whose ratio is a finite

@@ -25,6 +25,13 @@ the comparison); the border's two dense columns (every row has the duration and 
 are what a general sparse solver handles poorly and a bordered band handles exactly. The
 loop returns to Python at every iteration (tens of milliseconds at 16k knots), so that an
 interrupt acts at once.
+
+Compiled (``_ipm.c``, built by pip where a C compiler is; :data:`USE_COMPILED`): the same
+method, start, steps and stopping rules in one call, the band factorised by elimination with
+partial pivoting within the band (as LAPACK's ``dgbtf2``), a signal's handler run between
+iterations; the same solutions to the programmes' tolerances (the sums in another order),
+without the numpy calls' overhead that dominates a pick-and-place move's small programmes
+(a few hundred rows).
 """
 
 from __future__ import annotations
@@ -35,7 +42,23 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..._arrays import Array
+from ..._compiled import usable
 from ..._lazy import lazy_module
+
+try:  # the interior point compiled (_ipm.c), built by pip where a C compiler is
+    from . import _ipm as _compiled
+except ImportError:  # pragma: no cover - installed without a C compiler: the numpy solver
+    _compiled = None  # type: ignore[assignment]  # the module or None, as USE_COMPILED says
+
+#: The compiled solver's interface this module calls (``IPM_VERSION`` in _ipm.c): a build
+#: of another version (an old one left in place) is not used.
+IPM_VERSION = 1
+if not usable(_compiled, IPM_VERSION):
+    _compiled = None  # type: ignore[assignment]  # an old build: the numpy solver instead
+
+#: Whether the programmes are solved compiled (where it was built): False gives the numpy
+#: solver (the same solutions to the tolerances; the tests compare the two).
+USE_COMPILED = _compiled is not None
 
 lapack = lazy_module("scipy.linalg.lapack")
 sparse = lazy_module("scipy.sparse")
@@ -124,7 +147,19 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
     most iterations). Near the end the
     Newton systems lose accuracy (the barrier terms span many decades) and the dual
     residual may stall or grow: the best iterate met is returned, converged when it is
-    within a hundred times those tolerances."""
+    within a hundred times those tolerances. Compiled where it was built
+    (:data:`USE_COMPILED`)."""
+    if USE_COMPILED and _compiled is not None and lp.rg.shape[1:] == (P,) and P == 1:
+        x = np.empty(len(lp.c))
+
+        def f64(v: Array) -> Array:
+            return np.ascontiguousarray(v, float)
+
+        status, nit = _compiled.solve(f64(lp.c), np.ascontiguousarray(lp.rk, np.int64),
+                                      f64(lp.ra), f64(lp.rg), f64(lp.rb), f64(lp.E),
+                                      f64(lp.e), f64(lp.lo), f64(lp.hi), f64(x0), x, tol,
+                                      dual_tol, gap_tol, maxiter)
+        return LPResult(x, float(lp.c @ x), status, nit)
     c, rk, ra, rg, rb, E, lo, hi = (lp.c, lp.rk, lp.ra, lp.rg, lp.rb, lp.E, lp.lo, lp.hi)
     e = np.asarray(lp.e, float).reshape(-1)
     nx = len(c)

@@ -55,8 +55,10 @@ PROGRESS = 1e-4
 #: solutions are near vertices), so the next step would be far smaller still.
 STEP_TOL = 1e-4
 #: The largest mesh (intervals) whose trial steps' rows are built with their gradients and
-#: whose rows are kept while a programme is solved (a larger one makes them again after).
-TRIAL_GRADIENTS = 2048
+#: whose rows are kept while a programme is solved (a larger one makes them again after:
+#: four more evaluations of the rows in a run of two programmes, for the peak memory of a
+#: long path; at 8192 intervals a set of rows with their gradients is about 26 MB).
+TRIAL_GRADIENTS = 8192
 FEAS_TOL = 1e-4
 
 

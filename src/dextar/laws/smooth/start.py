@@ -205,7 +205,13 @@ def start_jerks(start: Start, mesh: Mesh, length: float) -> Array:
     the least to meet the end conditions and the pinned knots exactly (every interval's
     duration normalised by the start's)."""
     T, f = start.T, mesh.f
-    ak = np.interp(f * T, start.t, start.a)
+    # the start's acceleration at rest at both ends: its samples' last one is a difference
+    # of speeds interpolated between samples, not quite zero, and knots finer than the
+    # samples near the end took that slope and then jumped to zero in the last interval (a
+    # jerk growing with the knots: 61 % over at 16k knots, the start 17 % slower)
+    a = start.a.copy()
+    a[0] = a[-1] = 0.0
+    ak = np.interp(f * T, start.t, a)
     ak[0] = ak[-1] = 0.0
     Tk = np.full(mesh.M, T)
     j = projected(mesh, np.diff(ak) / (mesh.h * T), Tk, length)
