@@ -185,13 +185,11 @@ def test_csv_numbers_are_shortest_and_never_negative_zero(tmp_path):
 
 
 @pytest.mark.slow
-def test_program_figures_and_report_count_and_name_the_moves(tmp_path):
+def test_program_figures_and_report_count_and_name_the_moves(pick_place_program):
     from dextar.config import load_scenario
     from dextar.output.program import moves_figure
 
-    out = tmp_path / "o"
-    assert main(["program", str(EXAMPLES / "pick_place.toml"), "--out", str(out),
-                 "--quiet"]) == 0
+    out = pick_place_program  # (exit 0: tests/conftest.py)
     title = re.search(r"<title>(.*?)</title>", (out / "report.html").read_text()).group(1)
     assert title == "Program pick_place.toml: fits the motors"
     sc = load_scenario(EXAMPLES / "pick_place.toml")
