@@ -10,6 +10,8 @@ from collections import Counter
 
 import pytest
 
+from .once import made_once
+
 
 def _file(item: pytest.Item) -> str:
     return item.nodeid.split("::")[0]
@@ -20,3 +22,19 @@ def pytest_collection_modifyitems(items):
     tests = Counter(_file(item) for item in items)
     slow = Counter(_file(item) for item in items if item.get_closest_marker("slow"))
     items.sort(key=lambda item: -slow[_file(item)] / tests[_file(item)])  # stable
+
+
+@pytest.fixture(scope="session")
+def pick_place_program(tmp_path_factory):
+    """``dextar program examples/pick_place.toml --quiet`` with its figures and report (the
+    folder), made once for the run (tests/once.py): tests/program/test_program.py and
+    tests/cli/test_traps.py each read it (3.4 s of CPU each time)."""
+    from dextar.cli import main
+
+    from .program.test_program import EXAMPLES
+
+    def make(out):
+        assert main(["program", str(EXAMPLES / "pick_place.toml"), "--out", str(out),
+                     "--quiet"]) == 0
+
+    return made_once(tmp_path_factory, "pick_place_program", make)

@@ -1,8 +1,12 @@
 """dextar excite and dextar identify from the command line: files, columns, a config that
 reproduces the identified base parameters, and bad input refused in one line (exit 2)."""
 
+import contextlib
 import csv
+import io
 import json
+from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -19,6 +23,38 @@ pytestmark = pytest.mark.slow
 CONFIG = str(EXAMPLES / "pick_place.toml")
 COLUMNS = ["t_s", "phi_rad", "psi_rad", "dphi_rad_s", "dpsi_rad_s", "ddphi_rad_s2",
            "ddpsi_rad_s2", "tau1_Nm", "tau2_Nm"]
+
+
+@dataclass(frozen=True)
+class Ran:
+    """A command run once for the file's tests: its exit status, folder and words."""
+    code: int
+    out: Path
+    stdout: str
+    stderr: str
+
+
+def ran(argv: list[str], out: Path) -> Ran:
+    stdout, stderr = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr):
+        code = main([*argv, "--out", str(out)])
+    return Ran(code, out, stdout.getvalue(), stderr.getvalue())
+
+
+# The two identifications of the recording that three tests each read (the same command
+# line, the same files and words): run once for the file, not once per test (2-4 s each).
+@pytest.fixture(scope="module")
+def identified(excite_csv, tmp_path_factory):
+    """``identify`` with the right config: identified, exit 0."""
+    return ran(["identify", str(excite_csv), "--config", CONFIG, "--quiet"],
+               tmp_path_factory.mktemp("identified") / "ok")
+
+
+@pytest.fixture(scope="module")
+def identified_poorly(excite_csv, tmp_path_factory):
+    """``identify`` without --config (the DexTAR without gravity): a poor fit, exit 1."""
+    return ran(["identify", str(excite_csv), "--quiet"],
+               tmp_path_factory.mktemp("identified") / "poor")
 
 
 def test_excite_writes_a_rest_to_rest_periodic_motion(excite_csv, capsys):
@@ -133,38 +169,38 @@ def test_bad_options_exit_2(excite_csv, tmp_path, capsys):
     assert "must end in .csv" in capsys.readouterr().err
 
 
-def test_a_poor_fit_is_exit_1_with_its_files_and_causes(excite_csv, tmp_path, capsys):
+def test_a_poor_fit_is_exit_1_with_its_files_and_causes(identified_poorly, identified):
     """The pick-and-place robot's data (gravity, a gripper) identified as the default DexTAR
     without gravity: computed, written, exit 1, the likely causes named (measured fit quality
     97.8 % / 92.6 % against the 20 % limit)."""
-    out = tmp_path / "id"
-    assert main(["identify", str(excite_csv), "--out", str(out), "--quiet"]) == 1
-    err = capsys.readouterr().err
+    out = identified_poorly.out
+    assert identified_poorly.code == 1
+    err = identified_poorly.stderr
     assert "no --config: the robot is assumed to be the DexTAR" in err
     assert "poor fit: the model leaves" in err and "gravity left out" in err
     s = json.loads((out / "summary.json").read_text())
     assert s["status"] == "poor fit" and min(s["fit_quality"]) > 0.5
     assert (out / "identified.toml").exists() and (out / "report.html").exists()
     # the right config fits: exit 0, a fit quality far below the limit
-    assert main(["identify", str(excite_csv), "--config", CONFIG, "--out",
-                 str(tmp_path / "ok"), "--quiet"]) == 0
-    s = json.loads((tmp_path / "ok" / "summary.json").read_text())
+    assert identified.code == 0
+    s = json.loads((identified.out / "summary.json").read_text())
     assert s["status"] == "identified" and max(s["fit_quality"]) < 0.01
     # without --task the verdict is along the recorded motion, its poses and speeds named
     assert s["prediction_uncertainty_reference"].startswith("the recorded motion (motor A ")
     assert {"rel_std", "poorly_determined"} <= set(s["base_parameters"][0])
-    head = (tmp_path / "ok" / "parameters.csv").read_text().splitlines()[0]
+    head = (identified.out / "parameters.csv").read_text().splitlines()[0]
     assert head.endswith(",poorly_determined")
 
 
 def test_a_model_not_identified_says_so_first_and_model_refuses_it(excite_csv, tmp_path,
-                                                                   capsys):
+                                                                   capsys, identified,
+                                                                   identified_poorly):
     """identified.toml's first line names the status as calibrated.toml's does; a model
     whose first line says it is not identified is refused by --model (exit 2, named). The
     former file began "# identified by dextar from DATA (constrained, ...)" whatever the
     status, and program --model took it: exit 0, "fits"."""
-    poor, ok = tmp_path / "poor", tmp_path / "ok"
-    assert main(["identify", str(excite_csv), "--out", str(poor), "--quiet"]) == 1
+    poor, ok = identified_poorly.out, identified.out
+    assert identified_poorly.code == 1
     first = (poor / "identified.toml").read_text().splitlines()[0]
     assert first.startswith(f"# identified by dextar from {excite_csv} (poor fit: "), first
     assert "gravity left out" in first and first.endswith("refuses this file as --model)")
@@ -180,8 +216,7 @@ def test_a_model_not_identified_says_so_first_and_model_refuses_it(excite_csv, t
     edited.write_text("\n".join((poor / "identified.toml").read_text().splitlines()[1:]))
     assert load_scenario(CONFIG, model=edited).source.endswith(f"the model of {edited}")
     # an identified model: its first line says so, and --model takes it
-    assert main(["identify", str(excite_csv), "--config", CONFIG, "--out", str(ok),
-                 "--quiet"]) == 0
+    assert identified.code == 0
     first = (ok / "identified.toml").read_text().splitlines()[0]
     assert first.startswith(f"# identified by dextar from {excite_csv} (identified: "), first
     assert main(["plan", CONFIG, "--model", str(ok / "identified.toml"), "--out",
@@ -219,12 +254,11 @@ def test_excite_covers_a_task_with_the_motors_headroom(tmp_path, capsys):
     assert 0.0 < p["task_coverage"] <= 1.0 and len(p["task_speed_ratio"]) == 2
 
 
-def test_every_config_command_takes_a_model_file(excite_csv, tmp_path):
+def test_every_config_command_takes_a_model_file(identified, tmp_path):
     """--model identified.toml: the identified robot, inertia, friction and gravity, the
     task's other tables kept."""
-    out = tmp_path / "id"
-    assert main(["identify", str(excite_csv), "--config", CONFIG, "--out", str(out),
-                 "--quiet"]) == 0
+    out = identified.out
+    assert identified.code == 0
     model = out / "identified.toml"
     ident = load_scenario(model).si_model.inertia
     assert load_scenario(CONFIG, model=model).si_model.inertia == ident

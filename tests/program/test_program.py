@@ -33,12 +33,10 @@ def pick_place(tmp_path_factory):
 
 
 @pytest.mark.slow
-def test_figures_and_report_are_written(tmp_path):
+def test_figures_and_report_are_written(pick_place_program):
     from html.parser import HTMLParser
 
-    out = tmp_path / "pp"
-    assert main(["program", str(EXAMPLES / "pick_place.toml"), "--out", str(out),
-                 "--quiet"]) == 0
+    out = pick_place_program  # (exit 0: tests/conftest.py)
     for name in ("moves", "motion", "operating_points"):
         assert (out / f"{name}.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
         assert (out / f"{name}.svg").read_text().rstrip().endswith("</svg>")
