@@ -53,6 +53,7 @@ from .space import DesignSpace
 from .sweep import INSTALL_HINT, Chunks, Cluster, SweepStats, chunks_of, require_dask
 
 nsga2 = lazy_module("pymoo.algorithms.moo.nsga2")
+sms = lazy_module("pymoo.algorithms.moo.sms")
 pymoo_problem = lazy_module("pymoo.core.problem")
 pymoo_evaluator = lazy_module("pymoo.core.evaluator")
 pymoo_static = lazy_module("pymoo.problems.static")
@@ -61,8 +62,10 @@ pymoo_hv = lazy_module("pymoo.indicators.hv")
 
 Row = dict[str, Any]
 
-#: The adaptive searches (``[design] search``), beside the sweeps' samplings.
-SEARCHES = ("nsga2",)
+#: The adaptive searches (``[design] search``), beside the sweeps' samplings: NSGA-II
+#: (survival by non-dominated rank and crowding distance) and SMS-EMOA (survival by rank and
+#: each design's exclusive contribution to the hypervolume).
+SEARCHES = ("nsga2", "smsemoa")
 #: The reference point of a hypervolume, each objective scaled to [0, 1] between the ideal
 #: and the nadir point of the front it is measured against (a usual choice, e.g. Ishibuchi
 #: et al., Evol. Comput. 26(3), 2018: a little beyond the nadir, so that the front's extreme
@@ -75,7 +78,8 @@ VIOLATION_LIMIT, VIOLATION_UNPLANNED = 1.0, 2.0
 def require_pymoo() -> None:
     """Raise a :class:`ConfigError` naming the extra when pymoo is not installed."""
     if importlib.util.find_spec("pymoo") is None:
-        raise ConfigError(f"[design] search = \"nsga2\" needs pymoo: {INSTALL_HINT}")
+        raise ConfigError(f"[design] search = {' or '.join(map(repr, SEARCHES))} needs pymoo: "
+                          f"{INSTALL_HINT}")
 
 
 def pymoo_version() -> str:
@@ -175,9 +179,9 @@ class Proposer:
         self.problem = pymoo_problem.Problem(n_var=k, n_obj=len(space.objectives),
                                              n_ieq_constr=1, xl=0.0, xu=1.0)
         first = replace(space, samples=settings.population).unit_sample()
-        self.algorithm = nsga2.NSGA2(pop_size=settings.population,
-                                     n_offsprings=settings.batch, sampling=first,
-                                     eliminate_duplicates=True)
+        kind = nsga2.NSGA2 if settings.kind == "nsga2" else sms.SMSEMOA
+        self.algorithm = kind(pop_size=settings.population, n_offsprings=settings.batch,
+                              sampling=first, eliminate_duplicates=True)
         self.algorithm.setup(self.problem, termination=pymoo_termination.NoTermination(),
                              seed=settings.seed)
         self.pending: collections.deque[Any] = collections.deque()
