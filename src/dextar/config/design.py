@@ -61,8 +61,9 @@ class DesignTable(Table):
                          maximum=1_000_000),
         "sampling": Param("choice", "", None, "a sweep's sampling, sobol, grid or random (the "
                           "older name of [design].search)", choices=SAMPLINGS),
-        "population": Param("integer", "", 40, "designs a search (nsga2, smsemoa) keeps from one batch "
-                            "to the next (its first sample, scrambled Sobol, has as many)",
+        "population": Param("integer", "", 20, "designs a search (nsga2, smsemoa) keeps from "
+                            "one batch to the next (its first sample, scrambled Sobol, has as "
+                            "many); about evaluations / 20 or less",
                             minimum=4, maximum=100_000),
         "evaluations": Param("integer", "", 2000, "designs a search evaluates in all",
                              minimum=4, maximum=1_000_000),
