@@ -64,7 +64,7 @@ TASKS = {
              "L2": [60.0, 140.0], "d": [0.0, 100.0], "mass_per_length": [0.4, 0.3],
              "objectives": ["peak_torque_A_Nm", "footprint_mm", "-gci"]}),
 }
-POPULATION = 40
+POPULATION = 20  # the shipped default ([design].population)
 CHUNK = 8
 DENSE = {"program": 4096, "run": 8192}
 
