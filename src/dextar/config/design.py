@@ -53,17 +53,19 @@ class DesignTable(Table):
         "mass_per_length": Param("point", "", None, "kg/m of the proximal and distal rods "
                                  "(uniform rods whose masses follow the lengths)"),
         "search": Param("choice", "", None, "sobol, grid or random (a sweep of [design].samples "
-                        "designs) or nsga2 (an adaptive multi-objective search of "
-                        "[design].evaluations designs); default sobol",
+                        "designs) or nsga2 or smsemoa (an adaptive multi-objective search of "
+                        "[design].evaluations designs; smsemoa keeps the designs that add most "
+                        "to the front's hypervolume); default sobol",
                         choices=(*SAMPLINGS, *SEARCHES)),
         "samples": Param("integer", "", 1000, "designs of a sweep", minimum=1,
                          maximum=1_000_000),
         "sampling": Param("choice", "", None, "a sweep's sampling, sobol, grid or random (the "
                           "older name of [design].search)", choices=SAMPLINGS),
-        "population": Param("integer", "", 40, "designs an nsga2 search keeps from one batch "
-                            "to the next (its first sample, scrambled Sobol, has as many)",
+        "population": Param("integer", "", 20, "designs a search (nsga2, smsemoa) keeps from "
+                            "one batch to the next (its first sample, scrambled Sobol, has as "
+                            "many); about evaluations / 20 or less",
                             minimum=4, maximum=100_000),
-        "evaluations": Param("integer", "", 2000, "designs an nsga2 search evaluates in all",
+        "evaluations": Param("integer", "", 2000, "designs a search evaluates in all",
                              minimum=4, maximum=1_000_000),
         "seed": Param("integer", "", 0, "seed of the sampling and of the search", minimum=0,
                       maximum=2**31 - 1),
@@ -126,7 +128,7 @@ class DesignTable(Table):
         for key in ("population", "evaluations"):
             if kind not in SEARCHES and key in raw:
                 raise ConfigError(f"config key [design].{key} is a search's (search = "
-                                  f"\"nsga2\"), not a {kind} sweep's")
+                                  f"\"nsga2\" or \"smsemoa\"), not a {kind} sweep's")
         if "motors" not in values:
             for o in objectives:
                 if o.lstrip("-") in MOTOR_METRICS:
@@ -184,7 +186,7 @@ class DesignTable(Table):
 
     @property
     def search_kind(self) -> str:
-        """``sobol``, ``grid`` or ``random`` (a sweep) or ``nsga2`` (a search)."""
+        """``sobol``, ``grid`` or ``random`` (a sweep) or ``nsga2``, ``smsemoa`` (a search)."""
         return str((self.values or {}).get("search", "sobol"))
 
     def search(self, *, evaluations: int | None = None,

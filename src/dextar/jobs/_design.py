@@ -69,7 +69,7 @@ class DesignSweep:
 
     @property
     def kind(self) -> str:
-        """``sobol``, ``grid``, ``random`` or ``nsga2``."""
+        """``sobol``, ``grid``, ``random``, ``nsga2`` or ``smsemoa``."""
         return self.space.sampling if self.search is None else self.search.kind
 
 

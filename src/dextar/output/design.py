@@ -18,7 +18,7 @@ import numpy as np
 from .._arrays import Array
 from .._lazy import lazy_module
 from ..design.pareto import Choice
-from ..design.search import REFERENCE_POINT, HypervolumeCurve, SearchSettings
+from ..design.search import REFERENCE_POINT, SEARCHES, HypervolumeCurve, SearchSettings
 from ..design.space import (
     LENGTHS,
     METRICS,
@@ -251,7 +251,7 @@ def design_report(summary: Mapping[str, Any], pareto_rows: Sequence[Mapping[str,
               f"{best['design']}, l1 = {best['l1']:.4g}, l2 = {best['l2']:.4g}, L1 = "
               f"{best['L1']:.4g}, L2 = {best['L2']:.4g}, d = {best['d']:.4g} mm; written to "
               "best.toml.</p>") if best else "<p>No feasible design.</p>"
-    what = "search" if summary.get("search") == "nsga2" else "sweep"
+    what = "search" if summary.get("search") in SEARCHES else "sweep"
     return page(f"Design {what} of {Path(str(summary['task'])).name}",
                 f"<p>Task file {esc(str(summary['task']))}.</p>{facts}{chosen}"
                 f"<h2>Pareto designs</h2>{pareto}<h2>Figures</h2>{figures(pngs)}")
