@@ -144,9 +144,14 @@ def test_one_design_is_a_row_without_a_cluster(tmp_path):
 def test_one_worker_gives_the_same_file(sweep2, tmp_path):
     task, out2 = sweep2
     out1 = tmp_path / "one"
-    assert main(["design", str(task), "--out", str(out1), "--workers", "1", "--quiet"]) == 0
+    # --no-figures: the same data files (the figures are drawn after the sweep, from them)
+    assert main(["design", str(task), "--out", str(out1), "--workers", "1", "--quiet",
+                 "--no-figures"]) == 0
     assert (out1 / "designs.csv").read_bytes() == (out2 / "designs.csv").read_bytes()
     assert (out1 / "pareto.csv").read_bytes() == (out2 / "pareto.csv").read_bytes()
+    assert (out1 / "best.toml").read_bytes() == (out2 / "best.toml").read_bytes()
+    assert not list(out1.glob("*.png")) and not (out1 / "report.html").exists()
+    assert list(out2.glob("*.png")) and (out2 / "report.html").exists()
 
 
 @pytest.mark.slow
@@ -172,7 +177,7 @@ def test_a_killed_sweep_resumes_to_the_same_file(sweep2, tmp_path, scheduler):
     # a line cut short by the kill is dropped on resume
     csv_path.write_text(partial + "32,1.0,2.")
     assert main(["design", str(task), "--out", str(out), "--resume", "--scheduler", scheduler,
-                 "--quiet"]) == 0
+                 "--quiet", "--no-figures"]) == 0
     assert csv_path.read_bytes() == (out2 / "designs.csv").read_bytes()
     s = json.loads((out / "summary.json").read_text())
     assert s["resumed"] == done and s["evaluated"] == 32 - done
@@ -361,7 +366,7 @@ def test_a_running_cluster_by_address_gives_the_same_file(sweep2, tmp_path):
         task, out2 = sweep2
         out = tmp_path / "remote"
         assert main(["design", str(task), "--out", str(out), "--scheduler", address,
-                     "--quiet"]) == 0
+                     "--quiet", "--no-figures"]) == 0
         assert (out / "designs.csv").read_bytes() == (out2 / "designs.csv").read_bytes()
     finally:
         for p in procs:

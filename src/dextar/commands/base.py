@@ -80,6 +80,18 @@ def into_directory(sp: argparse.ArgumentParser, force: str = "write into an exis
     sp.add_argument("--json", action="store_true", help="print one JSON object")
 
 
+def no_figures_argument(sp: argparse.ArgumentParser, what: str) -> None:
+    """``--no-figures``: the command's data files only (``what``), no figures and no
+    ``report.html`` (batches, headless machines, resumable runs)."""
+    sp.add_argument("--no-figures", dest="figures", action="store_false",
+                    help=f"write {what} only (no figures, no report.html)")
+
+
+def wants_figures(args: argparse.Namespace) -> bool:
+    """False when the command line said ``--no-figures``."""
+    return bool(getattr(args, "figures", True))
+
+
 def config_argument(sp: argparse.ArgumentParser, *, required: bool = False,
                     help: str = "TOML config (default: the paper's example)") -> None:
     """The config file of a command (positional, optional unless ``required``) and

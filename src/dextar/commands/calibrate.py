@@ -16,7 +16,15 @@ from .. import jobs
 from .._lazy import lazy_module
 from ..config.kinematic import load_kinematic_config
 from ..output.files import OutputDir
-from .base import Result, into_directory, note_lines, noted, shown
+from .base import (
+    Result,
+    into_directory,
+    no_figures_argument,
+    note_lines,
+    noted,
+    shown,
+    wants_figures,
+)
 
 if TYPE_CHECKING:  # the writers, imported when the command runs (start-up: dextar._lazy)
     from ..output import calibration as written
@@ -26,7 +34,7 @@ else:
 
 def add_arguments(sp: argparse.ArgumentParser) -> None:
     """``data``, ``--config``, ``--validate``, ``--frame``, ``--robust``,
-    ``--outlier-factor``, ``--out``, ``--force``, ``--quiet``, ``--json``."""
+    ``--outlier-factor``, ``--out``, ``--force``, ``--quiet``, ``--json``, ``--no-figures``."""
     sp.add_argument("data", help="CSV with phi_deg, psi_deg (encoder readings), x_mm, y_mm "
                     "(measured point) [, mode, assembly, sigma_mm]")
     sp.add_argument("--config", help="TOML config: the nominal [robot] (its encoder offsets "
@@ -43,10 +51,13 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
                     help="a row farther from its prediction than this many residual scales "
                     "is an outlier (default 5)")
     into_directory(sp)
+    no_figures_argument(sp, "calibrated.toml, the residuals and summary.json")
 
 
 def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
-    """Calibrate (:func:`dextar.jobs.calibrate`: outliers diagnosed), write, word."""
+    """Calibrate (:func:`dextar.jobs.calibrate`: outliers diagnosed), write, word (the
+    figures unless ``figures`` is False or the command line said ``--no-figures``)."""
+    figures = figures and wants_figures(args)
     od = OutputDir(args.out, force=args.force, produces=written.CALIBRATION_FILES)  # checked
     kc = load_kinematic_config(args.config)
     rt, inst = kc.robot, kc.instrument

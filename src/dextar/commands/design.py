@@ -12,7 +12,17 @@ from typing import TYPE_CHECKING
 from .. import jobs
 from .._lazy import lazy_module
 from ..output.files import OutputDir
-from .base import Result, config_argument, into_directory, load, note_lines, noted, shown
+from .base import (
+    Result,
+    config_argument,
+    into_directory,
+    load,
+    no_figures_argument,
+    note_lines,
+    noted,
+    shown,
+    wants_figures,
+)
 
 if TYPE_CHECKING:  # the writers, imported when the command runs (start-up: dextar._lazy)
     import dextar.design.search  # (named in full: the docs' references find its Progress)
@@ -24,7 +34,7 @@ else:
 
 def add_arguments(sp: argparse.ArgumentParser) -> None:
     """``config``, ``--out``, ``--samples``, ``--seed``, ``--workers`` | ``--scheduler``,
-    ``--resume``, ``--force``, ``--quiet``, ``--json``."""
+    ``--resume``, ``--force``, ``--quiet``, ``--json``, ``--no-figures``."""
     config_argument(sp, required=True, help="TOML task file (a program task or a run config) "
                     "with [design]")
     into_directory(sp, force="overwrite a non-empty --out")
@@ -41,6 +51,7 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
     sp.add_argument("--resume", action="store_true",
                     help="complete the sweep or search in --out (evaluate only what is "
                     "missing)")
+    no_figures_argument(sp, "designs.csv, pareto.csv, best.toml and summary.json")
 
 
 def duration_text(seconds: float) -> str:
@@ -97,7 +108,9 @@ def _dashboard(args: argparse.Namespace) -> Callable[[str], None] | None:
 
 
 def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
-    """Sweep and choose (:func:`dextar.jobs.design`), write, word."""
+    """Sweep and choose (:func:`dextar.jobs.design`), write, word (the figures unless
+    ``figures`` is False or the command line said ``--no-figures``)."""
+    figures = figures and wants_figures(args)
     sc = load(args)
     with noted(sc):
         sweep = jobs.design_sweep(sc, samples=args.samples, seed=args.seed)

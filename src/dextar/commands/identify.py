@@ -8,7 +8,16 @@ from typing import TYPE_CHECKING
 
 from .. import jobs
 from .._lazy import lazy_module
-from .base import Result, into_directory, load, model_argument, note_lines, shown
+from .base import (
+    Result,
+    into_directory,
+    load,
+    model_argument,
+    no_figures_argument,
+    note_lines,
+    shown,
+    wants_figures,
+)
 
 if TYPE_CHECKING:  # the writers, imported when the command runs (start-up: dextar._lazy)
     from ..output import identification as written
@@ -32,10 +41,13 @@ def add_arguments(sp: argparse.ArgumentParser) -> None:
     sp.add_argument("--cutoff-hz", type=float, default=None,
                     help="low-pass cut-off, Hz (default: from the data's bandwidth)")
     into_directory(sp)
+    no_figures_argument(sp, "identified.toml, parameters.csv and summary.json")
 
 
 def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
-    """Identify and validate (:func:`dextar.jobs.identify_model`), write, word."""
+    """Identify and validate (:func:`dextar.jobs.identify_model`), write, word (the figures
+    unless ``figures`` is False or the command line said ``--no-figures``)."""
+    figures = figures and wants_figures(args)
     sc = load(args)
     job = jobs.identify_model(args.data, sc, config=args.config, cutoff_hz=args.cutoff_hz,
                               task=args.task, validate=args.validate)
