@@ -367,17 +367,18 @@ def test_points_in_metres_exit_2_named(story, tmp_path, capsys):
 
 
 def test_a_fit_that_did_not_converge_writes_no_calibrated_config(story, tmp_path, capsys,
-                                                                 monkeypatch, no_figures):
+                                                                 monkeypatch):
     """A solver stopped after one evaluation: exit 1, the diagnosis files, no
     calibrated.toml (not even the one of an earlier run in the same directory)."""
     out = tmp_path / "o"
     code, _, _ = cli(["calibrate", story["measured"], "--config", story["cfg"], "--out", out,
-                      "--quiet"], capsys)
+                      "--quiet", "--no-figures"], capsys)
     assert code == 0 and (out / "calibrated.toml").exists()
+    assert not list(out.glob("*.png")) and not (out / "report.html").exists()
     # the fit the job calls (dextar.calibration.fit.calibrate), stopped after one evaluation
     monkeypatch.setattr(cal_fit, "calibrate", functools.partial(cal_fit.calibrate, max_nfev=1))
     code, text, err = cli(["calibrate", story["measured"], "--config", story["cfg"], "--out",
-                           out, "--force"], capsys)
+                           out, "--force", "--no-figures"], capsys)
     assert code == 1 and "not converged" in err and "no calibrated.toml written" in err, err
     assert not (out / "calibrated.toml").exists()
     s = json.loads((out / "summary.json").read_text())

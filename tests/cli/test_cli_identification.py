@@ -46,8 +46,8 @@ def ran(argv: list[str], out: Path) -> Ran:
 @pytest.fixture(scope="module")
 def identified(excite_csv, tmp_path_factory):
     """``identify`` with the right config: identified, exit 0."""
-    return ran(["identify", str(excite_csv), "--config", CONFIG, "--quiet"],
-               tmp_path_factory.mktemp("identified") / "ok")
+    return ran(["identify", str(excite_csv), "--config", CONFIG, "--quiet", "--no-figures"],
+               tmp_path_factory.mktemp("identified") / "ok")  # (no test reads its figures)
 
 
 @pytest.fixture(scope="module")
@@ -185,6 +185,9 @@ def test_a_poor_fit_is_exit_1_with_its_files_and_causes(identified_poorly, ident
     assert identified.code == 0
     s = json.loads((identified.out / "summary.json").read_text())
     assert s["status"] == "identified" and max(s["fit_quality"]) < 0.01
+    # --no-figures: the data files, no fit.png or report.html
+    assert {p.name for p in identified.out.iterdir()} == {"identified.toml", "parameters.csv",
+                                                          "summary.json"}
     # without --task the verdict is along the recorded motion, its poses and speeds named
     assert s["prediction_uncertainty_reference"].startswith("the recorded motion (motor A ")
     assert {"rel_std", "poorly_determined"} <= set(s["base_parameters"][0])
@@ -240,7 +243,7 @@ def test_validation_reports_the_excited_region(excite_csv, tmp_path, capsys):
                header="t_s,phi_rad,psi_rad,tau1_Nm,tau2_Nm")
     out = tmp_path / "v"
     assert main(["identify", str(excite_csv), "--config", CONFIG, "--validate", str(semi),
-                 "--out", str(out), "--quiet"]) == 0
+                 "--out", str(out), "--quiet", "--no-figures"]) == 0
     s = json.loads((out / "summary.json").read_text())
     assert 0.0 <= s["validation_inside_fraction"] < 1.0
     assert "the prediction extrapolates there" in capsys.readouterr().err
