@@ -99,6 +99,7 @@ class RowModel:
         self.t2 = np.concatenate([np.zeros(M - 1), h / 2])
         cap = speed_cap(second, table.co)
         self._grad = True
+        self._kept: dict[tuple[int, int, int], tuple[Array, ...]] = {}
         self.root_cap = (None if not np.isfinite(cap).any()
                          else np.sqrt(np.where(np.isfinite(cap), cap, 1e300)))
 
@@ -141,25 +142,44 @@ class RowModel:
         out = local(h, k, theta, gs, gw, ga, gj, gT)
         return out if keep is None else out[keep]
 
+    def _points(self, k0: int, k1: int, m: int) -> tuple[Array, ...]:
+        """The points of the intervals ``k0`` to ``k1`` (excluded), the same at every motion
+        (kept): the second-order rows' intervals and offsets, each repeated for the ``m``
+        rows at a point; the intervals; the third-order rows' intervals, offsets and which
+        are at an interval's end."""
+        key = (k0, k1, m)
+        if key not in self._kept:
+            in2 = (self.k2 >= k0) & (self.k2 < k1)
+            k, th = self.k2[in2], self.t2[in2]
+            kM = np.arange(k0, k1)
+            n1 = k1 - k0
+            h = self.mesh.h
+            self._kept[key] = (k, th, np.repeat(k, m), np.repeat(th, m), kM,
+                               np.concatenate([kM, kM, kM]),
+                               np.concatenate([np.zeros(n1), h[kM] / 2, h[kM]]),
+                               np.arange(3 * n1) >= 2 * n1)
+        return self._kept[key]
+
     def _block(self, mo: Motion, pr: PointRows, finite: Array, phmax: float, k0: int,
                k1: int) -> Rows:
         """The rows of the intervals ``k0`` to ``k1`` (excluded)."""
         mesh, tab, S = self.mesh, self.table, self.length
         h = mesh.h
         m = pr.pu.shape[1]
-        in2 = (self.k2 >= k0) & (self.k2 < k1)
-        k, th = self.k2[in2], self.t2[in2]
+        k, th, kk, tt, kM, k3, th3, end3 = self._points(k0, k1, m)
         sig, w, al = mo.at(mesh, k, th)
-        vals, slopes = interp(tab.s, np.concatenate([pr.pu, pr.px, np.where(finite, pr.ph,
-                                                                             0.0)], axis=1),
-                               sig)
-        pu, px, ph = vals[:, :m], vals[:, m:2 * m], vals[:, 2 * m:]
-        dpu, dpx, dph = slopes[:, :m], slopes[:, m:2 * m], slopes[:, 2 * m:]
-        keep = (interp(tab.s, finite.astype(float), sig)[0] > 1 - 1e-12).reshape(-1)
+        # the rows' coefficients, whether each is finite, and the speed cap's root: one
+        # interpolation (each column's arithmetic as apart)
+        cols = [pr.pu, pr.px, np.where(finite, pr.ph, 0.0), finite.astype(float)]
+        if self.root_cap is not None:
+            cols.append(self.root_cap[:, None])
+        vals, slopes = interp(tab.s, np.concatenate(cols, axis=1), sig)
+        pu, px, ph = vals[:, :m], vals[:, m:2 * m], vals[:, 2 * m:3 * m]
+        dpu, dpx, dph = slopes[:, :m], slopes[:, m:2 * m], slopes[:, 2 * m:3 * m]
+        keep = (vals[:, 3 * m:4 * m] > 1 - 1e-12).reshape(-1)
         a_, w_, T = al[:, None], w[:, None], mo.Tk[k][:, None]
         c = np.maximum(np.abs(ph), 1e-9 * phmax + 1e-300) * T * T
         F = (pu * a_ + px * w_ * w_ - ph * T * T) / c
-        kk, tt = np.repeat(k, m), np.repeat(th, m)
         zero = np.zeros(len(kk))
 
         def flat(v: Array) -> Array:
@@ -172,8 +192,7 @@ class RowModel:
         Fs, ks, names = [flat(F)[keep]], [kk[keep]], ["second-order"]
         n2 = len(k)
         if self.root_cap is not None:  # w <= sqrt(cap) T
-            rv, rs = interp(tab.s, self.root_cap[:, None], sig)
-            rv, rs = rv[:, 0], rs[:, 0]
+            rv, rs = vals[:, 4 * m], slopes[:, 4 * m]
             T = mo.Tk[k]
             c2 = np.maximum(rv, 1e-300) * T
             Fc = (w - rv * T) / c2
@@ -191,12 +210,8 @@ class RowModel:
         names.append("w>=0")
         # the third-order rows at every interval's start, middle and end (at its end, the
         # table's segment before the point), all at once
-        kM = np.arange(k0, k1)
-        n1 = k1 - k0
-        k3 = np.concatenate([kM, kM, kM])
-        th3 = np.concatenate([np.zeros(n1), h[kM] / 2, h[kM]])
         sig, w, al = mo.at(mesh, k3, th3)
-        v, d = tab.at(sig, np.arange(3 * n1) >= 2 * n1)
+        v, d = tab.at(sig, end3)
         F3, C3, kk3, n3 = self._third_at(mo, k3, th3, v, d, w, al)
         norms.append(n3)
         Fs.append(F3)

@@ -27,8 +27,7 @@ from ..constraints import (
     TorqueRateLimit,
 )
 from .mesh import Mesh, make_mesh, projected
-from .table import DB, DG, Q1, Q2, Q3, A, B, Table
-from .table import segments as linear_in
+from .table import DB, DG, Q1, Q2, Q3, A, B, Table, values_at
 
 
 def jumps(base: Any) -> tuple[Array, Array]:
@@ -149,7 +148,7 @@ def fractions(start: Start, table: Table, cons: Sequence[Constraint], segments: 
     ``sqrt(c / (32 tol))`` intervals per unit time."""
     t, s, v, a = start.t, start.s, start.v, start.a
     used = max(c.stop for c in (Q1, Q2, Q3, A, B))  # (the columns it needs, first)
-    vals = linear_in(table.s, table.lo[:, :used], table.hi[:, :used], s)[0]
+    vals = values_at(table.s, table.lo[:, :used], table.hi[:, :used], s)
     q1, q2, q3, b = vals[:, Q1], vals[:, Q2], vals[:, Q3], vals[:, B]
     vv, aa = v[:, None], a[:, None]
     parts: list[Array] = []
@@ -168,10 +167,9 @@ def fractions(start: Start, table: Table, cons: Sequence[Constraint], segments: 
             span = np.asarray(wmax, float) - (0.0 if knee is None else np.asarray(knee))
             parts.append(q1 * vv / span)
     dt = t[1] - t[0]
-    c2 = np.zeros_like(t)
-    for p in parts:
-        c2 = np.maximum(c2, np.abs(np.gradient(np.gradient(p, dt, axis=0), dt,
-                                               axis=0)).max(axis=1))
+    # every part's columns side by side: one pair of differences (the same per column)
+    c2 = np.abs(np.gradient(np.gradient(np.concatenate(parts, axis=1), dt, axis=0), dt,
+                            axis=0)).max(axis=1, initial=0.0) if parts else np.zeros_like(t)
     density = np.maximum(np.sqrt(c2 / (32 * tol)), segments / start.T)
     cdf = np.concatenate([[0.0], np.cumsum(0.5 * (density[1:] + density[:-1]) * dt)])
     M = max(segments, int(np.ceil(cdf[-1])))
