@@ -134,13 +134,22 @@ class RowModel:
                     tuple(kind for r in parts for kind in r.kinds))
 
     def _loc(self, h: Array, k: Array, theta: Array, gs: Array, gw: Array, ga: Array,
-             gj: Array, gT: Array, keep: Array | None = None) -> Array:
-        """:func:`local` of the rows (those ``keep`` selects), or nothing when the rows are
-        built without their gradients."""
+             gj: Array, gT: Array, keep: Array | None = None) -> list[Array]:
+        """The arguments of :func:`local` after ``h`` for the rows (those ``keep`` selects),
+        or none when the rows are built without their gradients: every block's are joined
+        for one call (:meth:`_gradients`: elementwise, the same as a call per block)."""
         if not self._grad:
-            return np.zeros((0, 10))
-        out = local(h, k, theta, gs, gw, ga, gj, gT)
-        return out if keep is None else out[keep]
+            return []
+        args = [k, theta, gs, gw, ga, gj, gT]
+        return args if keep is None else [a[keep] for a in args]
+
+    def _gradients(self, blocks: list[list[Array]]) -> tuple[Array, Array]:
+        """``C`` (R, 5) and the sizes (R, 5) float32 of the blocks' rows (:meth:`_loc`)."""
+        blocks = [b for b in blocks if b]
+        if not blocks:
+            return np.zeros((0, 5)), np.zeros((0, 5), np.float32)
+        out = local(self.mesh.h, *(np.concatenate([b[i] for b in blocks]) for i in range(7)))
+        return np.ascontiguousarray(out[:, :5]), out[:, 5:].astype(np.float32)
 
     def _points(self, k0: int, k1: int, m: int) -> tuple[Array, ...]:
         """The points of the intervals ``k0`` to ``k1`` (excluded), the same at every motion
@@ -215,29 +224,28 @@ class RowModel:
         F3, C3, kk3, n3 = self._third_at(mo, k3, th3, v, d, w, al)
         norms.append(n3)
         Fs.append(F3)
-        Cs.append(C3)
+        Cs.extend(C3)
         ks.append(kk3)
         names.append("third")
-        C = np.concatenate([c[:, :5] for c in Cs])
-        sizes = np.concatenate([c[:, 5:].astype(np.float32) for c in Cs])
+        C, sizes = self._gradients(Cs)
         del Cs
         return Rows(np.concatenate(Fs), np.concatenate(ks).astype(np.int32), C,
                     np.concatenate(norms), sizes,
                     tuple((n, len(f)) for n, f in zip(names, Fs, strict=True)))
 
     def _third_at(self, mo: Motion, k: Array, theta: Array, v: Array, d: Array, w: Array,
-                  al: Array) -> tuple[Array, Array, Array, Array]:
+                  al: Array) -> tuple[Array, list[list[Array]], Array, Array]:
         """The joint jerk and torque-rate rows, on both sides of each limit, at offsets
         ``theta`` into the intervals ``k`` (n,), with the table's columns ``v`` and slopes
-        ``d`` (n, 18) and the states ``w, al`` (n,) there: rows, gradients, intervals,
-        normalisations."""
+        ``d`` (n, 18) and the states ``w, al`` (n,) there: rows, their gradients' arguments
+        (:meth:`_loc`), intervals, normalisations."""
         T = mo.Tk[k][:, None]
         h = self.mesh.h
         q1, q2, q3 = v[:, Q1], v[:, Q2], v[:, Q3]
         dq1, dq2, dq3 = d[:, Q1], d[:, Q2], d[:, Q3]
         jj, ww, aa = mo.J[k][:, None], w[:, None], al[:, None]
         Fs: list[Array] = []
-        Cs: list[Array] = []
+        Cs: list[list[Array]] = []
         Ns: list[Array] = []
         for c in self.third:
             if isinstance(c, JerkLimit):
@@ -279,13 +287,12 @@ class RowModel:
                 Fs.append(((sign * val - scale) / scale).reshape(-1))
                 Ns.append(np.broadcast_to(scale, val.shape).reshape(-1))
                 if not self._grad:
-                    Cs.append(np.zeros((0, 10)))
                     continue
                 g_s, g_w, g_a, g_j = ((sign * x / scale).reshape(-1) for x in (gs, gw, ga, gj))
                 Cs.append(self._loc(h, kk, tt, g_s, g_w, g_a, g_j,
                                     ((sign * gT - 3 * lim * T * T) / scale).reshape(-1)))
         if not Fs:
-            return np.zeros(0), np.zeros((0, 10)), np.zeros(0, int), np.zeros(0)
+            return np.zeros(0), [], np.zeros(0, int), np.zeros(0)
         n = len(Fs)
-        return (np.concatenate(Fs), np.concatenate(Cs), np.tile(np.repeat(k, 2), n),
+        return (np.concatenate(Fs), Cs, np.tile(np.repeat(k, 2), n),
                 np.concatenate(Ns))
