@@ -268,3 +268,27 @@ def test_the_check_finds_a_peak_between_its_samples(peak, found):
         assert np.flatnonzero(excess).tolist() == [2] and dyn.calls == 2
     else:
         assert ratio["torque"] <= 0.9995 and not excess.any() and dyn.calls == 1
+
+
+def test_rows_kept_for_the_same_motion_only(setup):
+    """Rows kept (time_scaled's last, the SLP's first) are returned once for the same
+    motion, with gradients only if they have them; another motion gets its own rows."""
+    model, me, J, Tk, _ = setup
+    mo = mesh.motion(me, J, Tk, model.length)
+    other = mesh.motion(me, J, Tk * 1.01, model.length)
+    fresh = model.rows(mo)
+    kept = model.rows(mo, keep=True)
+    assert model.rows(mo) is kept  # the same motion: the kept rows
+    assert model.rows(mo) is not kept  # once only
+    model.rows(mo, keep=True)
+    r = model.rows(other)  # another motion: its own rows
+    assert not np.array_equal(r.F, fresh.F)
+    np.testing.assert_array_equal(r.F, model.rows(other).F)
+    lean = model.rows(mo, gradients=False, keep=True)
+    assert lean.C.shape[0] == 0
+    full = model.rows(mo)  # gradients asked: not the lean rows
+    assert full is not lean and full.C.shape == fresh.C.shape
+    np.testing.assert_array_equal(full.C, fresh.C)
+    np.testing.assert_array_equal(full.F, fresh.F)
+    model.rows(mo, gradients=False, keep=True)
+    assert model.rows(mo, gradients=False).C.shape[0] == 0

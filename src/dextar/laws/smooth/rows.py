@@ -85,6 +85,11 @@ def local(h: Array, k: Array, theta: Array, gs: Array, gw: Array, ga: Array, gj:
                      np.abs(ga), np.abs(gj), np.abs(gT)], axis=1)
 
 
+def _key(mo: Motion) -> tuple[Array, ...]:
+    """What the rows at a motion depend on (with the row model's mesh, table and limits)."""
+    return (mo.J, mo.Tk, mo.sigma, mo.w, mo.alpha, mo.w_end, mo.alpha_end)
+
+
 class RowModel:
     """The rows of the transcription at any motion (see the module doc)."""
 
@@ -100,6 +105,7 @@ class RowModel:
         cap = speed_cap(second, table.co)
         self._grad = True
         self._kept: dict[tuple[int, int, int], tuple[Array, ...]] = {}
+        self._last: tuple[tuple[Array, ...], Rows] | None = None
         self.root_cap = (None if not np.isfinite(cap).any()
                          else np.sqrt(np.where(np.isfinite(cap), cap, 1e300)))
 
@@ -111,10 +117,23 @@ class RowModel:
         x0 = np.interp(self.table.s, mo.sigma, x)
         return np.asarray(np.maximum(x0, 1e-4 * float(x0.max()) + 1e-300))
 
-    def rows(self, mo: Motion, gradients: bool = True) -> Rows:
+    def rows(self, mo: Motion, gradients: bool = True, keep: bool = False) -> Rows:
         """All rows at the motion, normalised by their limits (at its durations), built
         :data:`CHUNK` intervals at a time (their temporaries bounded); without
-        ``gradients``, their values only (``C`` and ``sizes`` empty)."""
+        ``gradients``, their values only (``C`` and ``sizes`` empty). With ``keep``, they
+        are kept until the next call, which returns them (and lets them go) if it asks for
+        the same motion (its jerks, durations and knots' states equal) and no more."""
+        kept, self._last = self._last, None
+        if kept is not None and (kept[1].C.shape[0] == kept[1].F.shape[0] or not gradients) \
+                and all(np.array_equal(x, y) for x, y in zip(kept[0], _key(mo), strict=True)):
+            return kept[1]
+        out = self._rows(mo, gradients)
+        if keep:
+            self._last = (_key(mo), out)
+        return out
+
+    def _rows(self, mo: Motion, gradients: bool) -> Rows:
+        """All rows at the motion (:meth:`rows`)."""
         self._grad = gradients
         x0 = self.tangent(mo)
         tab = self.table

@@ -152,13 +152,19 @@ def fractions(start: Start, table: Table, cons: Sequence[Constraint], segments: 
     q1, q2, q3, b = vals[:, Q1], vals[:, Q2], vals[:, Q3], vals[:, B]
     vv, aa = v[:, None], a[:, None]
     parts: list[Array] = []
+    torque: Array | None = None
+    seen: set[tuple[str, tuple[float, ...]]] = set()  # (a part twice changes no maximum)
     for c in cons:
         lim = getattr(c, "max_acceleration", None)
-        if lim is not None:
+        if lim is not None and ("acceleration", tuple(lim)) not in seen:
+            seen.add(("acceleration", tuple(lim)))
             parts.append((q1 * aa + q2 * vv * vv) / np.asarray(lim, float))
         lim = c.torque_limit
-        if lim is not None:
-            parts.append((vals[:, A] * aa + b * vv * vv) / np.asarray(lim, float))
+        if lim is not None and ("torque", tuple(lim)) not in seen:
+            seen.add(("torque", tuple(lim)))
+            if torque is None:
+                torque = vals[:, A] * aa + b * vv * vv
+            parts.append(torque / np.asarray(lim, float))
         if isinstance(c, JerkLimit):
             parts.append((3 * q2 * vv * aa + q3 * vv**3) / np.asarray(c.max_jerk, float))
         wmax = getattr(c, "max_speed", None)
