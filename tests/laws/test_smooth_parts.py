@@ -292,3 +292,14 @@ def test_rows_kept_for_the_same_motion_only(setup):
     np.testing.assert_array_equal(full.F, fresh.F)
     model.rows(mo, gradients=False, keep=True)
     assert model.rows(mo, gradients=False).C.shape[0] == 0
+
+
+@pytest.mark.parametrize("n", [2, 3, 50])
+def test_knot_placement_differences_are_numpy_gradient(n):
+    """start._gradient (the knot placement's differences, without temporaries) is
+    np.gradient along the first axis, ends included; a wrong spacing is not."""
+    f = np.random.default_rng(n).standard_normal((n, 4)) * np.array([1e-6, 1.0, 1e3, 1e8])
+    dx = 0.1 / 3
+    np.testing.assert_allclose(start._gradient(f, dx), np.gradient(f, dx, axis=0),
+                               rtol=1e-14, atol=0)
+    assert not np.allclose(start._gradient(f, 2 * dx), np.gradient(f, dx, axis=0))
