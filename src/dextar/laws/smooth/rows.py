@@ -72,17 +72,25 @@ class Rows:
 
 
 def local(h: Array, k: Array, theta: Array, gs: Array, gw: Array, ga: Array, gj: Array,
-           gT: Array) -> Array:
+           gT: Array) -> tuple[Array, Array]:
     """A row's gradient ``C`` (n, 5) in its interval's ``sigma_k, w_k, alpha_k``, end
     acceleration and duration ``T_k`` (all in the interval's normalisation) from its
     derivatives in the point's ``sigma, w, alpha``, the interval's jerk ``J`` and ``T_k``
-    (each (n,)), the point ``theta`` into the interval ``k``; then those derivatives'
-    sizes (n, 5), for the bound of the row's change in a trust region."""
+    (each (n,)), the point ``theta`` into the interval ``k``; and those derivatives'
+    sizes (n, 5) float32, for the bound of the row's change in a trust region."""
     cJ = gs * theta**3 / 6 + gw * theta**2 / 2 + ga * theta + gj
     ca = gs * theta**2 / 2 + gw * theta + ga
     hk = h[k]
-    return np.stack([gs, gs * theta + gw, ca - cJ / hk, cJ / hk, gT, np.abs(gs), np.abs(gw),
-                     np.abs(ga), np.abs(gj), np.abs(gT)], axis=1)
+    C = np.empty((len(k), 5))
+    C[:, 0] = gs
+    C[:, 1] = gs * theta + gw
+    C[:, 3] = cJ / hk
+    C[:, 2] = ca - C[:, 3]
+    C[:, 4] = gT
+    sizes = np.empty((len(k), 5), np.float32)  # (each cast once, as astype would)
+    for i, g in enumerate((gs, gw, ga, gj, gT)):
+        sizes[:, i] = np.abs(g)
+    return C, sizes
 
 
 def _key(mo: Motion) -> tuple[Array, ...]:
@@ -167,8 +175,7 @@ class RowModel:
         blocks = [b for b in blocks if b]
         if not blocks:
             return np.zeros((0, 5)), np.zeros((0, 5), np.float32)
-        out = local(self.mesh.h, *(np.concatenate([b[i] for b in blocks]) for i in range(7)))
-        return np.ascontiguousarray(out[:, :5]), out[:, 5:].astype(np.float32)
+        return local(self.mesh.h, *(np.concatenate([b[i] for b in blocks]) for i in range(7)))
 
     def _points(self, k0: int, k1: int, m: int) -> tuple[Array, ...]:
         """The points of the intervals ``k0`` to ``k1`` (excluded), the same at every motion
