@@ -303,3 +303,17 @@ def test_knot_placement_differences_are_numpy_gradient(n):
     np.testing.assert_allclose(start._gradient(f, dx), np.gradient(f, dx, axis=0),
                                rtol=1e-14, atol=0)
     assert not np.allclose(start._gradient(f, 2 * dx), np.gradient(f, dx, axis=0))
+
+
+def test_table_values_are_the_segments_values():
+    """table.values_at is segments' values (at a grid point the segment after it, beyond the
+    ends the end segments held), on a table whose segments jump at the grid points."""
+    rng = np.random.default_rng(3)
+    grid = np.cumsum(rng.uniform(0.1, 1.0, 41)) - 0.1
+    lo, hi = rng.standard_normal((40, 6)), rng.standard_normal((40, 6))
+    s = np.concatenate([rng.uniform(grid[0] - 0.5, grid[-1] + 0.5, 300), grid])
+    np.testing.assert_allclose(table.values_at(grid, lo[:, :4], hi[:, :4], s),
+                               table.segments(grid, lo[:, :4], hi[:, :4], s)[0],
+                               rtol=1e-13, atol=1e-13)
+    np.testing.assert_allclose(table.values_at(grid, lo, hi, grid[5:6]), lo[5:6], atol=1e-13)
+    assert not np.allclose(table.values_at(grid, lo, hi, grid[5:6]), hi[4:5])

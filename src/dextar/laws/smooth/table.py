@@ -175,8 +175,12 @@ def values_at(grid: Array, lo: Array, hi: Array, s: Array) -> Array:
     k = np.clip(np.searchsorted(grid, s, side="right") - 1, 0, len(grid) - 2)
     ds = grid[k + 1] - grid[k]
     w = ((np.clip(s, grid[0], grid[-1]) - grid[k]) / ds)[:, None]
-    a = lo[k]
-    return np.asarray(a + (hi[k] - a) * w)
+    a = np.ascontiguousarray(lo)[k]  # (rows gathered from a contiguous table: faster)
+    out = np.ascontiguousarray(hi)[k]
+    out -= a  # a + (b - a) w, in place
+    out *= w
+    out += a
+    return np.asarray(out)
 
 
 def segments(grid: Array, lo: Array, hi: Array, s: Array, before: bool | Array = False
