@@ -268,3 +268,52 @@ def test_the_check_finds_a_peak_between_its_samples(peak, found):
         assert np.flatnonzero(excess).tolist() == [2] and dyn.calls == 2
     else:
         assert ratio["torque"] <= 0.9995 and not excess.any() and dyn.calls == 1
+
+
+def test_rows_kept_for_the_same_motion_only(setup):
+    """Rows kept (time_scaled's last, the SLP's first) are returned once for the same
+    motion, with gradients only if they have them; another motion gets its own rows."""
+    model, me, J, Tk, _ = setup
+    mo = mesh.motion(me, J, Tk, model.length)
+    other = mesh.motion(me, J, Tk * 1.01, model.length)
+    fresh = model.rows(mo)
+    kept = model.rows(mo, keep=True)
+    assert model.rows(mo) is kept  # the same motion: the kept rows
+    assert model.rows(mo) is not kept  # once only
+    model.rows(mo, keep=True)
+    r = model.rows(other)  # another motion: its own rows
+    assert not np.array_equal(r.F, fresh.F)
+    np.testing.assert_array_equal(r.F, model.rows(other).F)
+    lean = model.rows(mo, gradients=False, keep=True)
+    assert lean.C.shape[0] == 0
+    full = model.rows(mo)  # gradients asked: not the lean rows
+    assert full is not lean and full.C.shape == fresh.C.shape
+    np.testing.assert_array_equal(full.C, fresh.C)
+    np.testing.assert_array_equal(full.F, fresh.F)
+    model.rows(mo, gradients=False, keep=True)
+    assert model.rows(mo, gradients=False).C.shape[0] == 0
+
+
+@pytest.mark.parametrize("n", [2, 3, 50])
+def test_knot_placement_differences_are_numpy_gradient(n):
+    """start._gradient (the knot placement's differences, without temporaries) is
+    np.gradient along the first axis, ends included; a wrong spacing is not."""
+    f = np.random.default_rng(n).standard_normal((n, 4)) * np.array([1e-6, 1.0, 1e3, 1e8])
+    dx = 0.1 / 3
+    np.testing.assert_allclose(start._gradient(f, dx), np.gradient(f, dx, axis=0),
+                               rtol=1e-14, atol=0)
+    assert not np.allclose(start._gradient(f, 2 * dx), np.gradient(f, dx, axis=0))
+
+
+def test_table_values_are_the_segments_values():
+    """table.values_at is segments' values (at a grid point the segment after it, beyond the
+    ends the end segments held), on a table whose segments jump at the grid points."""
+    rng = np.random.default_rng(3)
+    grid = np.cumsum(rng.uniform(0.1, 1.0, 41)) - 0.1
+    lo, hi = rng.standard_normal((40, 6)), rng.standard_normal((40, 6))
+    s = np.concatenate([rng.uniform(grid[0] - 0.5, grid[-1] + 0.5, 300), grid])
+    np.testing.assert_allclose(table.values_at(grid, lo[:, :4], hi[:, :4], s),
+                               table.segments(grid, lo[:, :4], hi[:, :4], s)[0],
+                               rtol=1e-13, atol=1e-13)
+    np.testing.assert_allclose(table.values_at(grid, lo, hi, grid[5:6]), lo[5:6], atol=1e-13)
+    assert not np.allclose(table.values_at(grid, lo, hi, grid[5:6]), hi[4:5])

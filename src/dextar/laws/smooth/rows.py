@@ -72,17 +72,30 @@ class Rows:
 
 
 def local(h: Array, k: Array, theta: Array, gs: Array, gw: Array, ga: Array, gj: Array,
-           gT: Array) -> Array:
+           gT: Array) -> tuple[Array, Array]:
     """A row's gradient ``C`` (n, 5) in its interval's ``sigma_k, w_k, alpha_k``, end
     acceleration and duration ``T_k`` (all in the interval's normalisation) from its
     derivatives in the point's ``sigma, w, alpha``, the interval's jerk ``J`` and ``T_k``
-    (each (n,)), the point ``theta`` into the interval ``k``; then those derivatives'
-    sizes (n, 5), for the bound of the row's change in a trust region."""
+    (each (n,)), the point ``theta`` into the interval ``k``; and those derivatives'
+    sizes (n, 5) float32, for the bound of the row's change in a trust region."""
     cJ = gs * theta**3 / 6 + gw * theta**2 / 2 + ga * theta + gj
     ca = gs * theta**2 / 2 + gw * theta + ga
     hk = h[k]
-    return np.stack([gs, gs * theta + gw, ca - cJ / hk, cJ / hk, gT, np.abs(gs), np.abs(gw),
-                     np.abs(ga), np.abs(gj), np.abs(gT)], axis=1)
+    C = np.empty((len(k), 5))
+    C[:, 0] = gs
+    C[:, 1] = gs * theta + gw
+    C[:, 3] = cJ / hk
+    C[:, 2] = ca - C[:, 3]
+    C[:, 4] = gT
+    sizes = np.empty((len(k), 5), np.float32)  # (each cast once, as astype would)
+    for i, g in enumerate((gs, gw, ga, gj, gT)):
+        sizes[:, i] = np.abs(g)
+    return C, sizes
+
+
+def _key(mo: Motion) -> tuple[Array, ...]:
+    """What the rows at a motion depend on (with the row model's mesh, table and limits)."""
+    return (mo.J, mo.Tk, mo.sigma, mo.w, mo.alpha, mo.w_end, mo.alpha_end)
 
 
 class RowModel:
@@ -99,6 +112,8 @@ class RowModel:
         self.t2 = np.concatenate([np.zeros(M - 1), h / 2])
         cap = speed_cap(second, table.co)
         self._grad = True
+        self._kept: dict[tuple[int, int, int], tuple[Array, ...]] = {}
+        self._last: tuple[tuple[Array, ...], Rows] | None = None
         self.root_cap = (None if not np.isfinite(cap).any()
                          else np.sqrt(np.where(np.isfinite(cap), cap, 1e300)))
 
@@ -110,10 +125,23 @@ class RowModel:
         x0 = np.interp(self.table.s, mo.sigma, x)
         return np.asarray(np.maximum(x0, 1e-4 * float(x0.max()) + 1e-300))
 
-    def rows(self, mo: Motion, gradients: bool = True) -> Rows:
+    def rows(self, mo: Motion, gradients: bool = True, keep: bool = False) -> Rows:
         """All rows at the motion, normalised by their limits (at its durations), built
         :data:`CHUNK` intervals at a time (their temporaries bounded); without
-        ``gradients``, their values only (``C`` and ``sizes`` empty)."""
+        ``gradients``, their values only (``C`` and ``sizes`` empty). With ``keep``, they
+        are kept until the next call, which returns them (and lets them go) if it asks for
+        the same motion (its jerks, durations and knots' states equal) and no more."""
+        kept, self._last = self._last, None
+        if kept is not None and (kept[1].C.shape[0] == kept[1].F.shape[0] or not gradients) \
+                and all(np.array_equal(x, y) for x, y in zip(kept[0], _key(mo), strict=True)):
+            return kept[1]
+        out = self._rows(mo, gradients)
+        if keep:
+            self._last = (_key(mo), out)
+        return out
+
+    def _rows(self, mo: Motion, gradients: bool) -> Rows:
+        """All rows at the motion (:meth:`rows`)."""
         self._grad = gradients
         x0 = self.tangent(mo)
         tab = self.table
@@ -133,13 +161,39 @@ class RowModel:
                     tuple(kind for r in parts for kind in r.kinds))
 
     def _loc(self, h: Array, k: Array, theta: Array, gs: Array, gw: Array, ga: Array,
-             gj: Array, gT: Array, keep: Array | None = None) -> Array:
-        """:func:`local` of the rows (those ``keep`` selects), or nothing when the rows are
-        built without their gradients."""
+             gj: Array, gT: Array, keep: Array | None = None) -> list[Array]:
+        """The arguments of :func:`local` after ``h`` for the rows (those ``keep`` selects),
+        or none when the rows are built without their gradients: every block's are joined
+        for one call (:meth:`_gradients`: elementwise, the same as a call per block)."""
         if not self._grad:
-            return np.zeros((0, 10))
-        out = local(h, k, theta, gs, gw, ga, gj, gT)
-        return out if keep is None else out[keep]
+            return []
+        args = [k, theta, gs, gw, ga, gj, gT]
+        return args if keep is None else [a[keep] for a in args]
+
+    def _gradients(self, blocks: list[list[Array]]) -> tuple[Array, Array]:
+        """``C`` (R, 5) and the sizes (R, 5) float32 of the blocks' rows (:meth:`_loc`)."""
+        blocks = [b for b in blocks if b]
+        if not blocks:
+            return np.zeros((0, 5)), np.zeros((0, 5), np.float32)
+        return local(self.mesh.h, *(np.concatenate([b[i] for b in blocks]) for i in range(7)))
+
+    def _points(self, k0: int, k1: int, m: int) -> tuple[Array, ...]:
+        """The points of the intervals ``k0`` to ``k1`` (excluded), the same at every motion
+        (kept): the second-order rows' intervals and offsets, each repeated for the ``m``
+        rows at a point; the intervals; the third-order rows' intervals, offsets and which
+        are at an interval's end."""
+        key = (k0, k1, m)
+        if key not in self._kept:
+            in2 = (self.k2 >= k0) & (self.k2 < k1)
+            k, th = self.k2[in2], self.t2[in2]
+            kM = np.arange(k0, k1)
+            n1 = k1 - k0
+            h = self.mesh.h
+            self._kept[key] = (k, th, np.repeat(k, m), np.repeat(th, m), kM,
+                               np.concatenate([kM, kM, kM]),
+                               np.concatenate([np.zeros(n1), h[kM] / 2, h[kM]]),
+                               np.arange(3 * n1) >= 2 * n1)
+        return self._kept[key]
 
     def _block(self, mo: Motion, pr: PointRows, finite: Array, phmax: float, k0: int,
                k1: int) -> Rows:
@@ -147,19 +201,20 @@ class RowModel:
         mesh, tab, S = self.mesh, self.table, self.length
         h = mesh.h
         m = pr.pu.shape[1]
-        in2 = (self.k2 >= k0) & (self.k2 < k1)
-        k, th = self.k2[in2], self.t2[in2]
+        k, th, kk, tt, kM, k3, th3, end3 = self._points(k0, k1, m)
         sig, w, al = mo.at(mesh, k, th)
-        vals, slopes = interp(tab.s, np.concatenate([pr.pu, pr.px, np.where(finite, pr.ph,
-                                                                             0.0)], axis=1),
-                               sig)
-        pu, px, ph = vals[:, :m], vals[:, m:2 * m], vals[:, 2 * m:]
-        dpu, dpx, dph = slopes[:, :m], slopes[:, m:2 * m], slopes[:, 2 * m:]
-        keep = (interp(tab.s, finite.astype(float), sig)[0] > 1 - 1e-12).reshape(-1)
+        # the rows' coefficients, whether each is finite, and the speed cap's root: one
+        # interpolation (each column's arithmetic as apart)
+        cols = [pr.pu, pr.px, np.where(finite, pr.ph, 0.0), finite.astype(float)]
+        if self.root_cap is not None:
+            cols.append(self.root_cap[:, None])
+        vals, slopes = interp(tab.s, np.concatenate(cols, axis=1), sig)
+        pu, px, ph = vals[:, :m], vals[:, m:2 * m], vals[:, 2 * m:3 * m]
+        dpu, dpx, dph = slopes[:, :m], slopes[:, m:2 * m], slopes[:, 2 * m:3 * m]
+        keep = (vals[:, 3 * m:4 * m] > 1 - 1e-12).reshape(-1)
         a_, w_, T = al[:, None], w[:, None], mo.Tk[k][:, None]
         c = np.maximum(np.abs(ph), 1e-9 * phmax + 1e-300) * T * T
         F = (pu * a_ + px * w_ * w_ - ph * T * T) / c
-        kk, tt = np.repeat(k, m), np.repeat(th, m)
         zero = np.zeros(len(kk))
 
         def flat(v: Array) -> Array:
@@ -172,8 +227,7 @@ class RowModel:
         Fs, ks, names = [flat(F)[keep]], [kk[keep]], ["second-order"]
         n2 = len(k)
         if self.root_cap is not None:  # w <= sqrt(cap) T
-            rv, rs = interp(tab.s, self.root_cap[:, None], sig)
-            rv, rs = rv[:, 0], rs[:, 0]
+            rv, rs = vals[:, 4 * m], slopes[:, 4 * m]
             T = mo.Tk[k]
             c2 = np.maximum(rv, 1e-300) * T
             Fc = (w - rv * T) / c2
@@ -191,38 +245,33 @@ class RowModel:
         names.append("w>=0")
         # the third-order rows at every interval's start, middle and end (at its end, the
         # table's segment before the point), all at once
-        kM = np.arange(k0, k1)
-        n1 = k1 - k0
-        k3 = np.concatenate([kM, kM, kM])
-        th3 = np.concatenate([np.zeros(n1), h[kM] / 2, h[kM]])
         sig, w, al = mo.at(mesh, k3, th3)
-        v, d = tab.at(sig, np.arange(3 * n1) >= 2 * n1)
+        v, d = tab.at(sig, end3)
         F3, C3, kk3, n3 = self._third_at(mo, k3, th3, v, d, w, al)
         norms.append(n3)
         Fs.append(F3)
-        Cs.append(C3)
+        Cs.extend(C3)
         ks.append(kk3)
         names.append("third")
-        C = np.concatenate([c[:, :5] for c in Cs])
-        sizes = np.concatenate([c[:, 5:].astype(np.float32) for c in Cs])
+        C, sizes = self._gradients(Cs)
         del Cs
         return Rows(np.concatenate(Fs), np.concatenate(ks).astype(np.int32), C,
                     np.concatenate(norms), sizes,
                     tuple((n, len(f)) for n, f in zip(names, Fs, strict=True)))
 
     def _third_at(self, mo: Motion, k: Array, theta: Array, v: Array, d: Array, w: Array,
-                  al: Array) -> tuple[Array, Array, Array, Array]:
+                  al: Array) -> tuple[Array, list[list[Array]], Array, Array]:
         """The joint jerk and torque-rate rows, on both sides of each limit, at offsets
         ``theta`` into the intervals ``k`` (n,), with the table's columns ``v`` and slopes
-        ``d`` (n, 18) and the states ``w, al`` (n,) there: rows, gradients, intervals,
-        normalisations."""
+        ``d`` (n, 18) and the states ``w, al`` (n,) there: rows, their gradients' arguments
+        (:meth:`_loc`), intervals, normalisations."""
         T = mo.Tk[k][:, None]
         h = self.mesh.h
         q1, q2, q3 = v[:, Q1], v[:, Q2], v[:, Q3]
         dq1, dq2, dq3 = d[:, Q1], d[:, Q2], d[:, Q3]
         jj, ww, aa = mo.J[k][:, None], w[:, None], al[:, None]
         Fs: list[Array] = []
-        Cs: list[Array] = []
+        Cs: list[list[Array]] = []
         Ns: list[Array] = []
         for c in self.third:
             if isinstance(c, JerkLimit):
@@ -264,13 +313,12 @@ class RowModel:
                 Fs.append(((sign * val - scale) / scale).reshape(-1))
                 Ns.append(np.broadcast_to(scale, val.shape).reshape(-1))
                 if not self._grad:
-                    Cs.append(np.zeros((0, 10)))
                     continue
                 g_s, g_w, g_a, g_j = ((sign * x / scale).reshape(-1) for x in (gs, gw, ga, gj))
                 Cs.append(self._loc(h, kk, tt, g_s, g_w, g_a, g_j,
                                     ((sign * gT - 3 * lim * T * T) / scale).reshape(-1)))
         if not Fs:
-            return np.zeros(0), np.zeros((0, 10)), np.zeros(0, int), np.zeros(0)
+            return np.zeros(0), [], np.zeros(0, int), np.zeros(0)
         n = len(Fs)
-        return (np.concatenate(Fs), np.concatenate(Cs), np.tile(np.repeat(k, 2), n),
+        return (np.concatenate(Fs), Cs, np.tile(np.repeat(k, 2), n),
                 np.concatenate(Ns))

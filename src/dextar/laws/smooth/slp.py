@@ -267,8 +267,13 @@ def time_scaled(model: RowModel, J: Array, Tk: Array) -> Array:
     where it does, so a few rounds, then stretching while a row is still beyond its limit
     (gravity or friction rows that scale more slowly)."""
     Tk = np.asarray(Tk, float)
+    # the rows of the motion it returns are the first programme's (:func:`slp`): kept, with
+    # their gradients, when the last factor was near 1 (likely the last round; the same rows
+    # without gradients cost nearly as much)
+    last = np.inf
     for _ in range(40):
-        rows = model.rows(motion(model.mesh, J, Tk, model.length), gradients=False)
+        near = abs(last - 1.0) < 0.1 and model.mesh.M <= TRIAL_GRADIENTS
+        rows = model.rows(motion(model.mesh, J, Tk, model.length), gradients=near, keep=near)
         i = int(np.argmax(rows.F))
         worst = float(rows.F[i])
         p = rows.powers()
@@ -282,6 +287,7 @@ def time_scaled(model: RowModel, J: Array, Tk: Array) -> Array:
                 break  # a row the duration does not change
             factor = max(factor, 1.5)
         Tk = Tk * (factor * (1 + 1e-4))
+        last = factor
     return Tk
 
 

@@ -27,8 +27,7 @@ from ..constraints import (
     TorqueRateLimit,
 )
 from .mesh import Mesh, make_mesh, projected
-from .table import DB, DG, Q1, Q2, Q3, A, B, Table
-from .table import segments as linear_in
+from .table import DB, DG, Q1, Q2, Q3, A, B, Table, values_at
 
 
 def jumps(base: Any) -> tuple[Array, Array]:
@@ -149,17 +148,23 @@ def fractions(start: Start, table: Table, cons: Sequence[Constraint], segments: 
     ``sqrt(c / (32 tol))`` intervals per unit time."""
     t, s, v, a = start.t, start.s, start.v, start.a
     used = max(c.stop for c in (Q1, Q2, Q3, A, B))  # (the columns it needs, first)
-    vals = linear_in(table.s, table.lo[:, :used], table.hi[:, :used], s)[0]
+    vals = values_at(table.s, table.lo[:, :used], table.hi[:, :used], s)
     q1, q2, q3, b = vals[:, Q1], vals[:, Q2], vals[:, Q3], vals[:, B]
     vv, aa = v[:, None], a[:, None]
     parts: list[Array] = []
+    torque: Array | None = None
+    seen: set[tuple[str, tuple[float, ...]]] = set()  # (a part twice changes no maximum)
     for c in cons:
         lim = getattr(c, "max_acceleration", None)
-        if lim is not None:
+        if lim is not None and ("acceleration", tuple(lim)) not in seen:
+            seen.add(("acceleration", tuple(lim)))
             parts.append((q1 * aa + q2 * vv * vv) / np.asarray(lim, float))
         lim = c.torque_limit
-        if lim is not None:
-            parts.append((vals[:, A] * aa + b * vv * vv) / np.asarray(lim, float))
+        if lim is not None and ("torque", tuple(lim)) not in seen:
+            seen.add(("torque", tuple(lim)))
+            if torque is None:
+                torque = vals[:, A] * aa + b * vv * vv
+            parts.append(torque / np.asarray(lim, float))
         if isinstance(c, JerkLimit):
             parts.append((3 * q2 * vv * aa + q3 * vv**3) / np.asarray(c.max_jerk, float))
         wmax = getattr(c, "max_speed", None)
@@ -168,16 +173,26 @@ def fractions(start: Start, table: Table, cons: Sequence[Constraint], segments: 
             span = np.asarray(wmax, float) - (0.0 if knee is None else np.asarray(knee))
             parts.append(q1 * vv / span)
     dt = t[1] - t[0]
-    c2 = np.zeros_like(t)
-    for p in parts:
-        c2 = np.maximum(c2, np.abs(np.gradient(np.gradient(p, dt, axis=0), dt,
-                                               axis=0)).max(axis=1))
+    # every part's columns side by side: one pair of differences (the same per column)
+    c2 = (np.abs(_gradient(_gradient(np.concatenate(parts, axis=1), dt), dt))
+          .max(axis=1, initial=0.0) if parts else np.zeros_like(t))
     density = np.maximum(np.sqrt(c2 / (32 * tol)), segments / start.T)
     cdf = np.concatenate([[0.0], np.cumsum(0.5 * (density[1:] + density[:-1]) * dt)])
     M = max(segments, int(np.ceil(cdf[-1])))
     f = np.interp(np.linspace(0.0, cdf[-1], M + 1), cdf, t / start.T)
     f[0], f[-1] = 0.0, 1.0
     return np.asarray(f)
+
+
+def _gradient(f: Array, dx: float) -> Array:
+    """``np.gradient(f, dx, axis=0)`` (central differences inside, one-sided at the ends:
+    the same operations, so the same bits) without its temporaries."""
+    out = np.empty_like(f)
+    np.subtract(f[2:], f[:-2], out=out[1:-1])
+    out[1:-1] /= 2.0 * dx
+    out[0] = (f[1] - f[0]) / dx
+    out[-1] = (f[-1] - f[-2]) / dx
+    return out
 
 
 def pinned(f: Array, start: Start, joints: Array) -> Mesh:

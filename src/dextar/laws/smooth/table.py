@@ -169,6 +169,20 @@ def interp(grid: Array, values: Array, s: Array) -> tuple[Array, Array]:
     return segments(grid, values[:-1], values[1:], s)
 
 
+def values_at(grid: Array, lo: Array, hi: Array, s: Array) -> Array:
+    """:func:`segments`' values alone (n, p) (at a grid point the segment after it): the
+    same arithmetic, without the slopes."""
+    k = np.clip(np.searchsorted(grid, s, side="right") - 1, 0, len(grid) - 2)
+    ds = grid[k + 1] - grid[k]
+    w = ((np.clip(s, grid[0], grid[-1]) - grid[k]) / ds)[:, None]
+    a = np.ascontiguousarray(lo)[k]  # (rows gathered from a contiguous table: faster)
+    out = np.ascontiguousarray(hi)[k]
+    out -= a  # a + (b - a) w, in place
+    out *= w
+    out += a
+    return np.asarray(out)
+
+
 def segments(grid: Array, lo: Array, hi: Array, s: Array, before: bool | Array = False
              ) -> tuple[Array, Array]:
     """Linear on each segment from ``lo`` to ``hi`` (N, p): the values at ``s`` (n,) and the
