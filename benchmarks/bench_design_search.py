@@ -65,7 +65,7 @@ TASKS = {
              "objectives": ["peak_torque_A_Nm", "footprint_mm", "-gci"]}),
 }
 POPULATION = 20  # the shipped default ([design].population)
-CHUNK = 8
+CHUNK = 4
 DENSE = {"program": 4096, "run": 8192}
 
 

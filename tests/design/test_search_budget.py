@@ -76,3 +76,19 @@ def test_smsemoa_makes_progress_on_the_toy_where_a_sweep_of_as_many_does_not(mon
         sobol = [_toy.toy_row(x, i) for i, x in enumerate(sweep.designs())]
         assert hypervolume(objectives_and_violation(sweep, sobol)[0], np.zeros(2),
                            np.ones(2)) < 0.72 * ref
+
+
+def test_a_search_keeps_five_batches_in_flight_by_default(tmp_path):
+    """At [design].chunk = 8 a search of population 20 had 2 batches in flight and 2 workers
+    waited at each batch's return (efficiency 0.71; at chunk 4, five in flight: 0.87-0.93,
+    benchmarks/bench_design_search.py): a search's default chunk is 4, a sweep's stays 8,
+    and a chunk written in the file is kept."""
+    def design(text):
+        return load_scenario(write_task(tmp_path, design="[design]\nl = [50.0, 120.0]\n"
+                                        + text)).design
+
+    search = design('search = "smsemoa"\n').search()
+    assert search is not None and search.batch == 4 and search.in_flight == 5
+    assert design('search = "nsga2"\n').search().in_flight == 5
+    assert design("samples = 16\n").chunk == 8
+    assert design('search = "smsemoa"\nchunk = 8\n').search().in_flight == 2

@@ -36,6 +36,9 @@ COUNTERWEIGHT_KEYS = {"counterweight_mass": (5, 6), "counterweight_mass1": (5,),
 #: Objectives when ``[design].objectives`` is not given.
 DEFAULT_OBJECTIVES = ("cycle_time_s", "footprint_mm", "-min_type2_distance")
 
+#: Designs per unit of work by default: a sweep's, a search's (:attr:`DesignTable.chunk`).
+SWEEP_CHUNK, SEARCH_CHUNK = 8, 4
+
 
 def _range(what: str) -> Param:
     return Param("point", "", None, f"range [low, high] of {what}, mm")
@@ -70,8 +73,10 @@ class DesignTable(Table):
         "seed": Param("integer", "", 0, "seed of the sampling and of the search", minimum=0,
                       maximum=2**31 - 1),
         "objectives": Param("text", "", None, "metrics to minimise (a leading - maximises)"),
-        "chunk": Param("integer", "", 8, "designs per unit of work (a search proposes as many "
-                       "at a time)", minimum=1, maximum=10_000),
+        "chunk": Param("integer", "", None, "designs per unit of work (a search proposes as "
+                       "many at a time): default 8 for a sweep, 4 for a search (5 batches in "
+                       "flight at the population of 20: two workers kept busy)", minimum=1,
+                       maximum=10_000),
         "grid": Param("integer", "", 100, "time-optimal segments per motion in the sweep",
                       minimum=10, maximum=100_000),
         "counterweight_mass": Param("point", "", None, "range [low, high] of both proximal "
@@ -230,8 +235,14 @@ class DesignTable(Table):
 
     @property
     def chunk(self) -> int:
-        """Designs per unit of work."""
-        return int((self.values or {}).get("chunk", 8))
+        """Designs per unit of work: ``[design].chunk``, else 8 for a sweep and 4 for a search
+        (batches in flight are ``population // chunk``: at 8, two, and a worker of two waited
+        at each batch's return: 2-worker efficiency 0.71; at 4, five: 0.87, program task,
+        benchmarks/bench_design_search.py)."""
+        c = (self.values or {}).get("chunk")
+        if c is not None:
+            return int(c)
+        return SEARCH_CHUNK if self.search_kind in SEARCHES else SWEEP_CHUNK
 
     @property
     def grid(self) -> int:
