@@ -9,7 +9,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
-from ..design.search import SEARCHES, SearchSettings
+from ..design.search import BATCH, SEARCHES, SearchSettings
 from ..design.space import (
     COUNTERWEIGHTS,
     LENGTHS,
@@ -37,7 +37,7 @@ COUNTERWEIGHT_KEYS = {"counterweight_mass": (5, 6), "counterweight_mass1": (5,),
 DEFAULT_OBJECTIVES = ("cycle_time_s", "footprint_mm", "-min_type2_distance")
 
 #: Designs per unit of work by default: a sweep's, a search's (:attr:`DesignTable.chunk`).
-SWEEP_CHUNK, SEARCH_CHUNK = 8, 4
+SWEEP_CHUNK, SEARCH_CHUNK = 8, BATCH
 
 
 def _range(what: str) -> Param:

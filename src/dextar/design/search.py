@@ -69,6 +69,11 @@ pymoo_hv = lazy_module("pymoo.indicators.hv")
 
 Row = dict[str, Any]
 
+#: Designs a search proposes at a time by default (``[design].chunk``): five batches in
+#: flight at the default population of 20, which keep two workers busy (at 8, two batches:
+#: 2-worker efficiency 0.71 against 0.87-0.93, benchmarks/bench_design_search.py).
+BATCH = 4
+
 #: The adaptive searches (``[design] search``), beside the sweeps' samplings: NSGA-II
 #: (survival by non-dominated rank and crowding distance) and SMS-EMOA (survival by rank and
 #: each design's exclusive contribution to the hypervolume).
@@ -122,7 +127,7 @@ class SearchSettings:
     population: int = 20
     evaluations: int = 2000
     seed: int = 0
-    batch: int = 8
+    batch: int = BATCH
     lag: int | None = None
     chunk: int | None = None
 

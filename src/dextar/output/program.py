@@ -296,6 +296,8 @@ def moves_figure(res: ProgramResult, robot_mm: FiveBar, mode: str) -> Figure:
     lo, hi = pts.min(axis=0) - 0.35 * span, pts.max(axis=0) + 0.35 * span  # the moves' region
     changes = mode_changes(res, mode)
     crossings = crossing_points(res)
+    title = (f"Program: {len(res.move_types) or len(res.moves)} moves, cycle "
+             f"{res.cycle_time_s:.3f} s")
     for ax, (m, inside) in zip(axes[:n], spans.items(), strict=True):
         ws = workspace_map(robot_mm, m, resolution=241)
         path = pts if n == 1 else np.where(inside[:, None], pts, np.nan)
@@ -307,8 +309,6 @@ def moves_figure(res: ProgramResult, robot_mm: FiveBar, mode: str) -> Figure:
         ax.set_xlim(lo[0], hi[0])
         ax.set_ylim(lo[1], hi[1])
         _number_moves(ax, res, inside if n > 1 else np.ones(len(res.t), bool), span)
-        title = (f"Program: {len(res.move_types) or len(res.moves)} moves, cycle "
-                 f"{res.cycle_time_s:.3f} s")
         if n == 1:
             ax.set_title(f"{title} (working mode at the start: {mode})", fontsize=10)
         else:
