@@ -88,6 +88,19 @@ class Rows:
                           + C[:, 4] * d_T[k])
 
 
+def compiled_monitor(grid: Array, lo: Array, hi: Array, s: Array, v: Array, a: Array,
+                     kinds: Sequence[float], lims: Sequence[Array], dt: float
+                     ) -> Array | None:
+    """:func:`.start.fractions`' monitor by the compiled rows (``monitor`` of _rows.c, the
+    same arithmetic as its numpy code), or None where they are not used."""
+    if not (USE_COMPILED and _compiled is not None and len(s) >= 2 and len(kinds)):
+        return None
+    out = np.empty(len(s))
+    _compiled.monitor(*(np.ascontiguousarray(x, dtype=float) for x in (
+        grid, lo, hi, s, v, a, kinds, np.concatenate(lims))), float(dt), out)
+    return out
+
+
 def local(h: Array, k: Array, theta: Array, gs: Array, gw: Array, ga: Array, gj: Array,
            gT: Array) -> tuple[Array, Array]:
     """A row's gradient ``C`` (n, 5) in its interval's ``sigma_k, w_k, alpha_k``, end

@@ -26,8 +26,8 @@ from ..constraints import (
     PathCoefficients,
     TorqueRateLimit,
 )
-from . import rows as _rows
 from .mesh import Mesh, make_mesh, projected
+from .rows import compiled_monitor
 from .table import DB, DG, Q1, Q2, Q3, A, B, Table, values_at
 
 
@@ -187,11 +187,8 @@ def _monitor(table: Table, s: Array, v: Array, a: Array, kinds: list[float],
     1 the torques without friction ``a_ a + b v^2``, 2 the joint jerks from the path's
     curvature ``3 q'' v a + q''' v^3``, 3 the joint speeds ``q' v``) over their limits
     ``lims`` (2, each); compiled where built (_rows.c: the same arithmetic)."""
-    if _rows.USE_COMPILED and _rows._compiled is not None and len(s) >= 2 and kinds:
-        out = np.empty(len(s))
-        _rows._compiled.monitor(*(np.ascontiguousarray(x, dtype=float) for x in (
-            table.s, table.lo, table.hi, s, v, a, kinds, np.concatenate(lims))),
-            float(dt), out)
+    out = compiled_monitor(table.s, table.lo, table.hi, s, v, a, kinds, lims, dt)
+    if out is not None:
         return out
     used = max(c.stop for c in (Q1, Q2, Q3, A, B))  # (the columns it needs, first)
     vals = values_at(table.s, table.lo[:, :used], table.hi[:, :used], s)
