@@ -96,8 +96,9 @@ def compiled_monitor(grid: Array, lo: Array, hi: Array, s: Array, v: Array, a: A
     if not (USE_COMPILED and _compiled is not None and len(s) >= 2 and len(kinds)):
         return None
     out = np.empty(len(s))
-    _compiled.monitor(*(np.ascontiguousarray(x, dtype=float) for x in (
-        grid, lo, hi, s, v, a, kinds, np.concatenate(lims))), float(dt), out)
+    g, lo, hi, s, v, a, k, lim = (np.ascontiguousarray(x, dtype=float) for x in (
+        grid, lo, hi, s, v, a, kinds, np.concatenate(lims)))
+    _compiled.monitor(g, lo, hi, s, v, a, k, lim, float(dt), out)
     return out
 
 
