@@ -97,7 +97,7 @@ def compiled_monitor(grid: Array, lo: Array, hi: Array, s: Array, v: Array, a: A
         return None
     out = np.empty(len(s))
     g, lo, hi, s, v, a, k, lim = (np.ascontiguousarray(x, dtype=float) for x in (
-        grid, lo, hi, s, v, a, kinds, np.concatenate(lims)))
+        grid, lo, hi, s, v, a, kinds, np.concatenate([np.broadcast_to(x, (2,)) for x in lims])))
     _compiled.monitor(g, lo, hi, s, v, a, k, lim, float(dt), out)
     return out
 
