@@ -9,7 +9,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from dextar.laws.constraints import motor_constraints
+from dextar.laws.constraints import PointRows, Tangent, motor_constraints, point_rows
 from dextar.laws.smooth import mesh, rows, solve, start
 from dextar.motors import MotorLimits
 
@@ -130,24 +130,99 @@ def test_the_compiled_monitor_places_the_numpy_knots(chain, monkeypatch):  # noq
         np.testing.assert_allclose(f_compiled, f_numpy, rtol=0, atol=1e-12)
 
 
-def test_the_compiled_rows_refuse_inconsistent_sizes(setup):  # noqa: F811
-    """Arrays of the wrong sizes are a ValueError (never a read past an array's end)."""
+def test_the_compiled_rows_leave_out_the_rows_without_a_limit(setup, monkeypatch):  # noqa: F811
+    """Where a second-order row's limit is not finite (a column ``ph`` of +-inf or NaN at
+    some grid points), its rows there are left out, by the compiled rows as by numpy's,
+    in a block from the first interval and in one past it."""
+    needs_build()
+    model, _, J, Tk, _ = setup
+    mo = motions(model, J, Tk)[1]
+    pr = point_rows(model.second, Tangent(model.table.moving, np.concatenate(
+        [model.tangent(mo)[:1], model.tangent(mo), model.tangent(mo)[-1:]])))
+    ph = pr.ph[1:-1].copy()
+    ph[40:60, 1], ph[100:103, 2], ph[150, 0] = np.inf, -np.inf, np.nan
+    pr = PointRows(pr.pu[1:-1], pr.px[1:-1], ph)
+    finite = np.isfinite(pr.ph)
+    phmax = float(np.abs(np.where(finite, pr.ph, 0.0)).max(initial=0.0))
+    m, M = pr.pu.shape[1], model.mesh.M
+    for k0, k1 in ((0, M), (5, 17)):
+        out = []
+        for compiled in (False, True):
+            monkeypatch.setattr(rows, "USE_COMPILED", compiled)
+            model._grad = True
+            out.append(model._block(mo, pr, finite, phmax, k0, k1))
+        assert_same(*out)
+        n2 = (k1 - max(k0, 1)) + (k1 - k0)
+        assert dict(out[1].kinds)["second-order"] < n2 * m  # some were left out
+
+
+@pytest.mark.parametrize("kinds", [[0.0], [1.0], [2.0], [3.0], [0.0, 1.0, 2.0, 3.0]])
+def test_the_compiled_monitor_is_the_numpy_monitor(chain, kinds, monkeypatch):  # noqa: F811
+    """Each part of the knots' monitor (a joint acceleration, a torque, a joint jerk, a
+    speed) and all of them at once, on the chain's start: the same values."""
+    needs_build()
+    dyn, path = chain
+    from .test_smooth_parts import grid
+
+    tab = solve.make_table(dyn, grid(path))
+    cons = motor_constraints(RATE)
+    second = [c for c in cons if c.order == 2]
+    base = solve._second_order(dyn, tab, second, None)
+    st = solve._start(dyn, tab, second, [c for c in cons if c.order == 3], base, None)
+    lims = [np.array([3.0, 5.0]) * (i + 1) for i in range(len(kinds))]
+    dt = float(st.t[1] - st.t[0])
+    out = []
+    for compiled in (False, True):
+        monkeypatch.setattr(rows, "USE_COMPILED", compiled)
+        out.append(start._monitor(tab, st.s, st.v, st.a, kinds, lims, dt))
+    assert np.abs(out[0]).max() > 0
+    np.testing.assert_allclose(out[1], out[0], rtol=1e-12, atol=1e-12 * np.abs(out[0]).max())
+
+
+@pytest.mark.parametrize("bad", ["fric", "F", "norm", "k", "C", "sizes", "k1", "m"])
+def test_the_compiled_rows_refuse_inconsistent_sizes(setup, bad):  # noqa: F811
+    """Arrays of the wrong sizes (an output one row short, a block past the mesh, a number
+    of columns whose products would overflow) are a ValueError, never a read or a write
+    past an array's end; a wrong dtype is a TypeError."""
     needs_build()
     assert rows._compiled is not None
     model, _, J, Tk, tab = setup
     mo = mesh.motion(model.mesh, J, Tk, model.length)
-    z = np.zeros(4)
-    out = np.zeros(10), np.zeros(10), np.zeros((10, 5))
-    k, sizes = np.zeros(10, np.int32), np.zeros((10, 5), np.float32)
+    M, m = model.mesh.M, 4
+    kinds, lims, fric = model._third_spec
+    R = (2 * M - 1) * (m + 1) + 12 * M * len(kinds)  # the rows of the whole mesh
+    short = {name: (R - 1 if bad == name else R) for name in ("F", "norm", "k", "C", "sizes")}
+    pcols = np.zeros((len(tab.s), 4 * m))
+    pcols[:, 3 * m:] = 1.0  # every limit finite: every row kept
+    args = dict(pcols=pcols, fric=fric[:4] if bad == "fric" else fric,
+                F=np.zeros(short["F"]), norm=np.zeros(short["norm"]),
+                C=np.zeros((short["C"], 5)), k=np.zeros(short["k"], np.int32),
+                sizes=np.zeros((short["sizes"], 5), np.float32),
+                m=2**62 + 1 if bad == "m" else m, k1=M + 1 if bad == "k1" else M)
+
+    def call(**kw):
+        a = {**args, **kw}
+        return rows._compiled.block(tab.s, a["pcols"], tab.lo, tab.hi, model.mesh.h, mo.J,
+                                    mo.Tk, mo.sigma, mo.w, mo.alpha, kinds, lims, a["fric"],
+                                    a["F"], a["norm"], a["C"], a["k"], a["sizes"], a["m"], 0,
+                                    0, a["k1"], 1e-300, model.length, -1.0 / model.length,
+                                    True)
+
     with pytest.raises(ValueError, match="inconsistent"):
-        rows._compiled.block(tab.s, np.zeros((len(tab.s), 5)), tab.lo, tab.hi,
-                             model.mesh.h, mo.J, mo.Tk, mo.sigma, mo.w, mo.alpha, z[:1], z[:2],
-                             z[:4], *out, k, sizes, 1, 1, 0, model.mesh.M, 1e-300, 1.0, -1.0,
-                             True)
+        call()
+    good = {**args, "fric": fric, "m": m, "k1": M, "F": np.zeros(R), "norm": np.zeros(R),
+            "C": np.zeros((R, 5)), "k": np.zeros(R, np.int32),
+            "sizes": np.zeros((R, 5), np.float32)}
+    assert sum(call(**good)) == R  # (the same call with every size right)
     with pytest.raises(TypeError, match="int32"):
-        rows._compiled.block(tab.s, np.zeros((len(tab.s), 5)), tab.lo, tab.hi,
-                             model.mesh.h, mo.J, mo.Tk, mo.sigma, mo.w, mo.alpha, z[:1], z[:2],
-                             np.zeros(5), *out, np.zeros(10), sizes, 1, 1, 0, 1, 1e-300, 1.0,
-                             -1.0, True)
+        call(**{**good, "k": np.zeros(R)})
+
+
+def test_the_compiled_monitor_refuses_inconsistent_sizes(setup):  # noqa: F811
+    """The monitor's arrays of the wrong sizes are a ValueError."""
+    needs_build()
+    assert rows._compiled is not None
+    tab = setup[4]
+    z = np.zeros(4)
     with pytest.raises(ValueError, match="inconsistent"):
         rows._compiled.monitor(tab.s, tab.lo, tab.hi, z, z, z[:3], z[:1], z[:2], 0.1, z)

@@ -28,7 +28,7 @@ modules, in the order of the solve:
   f_qdot (q' alpha + q'' w^2) T <= r_max T^3``, each normalised by its limit, linearised
   about the current motion in every variable (the states, the arc length at which the
   coefficients are taken, and ``T``); built compiled where the install built it
-  (``_rows.c``, the same bits as its numpy code).
+  (``_rows.c``, its numpy code's arithmetic in the same order).
 * :mod:`.slp`: each linear programme minimises ``T`` plus an exact penalty on the rows
   within a trust region; its variables are the states at the knots, ``T`` and the slack,
   its equalities the exact integration, so it is banded.

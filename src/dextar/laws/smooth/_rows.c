@@ -53,7 +53,8 @@
 #define CDB 14
 #define CDG 16
 
-/* numpy's maximum and clip (a NaN propagates) */
+/* numpy's maximum and clip where a NaN propagates (a tie of signed zeros, which numpy gives
+ * as +0, is not met by the callers: a floor above zero, a magnitude against a maximum) */
 static double np_max(double a, double b)
 {
     return (a >= b || isnan(a)) ? a : b;
@@ -139,7 +140,9 @@ static int get_buffer4(PyObject *obj, Py_buffer *view, char code, const char *na
     if (PyObject_GetBuffer(obj, view, flags) < 0)
         return -1;
     size_t n = view->format == NULL ? 0 : strlen(view->format);
-    if (view->itemsize != 4 || n == 0 || view->format[n - 1] != code) {
+    char got = n == 0 ? '\0' : view->format[n - 1];
+    /* (a 4-byte C long is numpy's int32 on some platforms) */
+    if (view->itemsize != 4 || !(got == code || (code == 'i' && got == 'l'))) {
         PyErr_Format(PyExc_TypeError, "%s must hold %s values", name,
                      code == 'i' ? "int32" : "float32");
         PyBuffer_Release(view);
@@ -180,15 +183,22 @@ static PyObject *block(PyObject *self, PyObject *args)
     held_z = 1;
     {
         Py_ssize_t n1 = v[0].len / 8, M = v[4].len / 8, nc = v[10].len / 8;
+        /* the sizes the rows need, bounded before any product (no overflow: m is at most
+         * a quarter of pcols' values, the blocks within the mesh, fewer than 1e15 rows) */
+        if (n1 < 2 || m < 0 || m > v[1].len / 8 / 4 || k0 < 0 || k1 > M || k1 < k0
+            || (double)(2 * (k1 - k0)) * (double)(m + 2) + 12.0 * (double)(k1 - k0) * nc
+                   > 1e15) {
+            PyErr_SetString(PyExc_ValueError, "block: inconsistent array sizes");
+            goto done;
+        }
         Py_ssize_t P = 4 * m + (has_cap ? 1 : 0);
         Py_ssize_t inner = k1 - (k0 > 1 ? k0 : 1), nint = k1 - k0;
         Py_ssize_t n2 = (inner > 0 ? inner : 0) + nint, n3 = 3 * nint;
         Py_ssize_t rmax = n2 * m + (has_cap ? n2 : 0) + n2 + 4 * n3 * nc;
-        if (n1 < 2 || m < 0 || v[1].len / 8 != n1 * P || v[2].len / 8 != (n1 - 1) * NCOL
+        if (v[1].len / 8 != n1 * P || v[2].len / 8 != (n1 - 1) * NCOL
             || v[3].len / 8 != (n1 - 1) * NCOL || v[5].len / 8 != M || v[6].len / 8 != M
             || v[7].len / 8 != M + 1 || v[8].len / 8 != M + 1 || v[9].len / 8 != M + 1
-            || v[11].len / 8 != 2 * nc || v[12].len / 8 != 5 || k0 < 0 || k1 > M
-            || k1 < k0 || v[13].len / 8 < rmax || v[14].len / 8 < rmax
+            || v[11].len / 8 != 2 * nc || v[12].len / 8 != 5 || v[13].len / 8 < rmax || v[14].len / 8 < rmax
             || kv.len / 4 < rmax || (grad && (v[15].len / 8 < 5 * rmax
                                               || zv.len / 4 < 5 * rmax))) {
             PyErr_SetString(PyExc_ValueError, "block: inconsistent array sizes");
@@ -354,7 +364,7 @@ static PyObject *monitor(PyObject *self, PyObject *args)
     Py_ssize_t nc = n1 >= 2 ? b[1].len / 8 / (n1 - 1) : 0, p = 2 * np_;
     if (n1 < 2 || nc < 10 || b[1].len / 8 != (n1 - 1) * nc || b[2].len != b[1].len
         || b[4].len / 8 != n || b[5].len / 8 != n || b[7].len / 8 != p || b[8].len / 8 != n
-        || n < 2) {
+        || n < 2 || (double)n * (double)p > 1e15) {
         PyErr_SetString(PyExc_ValueError, "monitor: inconsistent array sizes");
         goto done;
     }
@@ -368,7 +378,7 @@ static PyObject *monitor(PyObject *self, PyObject *args)
     {
         const double *grid = b[0].buf, *lo = b[1].buf, *hi = b[2].buf, *s = b[3].buf;
         const double *v = b[4].buf, *a = b[5].buf, *kinds = b[6].buf, *lims = b[7].buf;
-        double *c2 = b[8].buf, *G = P + n * p;
+        double *c2 = b[8].buf, *G = p > 0 ? P + n * p : NULL;
         for (Py_ssize_t i = 0; i < n && p > 0; i++) {
             Py_ssize_t k = segment(grid, n1, s[i], 0);
             double ds = grid[k + 1] - grid[k];
@@ -379,12 +389,15 @@ static PyObject *monitor(PyObject *self, PyObject *args)
                 double q1 = VAL(Q1), q2 = VAL(Q2);
                 for (Py_ssize_t c = 0; c < np_; c++) {
                     double x, lim = lims[2 * c + j];
-                    switch ((int)kinds[c]) {
-                    case 0: x = (q1 * aa + q2 * vv * vv) / lim; break;
-                    case 1: x = (VAL(CA) * aa + VAL(CB) * vv * vv) / lim; break;
-                    case 2: x = (3 * q2 * vv * aa + VAL(Q3) * pow(vv, 3)) / lim; break;
-                    default: x = q1 * vv / lim; break;
-                    }
+                    double kind = kinds[c];  /* (compared as start.py does) */
+                    if (kind == 0.0)
+                        x = (q1 * aa + q2 * vv * vv) / lim;
+                    else if (kind == 1.0)
+                        x = (VAL(CA) * aa + VAL(CB) * vv * vv) / lim;
+                    else if (kind == 2.0)
+                        x = (3 * q2 * vv * aa + VAL(Q3) * pow(vv, 3)) / lim;
+                    else
+                        x = q1 * vv / lim;
                     P[i * p + 2 * c + j] = x;
                 }
 #undef VAL
