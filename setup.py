@@ -9,7 +9,9 @@ pyproject.toml:
   slower (benchmarks/bench_time_optimal.py);
 * the jerk-limited law's banded interior point (src/dextar/laws/smooth/_ipm.c) of
   dextar.laws.smooth.banded: without it the numpy solver, the same solutions to the
-  programmes' tolerances, slower (benchmarks/bench_smooth.py).
+  programmes' tolerances, slower (benchmarks/bench_smooth.py);
+* the jerk-limited law's rows (src/dextar/laws/smooth/_rows.c) of
+  dextar.laws.smooth.rows: without it the numpy rows, the same rows to rounding, slower.
 
 The extensions are optional: an install without a C compiler goes on without them. No
 contraction into fused multiply-adds: the same results on every instruction set.
@@ -28,4 +30,6 @@ setup(ext_modules=[Extension("dextar.dynamics._kernel", ["src/dextar/dynamics/_k
                    Extension("dextar.laws._reach", ["src/dextar/laws/_reach.c"],
                              depends=SHARED, optional=True, extra_compile_args=FLAGS),
                    Extension("dextar.laws.smooth._ipm", ["src/dextar/laws/smooth/_ipm.c"],
+                             depends=SHARED, optional=True, extra_compile_args=FLAGS),
+                   Extension("dextar.laws.smooth._rows", ["src/dextar/laws/smooth/_rows.c"],
                              depends=SHARED, optional=True, extra_compile_args=FLAGS)])

@@ -21,8 +21,9 @@ Floors (issue 29):
   interior point (compiled where built) and by HiGHS (scipy's linprog, dual simplex and
   IPX) on the same rows, which is why the programmes have their own solver.
 
-The moves section also times the jerk-limited law with the numpy interior point (an install
-without a C compiler: laws/smooth/_ipm.c not built).
+The moves section also times the jerk-limited law without any compiled part (an install
+without a C compiler: laws/smooth/_ipm.c and _rows.c, dynamics/_kernel.c and laws/_reach.c not
+built), against the second-order law without them (issue 22's).
 """
 
 from __future__ import annotations
@@ -123,10 +124,10 @@ def section_moves(rounds: int = 15) -> None:
     assert limits is not None
     print(f"planning time per pick-and-place move (the law alone; {rounds} interleaved rounds, "
           f"CPU time best [median]; load {load()}):")
-    from dextar.laws.smooth import banded
+    from dextar.laws.smooth import banded, rows
 
     compiled = exact.USE_COMPILED, time_optimal.USE_COMPILED
-    ipm = banded.USE_COMPILED
+    ipm = banded.USE_COMPILED, rows.USE_COMPILED
     for a, b in (((-0.04, 0.11), (-0.04, 0.09)), ((0.04, 0.09), (0.04, 0.11))):
         mv = RobotAlongPath(sc.si_model, Line(a, b), sc.mode)
         solve_jerk_limited_law(mv, motors=jerky(limits), grid=400)  # (warm)
@@ -141,9 +142,12 @@ def section_moves(rounds: int = 15) -> None:
             t2 = time.process_time()
             l3 = solve_jerk_limited_law(mv, motors=jerky(limits), grid=400)
             t3 = time.process_time()
-            banded.USE_COMPILED = False  # (the numpy interior point)
+            # (without a C compiler: nothing compiled)
+            banded.USE_COMPILED = rows.USE_COMPILED = False
+            exact.USE_COMPILED = time_optimal.USE_COMPILED = False
             solve_jerk_limited_law(mv, motors=jerky(limits), grid=400)
-            banded.USE_COMPILED = ipm
+            banded.USE_COMPILED, rows.USE_COMPILED = ipm
+            exact.USE_COMPILED, time_optimal.USE_COMPILED = compiled
             t3n.append(time.process_time() - t3)
             t2s.append(t1 - t0)
             t22.append(t2 - t1)
@@ -158,9 +162,9 @@ def section_moves(rounds: int = 15) -> None:
               f"{now:.2f}x (floor 2x: {'met' if now <= 2 else 'NOT met'}); as issue 22 "
               f"measured it {min(t22) * 1e3:.1f} ms [{np.median(t22) * 1e3:.1f}]: {old:.2f}x "
               f"(floor 3x: {'met' if old <= 3 else 'NOT met'})\n"
-              f"    jerk-limited with the numpy interior point {min(t3n) * 1e3:.1f} ms "
-              f"[{np.median(t3n) * 1e3:.1f}]: {np.median(np.array(t3n) / np.array(t2s)):.2f}x "
-              f"today's second order")
+              f"    without a C compiler: jerk-limited {min(t3n) * 1e3:.1f} ms "
+              f"[{np.median(t3n) * 1e3:.1f}]: {np.median(np.array(t3n) / np.array(t22)):.2f}x "
+              f"the second order without it")
 
 
 def program_text(moves: str, extra: str = "", jerk: bool = True) -> str:

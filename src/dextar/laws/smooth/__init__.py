@@ -27,7 +27,8 @@ modules, in the order of the solve:
   q''' w^3 <= j_max T^3``, the torque rate ``a J + (a' + 2 b) w alpha + b' w^3 + g' w T^2 +
   f_qdot (q' alpha + q'' w^2) T <= r_max T^3``, each normalised by its limit, linearised
   about the current motion in every variable (the states, the arc length at which the
-  coefficients are taken, and ``T``).
+  coefficients are taken, and ``T``); built compiled where the install built it
+  (``_rows.c``, its numpy code's arithmetic in the same order).
 * :mod:`.slp`: each linear programme minimises ``T`` plus an exact penalty on the rows
   within a trust region; its variables are the states at the knots, ``T`` and the slack,
   its equalities the exact integration, so it is banded.

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..._arrays import Array
+from ..._compiled import usable
 from ..constraints import (
     Constraint,
     JerkLimit,
@@ -20,6 +21,22 @@ from ..constraints import (
 )
 from .mesh import Mesh, Motion, knot_T
 from .table import DA, DB, DG, Q1, Q2, Q3, A, B, Table, interp
+
+try:  # the rows compiled (_rows.c), built by pip where a C compiler is
+    from . import _rows as _compiled
+except ImportError:  # pragma: no cover - installed without a C compiler: the numpy rows
+    _compiled = None  # type: ignore[assignment]  # the module or None, as USE_COMPILED says
+
+#: The compiled rows' interface this module calls (``ROWS_VERSION`` in _rows.c): a build of
+#: another version (an old one left in place) is not used.
+ROWS_VERSION = 1
+if not usable(_compiled, ROWS_VERSION):
+    _compiled = None  # type: ignore[assignment]  # an old build: the numpy rows instead
+
+#: Whether the rows are built compiled (where it was built): False builds them with numpy
+#: (the same rows to rounding, the same bits where the C library's ``pow`` and ``cosh`` are
+#: numpy's; the tests compare the two).
+USE_COMPILED = _compiled is not None
 
 #: Intervals whose rows are built at once (the temporaries of a block are a few hundred
 #: bytes a row).
@@ -71,6 +88,20 @@ class Rows:
                           + C[:, 4] * d_T[k])
 
 
+def compiled_monitor(grid: Array, lo: Array, hi: Array, s: Array, v: Array, a: Array,
+                     kinds: Sequence[float], lims: Sequence[Array], dt: float
+                     ) -> Array | None:
+    """:func:`.start.fractions`' monitor by the compiled rows (``monitor`` of _rows.c, the
+    same arithmetic as its numpy code), or None where they are not used."""
+    if not (USE_COMPILED and _compiled is not None and len(s) >= 2 and len(kinds)):
+        return None
+    out = np.empty(len(s))
+    g, lo, hi, s, v, a, k, lim = (np.ascontiguousarray(x, dtype=float) for x in (
+        grid, lo, hi, s, v, a, kinds, np.concatenate([np.broadcast_to(x, (2,)) for x in lims])))
+    _compiled.monitor(g, lo, hi, s, v, a, k, lim, float(dt), out)
+    return out
+
+
 def local(h: Array, k: Array, theta: Array, gs: Array, gw: Array, ga: Array, gj: Array,
            gT: Array) -> tuple[Array, Array]:
     """A row's gradient ``C`` (n, 5) in its interval's ``sigma_k, w_k, alpha_k``, end
@@ -116,6 +147,17 @@ class RowModel:
         self._last: tuple[tuple[Array, ...], Rows] | None = None
         self.root_cap = (None if not np.isfinite(cap).any()
                          else np.sqrt(np.where(np.isfinite(cap), cap, 1e300)))
+        # the third-order limits as the compiled rows take them: kind (0 jerk, 1 torque
+        # rate), limits, and the friction (viscous, Coulomb, its regularisation speed)
+        spec = [(0.0, c.max_jerk) if isinstance(c, JerkLimit) else (1.0, c.max_torque_rate)
+                for c in self.third if isinstance(c, (JerkLimit, TorqueRateLimit))]
+        co = table.co
+        self._third_spec = (np.array([kind for kind, _ in spec], float),
+                            np.array([np.broadcast_to(np.asarray(lim, float), (2,))
+                                      for _, lim in spec], float).reshape(-1),
+                            np.concatenate([np.broadcast_to(np.asarray(co.viscous, float), (2,)),
+                                            np.broadcast_to(np.asarray(co.coulomb, float), (2,)),
+                                            [float(co.coulomb_speed)]]))
 
     def tangent(self, mo: Motion) -> Array:
         """The tangent points of the speed-dependent bounds on the grid: the motion's squared
@@ -198,6 +240,8 @@ class RowModel:
     def _block(self, mo: Motion, pr: PointRows, finite: Array, phmax: float, k0: int,
                k1: int) -> Rows:
         """The rows of the intervals ``k0`` to ``k1`` (excluded)."""
+        if USE_COMPILED and _compiled is not None:
+            return self._block_compiled(mo, pr, finite, phmax, k0, k1)
         mesh, tab, S = self.mesh, self.table, self.length
         h = mesh.h
         m = pr.pu.shape[1]
@@ -258,6 +302,38 @@ class RowModel:
         return Rows(np.concatenate(Fs), np.concatenate(ks).astype(np.int32), C,
                     np.concatenate(norms), sizes,
                     tuple((n, len(f)) for n, f in zip(names, Fs, strict=True)))
+
+    def _block_compiled(self, mo: Motion, pr: PointRows, finite: Array, phmax: float,
+                        k0: int, k1: int) -> Rows:
+        """:meth:`_block` by the compiled rows (_rows.c: the same rows, the same order)."""
+        assert _compiled is not None
+        tab = self.table
+        m = pr.pu.shape[1]
+        cols = [pr.pu, pr.px, np.where(finite, pr.ph, 0.0), finite.astype(float)]
+        if self.root_cap is not None:
+            cols.append(self.root_cap[:, None])
+        kinds, lims, fric = self._third_spec
+        nint = k1 - k0
+        n2 = max(k1 - max(k0, 1), 0) + nint
+        cap = self.root_cap is not None
+        rmax = n2 * m + (n2 if cap else 0) + n2 + 12 * nint * len(kinds)
+        F, norm, k = np.empty(rmax), np.empty(rmax), np.empty(rmax, np.int32)
+        grad = self._grad
+        C = np.empty((rmax if grad else 0, 5))
+        sizes = np.empty((rmax if grad else 0, 5), np.float32)
+
+        def f64(x: Array) -> Array:
+            return np.ascontiguousarray(x, dtype=float)
+
+        n_second, n_cap, n_w, n_third = _compiled.block(
+            f64(tab.s), np.concatenate(cols, axis=1), f64(tab.lo), f64(tab.hi),
+            f64(self.mesh.h), f64(mo.J), f64(mo.Tk), f64(mo.sigma), f64(mo.w), f64(mo.alpha),
+            kinds, lims, fric, F, norm, C, k, sizes, m, int(cap), k0, k1,
+            1e-9 * phmax + 1e-300, self.length, -1.0 / self.length, grad)
+        R = n_second + n_cap + n_w + n_third
+        names = [("second-order", n_second), *([("cap", n_cap)] if cap else []),
+                 ("w>=0", n_w), ("third", n_third)]
+        return Rows(F[:R], k[:R], C[:R], norm[:R], sizes[:R], tuple(names))
 
     def _third_at(self, mo: Motion, k: Array, theta: Array, v: Array, d: Array, w: Array,
                   al: Array) -> tuple[Array, list[list[Array]], Array, Array]:

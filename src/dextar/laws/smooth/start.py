@@ -27,6 +27,7 @@ from ..constraints import (
     TorqueRateLimit,
 )
 from .mesh import Mesh, make_mesh, projected
+from .rows import compiled_monitor
 from .table import DB, DG, Q1, Q2, Q3, A, B, Table, values_at
 
 
@@ -147,41 +148,68 @@ def fractions(start: Start, table: Table, cons: Sequence[Constraint], segments: 
     points ``h / 2`` apart by up to ``c h^2 / 32`` between them, so the density is
     ``sqrt(c / (32 tol))`` intervals per unit time."""
     t, s, v, a = start.t, start.s, start.v, start.a
-    used = max(c.stop for c in (Q1, Q2, Q3, A, B))  # (the columns it needs, first)
-    vals = values_at(table.s, table.lo[:, :used], table.hi[:, :used], s)
-    q1, q2, q3, b = vals[:, Q1], vals[:, Q2], vals[:, Q3], vals[:, B]
-    vv, aa = v[:, None], a[:, None]
-    parts: list[Array] = []
-    torque: Array | None = None
+    kinds: list[float] = []  # 0 acceleration, 1 torque, 2 jerk, 3 speed (see _monitor)
+    lims: list[Array] = []
     seen: set[tuple[str, tuple[float, ...]]] = set()  # (a part twice changes no maximum)
     for c in cons:
         lim = getattr(c, "max_acceleration", None)
         if lim is not None and ("acceleration", tuple(lim)) not in seen:
             seen.add(("acceleration", tuple(lim)))
-            parts.append((q1 * aa + q2 * vv * vv) / np.asarray(lim, float))
+            kinds.append(0.0)
+            lims.append(np.asarray(lim, float))
         lim = c.torque_limit
         if lim is not None and ("torque", tuple(lim)) not in seen:
             seen.add(("torque", tuple(lim)))
-            if torque is None:
-                torque = vals[:, A] * aa + b * vv * vv
-            parts.append(torque / np.asarray(lim, float))
+            kinds.append(1.0)
+            lims.append(np.asarray(lim, float))
         if isinstance(c, JerkLimit):
-            parts.append((3 * q2 * vv * aa + q3 * vv**3) / np.asarray(c.max_jerk, float))
+            kinds.append(2.0)
+            lims.append(np.asarray(c.max_jerk, float))
         wmax = getattr(c, "max_speed", None)
         if wmax is not None:  # near the speed limit, the envelope's torque falls steeply
             knee = getattr(c, "knee", None)
-            span = np.asarray(wmax, float) - (0.0 if knee is None else np.asarray(knee))
-            parts.append(q1 * vv / span)
+            kinds.append(3.0)
+            lims.append(np.asarray(wmax, float) - (0.0 if knee is None else np.asarray(knee)))
     dt = t[1] - t[0]
-    # every part's columns side by side: one pair of differences (the same per column)
-    c2 = (np.abs(_gradient(_gradient(np.concatenate(parts, axis=1), dt), dt))
-          .max(axis=1, initial=0.0) if parts else np.zeros_like(t))
+    c2 = _monitor(table, s, v, a, kinds, lims, dt)
     density = np.maximum(np.sqrt(c2 / (32 * tol)), segments / start.T)
     cdf = np.concatenate([[0.0], np.cumsum(0.5 * (density[1:] + density[:-1]) * dt)])
     M = max(segments, int(np.ceil(cdf[-1])))
     f = np.interp(np.linspace(0.0, cdf[-1], M + 1), cdf, t / start.T)
     f[0], f[-1] = 0.0, 1.0
     return np.asarray(f)
+
+
+def _monitor(table: Table, s: Array, v: Array, a: Array, kinds: list[float],
+             lims: list[Array], dt: float) -> Array:
+    """The monitor of :func:`fractions` at the samples ``s, v, a`` (n,): the largest second
+    time difference of its parts (``kinds``: 0 the joint accelerations ``q' a + q'' v^2``,
+    1 the torques without friction ``a_ a + b v^2``, 2 the joint jerks from the path's
+    curvature ``3 q'' v a + q''' v^3``, 3 the joint speeds ``q' v``) over their limits
+    ``lims`` (2, each); compiled where built (_rows.c: the same arithmetic)."""
+    out = compiled_monitor(table.s, table.lo, table.hi, s, v, a, kinds, lims, dt)
+    if out is not None:
+        return out
+    used = max(c.stop for c in (Q1, Q2, Q3, A, B))  # (the columns it needs, first)
+    vals = values_at(table.s, table.lo[:, :used], table.hi[:, :used], s)
+    q1, q2, q3 = vals[:, Q1], vals[:, Q2], vals[:, Q3]
+    vv, aa = v[:, None], a[:, None]
+    torque: Array | None = None
+    parts: list[Array] = []
+    for kind, lim in zip(kinds, lims, strict=True):
+        if kind == 0.0:
+            parts.append((q1 * aa + q2 * vv * vv) / lim)
+        elif kind == 1.0:
+            if torque is None:
+                torque = vals[:, A] * aa + vals[:, B] * vv * vv
+            parts.append(torque / lim)
+        elif kind == 2.0:
+            parts.append((3 * q2 * vv * aa + q3 * vv**3) / lim)
+        else:
+            parts.append(q1 * vv / lim)
+    # every part's columns side by side: one pair of differences (the same per column)
+    return (np.abs(_gradient(_gradient(np.concatenate(parts, axis=1), dt), dt))
+            .max(axis=1, initial=0.0) if parts else np.zeros_like(s))
 
 
 def _gradient(f: Array, dx: float) -> Array:

@@ -1,0 +1,453 @@
+/* The jerk-limited law's rows compiled: RowModel._block of dextar.laws.smooth.rows (the
+ * second-order rows interpolated between the table's points at the knots and the
+ * intervals' middles, the speed cap, w >= 0, and the joint jerk and torque-rate rows at
+ * every interval's start, middle and end, with their gradients in the programme's
+ * variables) in one call, each value by the same operations in the same order as the numpy
+ * code (the same bits where the C library's pow and cosh are numpy's), without its few
+ * hundred array operations per call: on a short move those cost more than the arithmetic.
+ *
+ * Built by `pip install` when a C compiler is there (an optional extension: without one,
+ * dextar builds the rows with numpy).
+ *
+ * block(grid, pcols, tlo, thi, h, J, Tk, sigma, w, alpha, kinds, lims, fric,
+ *       F, norm, C, k, sizes, m, has_cap, k0, k1, cfloor, S, neg_inv_S, grad)
+ *     -> (second, cap, w, third)
+ *   grid (N + 1) the table's arc lengths; pcols (N + 1) x P the second-order rows'
+ *   coefficients pu | px | ph | finite (m columns each) and, with has_cap, the speed cap's
+ *   root; tlo, thi (N x 18) the table's columns at its segments' ends; h, J, Tk (M) and
+ *   sigma, w, alpha (M + 1) the mesh and the motion; kinds (nc: 0 a jerk limit, 1 a torque
+ *   rate limit), lims (2 nc) and fric (viscous 2, Coulomb 2, Coulomb speed) the third-order
+ *   limits. The rows of the intervals k0 to k1 (excluded) are written into F, norm, C
+ *   (5 per row, with grad), k (int32) and sizes (float32, 5 per row, with grad); the counts
+ *   of each kind are returned.
+ *
+ * monitor(grid, lo, hi, s, v, a, kinds, lims, dt, c2)
+ *   start.fractions' monitor: the parts (kinds: 0 a joint acceleration, 1 a torque without
+ *   friction, 2 a joint jerk from the path's curvature, 3 a speed over its span; lims 2 per
+ *   part) of the start motion's samples s, v, a (n) from the table's first 10 columns (lo,
+ *   hi: N x ncols), their second differences in time (step dt, as numpy.gradient twice)
+ *   and the largest of their magnitudes at each sample written into c2 (n).
+ *
+ * Compiled without contraction into fused multiply-adds (-ffp-contract=off).
+ */
+
+#include "../../_buffers.h"
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+
+#if (defined(FLT_EVAL_METHOD) && FLT_EVAL_METHOD != 0) || defined(__FAST_MATH__)
+#error "dextar's compiled rows need double evaluation without -ffast-math"
+#endif
+
+/* The interface version: rows.py uses a build of this version only. */
+#define ROWS_VERSION 1
+/* The table's columns (2 each): q', q'', q''', a, b, g, a', b', g' (table.py). */
+#define NCOL 18
+#define Q1 0
+#define Q2 2
+#define Q3 4
+#define CA 6
+#define CB 8
+#define CDA 12
+#define CDB 14
+#define CDG 16
+
+/* numpy's maximum and clip where a NaN propagates (a tie of signed zeros, which numpy gives
+ * as +0, is not met by the callers: a floor above zero, a magnitude against a maximum) */
+static double np_max(double a, double b)
+{
+    return (a >= b || isnan(a)) ? a : b;
+}
+
+static double np_clip(double x, double lo, double hi)
+{
+    return x < lo ? lo : (x > hi ? hi : x);
+}
+
+/* numpy.searchsorted(grid, s, side) - 1 clipped to a segment (side "left" with before) */
+static Py_ssize_t segment(const double *g, Py_ssize_t n, double s, int before)
+{
+    if (isnan(s))
+        return n - 2;
+    Py_ssize_t lo = 0, hi = n;
+    while (lo < hi) {
+        Py_ssize_t mid = lo + (hi - lo) / 2;
+        if (before ? g[mid] < s : g[mid] <= s)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    Py_ssize_t k = lo - 1;
+    return k < 0 ? 0 : (k > n - 2 ? n - 2 : k);
+}
+
+typedef struct {
+    const double *h, *J, *Tk, *sigma, *w, *alpha;
+} Motion;
+
+/* Motion.at: sigma, w, alpha at the offset th into interval k */
+static void state_at(const Motion *mo, Py_ssize_t k, double th, double *sig, double *w,
+                     double *al)
+{
+    double J = mo->J[k], a = mo->alpha[k], ww = mo->w[k], s = mo->sigma[k];
+    double sg = s + th * (ww + th * (a / 2 + th * J / 6));
+    if (th >= mo->h[k])
+        sg = mo->sigma[k + 1];
+    *sig = sg;
+    *w = ww + th * (a + th * J / 2);
+    *al = a + th * J;
+}
+
+typedef struct {
+    double *F, *norm, *C;
+    int *k;
+    float *sizes;
+    Py_ssize_t n;
+    int grad;
+} Out;
+
+/* one row: its value, normalisation and (rows.local) gradient in its interval's variables */
+static void put(Out *o, Py_ssize_t k, double F, double norm, double th, double hk,
+                double gs, double gw, double ga, double gj, double gT)
+{
+    Py_ssize_t i = o->n++;
+    o->F[i] = F;
+    o->norm[i] = norm;
+    o->k[i] = (int)k;
+    if (!o->grad)
+        return;
+    double cJ = gs * pow(th, 3) / 6 + gw * (th * th) / 2 + ga * th + gj;
+    double ca = gs * (th * th) / 2 + gw * th + ga;
+    double *C = o->C + 5 * i;
+    float *z = o->sizes + 5 * i;
+    C[0] = gs;
+    C[1] = gs * th + gw;
+    C[3] = cJ / hk;
+    C[2] = ca - C[3];
+    C[4] = gT;
+    z[0] = (float)fabs(gs);
+    z[1] = (float)fabs(gw);
+    z[2] = (float)fabs(ga);
+    z[3] = (float)fabs(gj);
+    z[4] = (float)fabs(gT);
+}
+
+/* a buffer of 4-byte items of the struct code ``code`` ('i' int32, 'f' float32) */
+static int get_buffer4(PyObject *obj, Py_buffer *view, char code, const char *name)
+{
+    int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | PyBUF_WRITABLE;
+    if (PyObject_GetBuffer(obj, view, flags) < 0)
+        return -1;
+    size_t n = view->format == NULL ? 0 : strlen(view->format);
+    char got = n == 0 ? '\0' : view->format[n - 1];
+    /* (a 4-byte C long is numpy's int32 on some platforms) */
+    if (view->itemsize != 4 || !(got == code || (code == 'i' && got == 'l'))) {
+        PyErr_Format(PyExc_TypeError, "%s must hold %s values", name,
+                     code == 'i' ? "int32" : "float32");
+        PyBuffer_Release(view);
+        return -1;
+    }
+    return 0;
+}
+
+#define NIN 13
+#define NOUT 3
+
+static PyObject *block(PyObject *self, PyObject *args)
+{
+    (void)self;
+    PyObject *objs[NIN + NOUT], *kobj, *zobj;
+    Py_ssize_t m, k0, k1;
+    int has_cap, grad;
+    double cfloor, S, neg_inv_S;
+    if (!PyArg_ParseTuple(args, "OOOOOOOOOOOOOOOOOOninnddd" "p", &objs[0], &objs[1],
+                          &objs[2], &objs[3], &objs[4], &objs[5], &objs[6], &objs[7],
+                          &objs[8], &objs[9], &objs[10], &objs[11], &objs[12], &objs[13],
+                          &objs[14], &objs[15], &kobj, &zobj, &m, &has_cap, &k0, &k1,
+                          &cfloor, &S, &neg_inv_S, &grad))
+        return NULL;
+    static const char *const names[NIN + NOUT] = {
+        "grid", "pcols", "tlo", "thi", "h", "J", "Tk", "sigma", "w", "alpha", "kinds",
+        "lims", "fric", "F", "norm", "C"};
+    Py_buffer v[NIN + NOUT], kv, zv;
+    if (get_buffers(objs, v, NIN + NOUT, NIN, names) < 0)
+        return NULL;
+    PyObject *result = NULL;
+    int held_k = 0, held_z = 0;
+    if (get_buffer4(kobj, &kv, 'i', "k") < 0)
+        goto done;
+    held_k = 1;
+    if (get_buffer4(zobj, &zv, 'f', "sizes") < 0)
+        goto done;
+    held_z = 1;
+    {
+        Py_ssize_t n1 = v[0].len / 8, M = v[4].len / 8, nc = v[10].len / 8;
+        /* the sizes the rows need, bounded before any product (no overflow: m is at most
+         * a quarter of pcols' values, the blocks within the mesh, fewer than 1e15 rows) */
+        if (n1 < 2 || m < 0 || m > v[1].len / 8 / 4 || k0 < 0 || k1 > M || k1 < k0
+            || (double)(2 * (k1 - k0)) * (double)(m + 2) + 12.0 * (double)(k1 - k0) * nc
+                   > 1e15) {
+            PyErr_SetString(PyExc_ValueError, "block: inconsistent array sizes");
+            goto done;
+        }
+        Py_ssize_t P = 4 * m + (has_cap ? 1 : 0);
+        Py_ssize_t inner = k1 - (k0 > 1 ? k0 : 1), nint = k1 - k0;
+        Py_ssize_t n2 = (inner > 0 ? inner : 0) + nint, n3 = 3 * nint;
+        Py_ssize_t rmax = n2 * m + (has_cap ? n2 : 0) + n2 + 4 * n3 * nc;
+        if (v[1].len / 8 != n1 * P || v[2].len / 8 != (n1 - 1) * NCOL
+            || v[3].len / 8 != (n1 - 1) * NCOL || v[5].len / 8 != M || v[6].len / 8 != M
+            || v[7].len / 8 != M + 1 || v[8].len / 8 != M + 1 || v[9].len / 8 != M + 1
+            || v[11].len / 8 != 2 * nc || v[12].len / 8 != 5 || v[13].len / 8 < rmax || v[14].len / 8 < rmax
+            || kv.len / 4 < rmax || (grad && (v[15].len / 8 < 5 * rmax
+                                              || zv.len / 4 < 5 * rmax))) {
+            PyErr_SetString(PyExc_ValueError, "block: inconsistent array sizes");
+            goto done;
+        }
+        const double *grid = v[0].buf, *pc = v[1].buf, *tlo = v[2].buf, *thi = v[3].buf;
+        const double *kinds = v[10].buf, *lims = v[11].buf, *fric = v[12].buf;
+        Motion mo = {v[4].buf, v[5].buf, v[6].buf, v[7].buf, v[8].buf, v[9].buf};
+        Out o = {v[13].buf, v[14].buf, v[15].buf, kv.buf, zv.buf, 0, grad};
+        const double lo_s = grid[0], hi_s = grid[n1 - 1];
+        /* the second-order rows at the inner knots, then at the intervals' middles */
+        Py_ssize_t first = o.n;
+        for (int pass = 0; pass < 2; pass++) {
+            Py_ssize_t ka = pass == 0 ? (k0 > 1 ? k0 : 1) : k0;
+            for (Py_ssize_t k = ka; k < k1; k++) {
+                double th = pass == 0 ? 0.0 : mo.h[k] / 2, sig, w, al;
+                state_at(&mo, k, th, &sig, &w, &al);
+                Py_ssize_t s = segment(grid, n1, sig, 0);
+                double ds = grid[s + 1] - grid[s];
+                double u = (np_clip(sig, lo_s, hi_s) - grid[s]) / ds;
+                const double *a = pc + s * P, *b = pc + (s + 1) * P;
+                double T = mo.Tk[k];
+                for (Py_ssize_t j = 0; j < m; j++) {
+                    double fin = a[3 * m + j] + (b[3 * m + j] - a[3 * m + j]) * u;
+                    if (!(fin > 1 - 1e-12))
+                        continue;
+                    double pu = a[j] + (b[j] - a[j]) * u;
+                    double px = a[m + j] + (b[m + j] - a[m + j]) * u;
+                    double ph = a[2 * m + j] + (b[2 * m + j] - a[2 * m + j]) * u;
+                    double dpu = (b[j] - a[j]) / ds, dpx = (b[m + j] - a[m + j]) / ds;
+                    double dph = (b[2 * m + j] - a[2 * m + j]) / ds;
+                    double c = np_max(fabs(ph), cfloor) * T * T;
+                    double F = (pu * al + px * w * w - ph * T * T) / c;
+                    put(&o, k, F, c, th, mo.h[k], (dpu * al + dpx * w * w - dph * T * T) / c,
+                        2 * px * w / c, pu / c, 0.0, -2 * ph * T / c);
+                }
+            }
+        }
+        Py_ssize_t n_second = o.n - first;
+        /* the speed cap w <= sqrt(cap) T, then w >= 0, at the same points */
+        for (int kind = has_cap ? 0 : 1; kind < 2; kind++) {
+            for (int pass = 0; pass < 2; pass++) {
+                Py_ssize_t ka = pass == 0 ? (k0 > 1 ? k0 : 1) : k0;
+                for (Py_ssize_t k = ka; k < k1; k++) {
+                    double th = pass == 0 ? 0.0 : mo.h[k] / 2, sig, w, al;
+                    state_at(&mo, k, th, &sig, &w, &al);
+                    if (kind == 1) {
+                        put(&o, k, -w / S, S, th, mo.h[k], 0.0, neg_inv_S, 0.0, 0.0, 0.0);
+                        continue;
+                    }
+                    Py_ssize_t s = segment(grid, n1, sig, 0);
+                    double ds = grid[s + 1] - grid[s];
+                    double u = (np_clip(sig, lo_s, hi_s) - grid[s]) / ds;
+                    double a = pc[s * P + 4 * m], b = pc[(s + 1) * P + 4 * m];
+                    double rv = a + (b - a) * u, rs = (b - a) / ds, T = mo.Tk[k];
+                    double c2 = np_max(rv, 1e-300) * T;
+                    put(&o, k, (w - rv * T) / c2, c2, th, mo.h[k], -rs * T / c2, 1.0 / c2,
+                        0.0, 0.0, -rv / c2);
+                }
+            }
+        }
+        /* the third-order rows at every interval's start, middle and end (at its end, the
+         * table's segment before the point): per limit, both signs, per point, per joint */
+        Py_ssize_t n_third = 0;
+        for (Py_ssize_t ci = 0; ci < nc; ci++) {
+            int torque_rate = kinds[ci] != 0.0;
+            Py_ssize_t base = o.n;
+            for (Py_ssize_t p = 0; p < n3; p++) {
+                Py_ssize_t k = k0 + p % nint;
+                int part = (int)(p / nint), end = part == 2;
+                double th = part == 0 ? 0.0 : (part == 1 ? mo.h[k] / 2 : mo.h[k]), sig, ww, aa;
+                state_at(&mo, k, th, &sig, &ww, &aa);
+                Py_ssize_t s = segment(grid, n1, sig, end);
+                double ds = grid[s + 1] - grid[s];
+                double u = (np_clip(sig, lo_s, hi_s) - grid[s]) / ds;
+                const double *ta = tlo + s * NCOL, *tb = thi + s * NCOL;
+                double T = mo.Tk[k], jj = mo.J[k];
+                for (int j = 0; j < 2; j++) {
+#define VAL(c) (ta[(c) + j] + (tb[(c) + j] - ta[(c) + j]) * u)
+#define SLOPE(c) ((tb[(c) + j] - ta[(c) + j]) / ds)
+                    double q1 = VAL(Q1), q2 = VAL(Q2), val, gs, gw, ga, gj, gT;
+                    double lim = lims[2 * ci + j];
+                    if (!torque_rate) {
+                        double q3 = VAL(Q3);
+                        val = q1 * jj + 3 * q2 * ww * aa + q3 * pow(ww, 3);
+                        gs = SLOPE(Q1) * jj + 3 * SLOPE(Q2) * ww * aa
+                             + SLOPE(Q3) * pow(ww, 3);
+                        gw = 3 * q2 * aa + 3 * q3 * ww * ww;
+                        ga = 3 * q2 * ww;
+                        gj = q1;
+                        gT = 0.0;
+                    } else {
+                        double a = VAL(CA), b = VAL(CB), da = VAL(CDA), db = VAL(CDB);
+                        double dg = VAL(CDG), vs = fric[4];
+                        double ch = cosh(np_clip(q1 * ww / T / vs, -300, 300));
+                        double cf = fric[j] + fric[2 + j] / vs / (ch * ch);
+                        double acc = q1 * aa + q2 * ww * ww;
+                        val = (a * jj + (da + 2 * b) * ww * aa + db * pow(ww, 3)
+                               + dg * ww * T * T + cf * acc * T);
+                        gs = (SLOPE(CA) * jj + (SLOPE(CDA) + 2 * SLOPE(CB)) * ww * aa
+                              + SLOPE(CDB) * pow(ww, 3) + SLOPE(CDG) * ww * T * T
+                              + cf * (SLOPE(Q1) * aa + SLOPE(Q2) * ww * ww) * T);
+                        gw = ((da + 2 * b) * aa + 3 * db * ww * ww + dg * T * T
+                              + cf * 2 * q2 * ww * T);
+                        ga = (da + 2 * b) * ww + cf * q1 * T;
+                        gj = a;
+                        gT = 2 * dg * ww * T + cf * acc;
+                    }
+#undef VAL
+#undef SLOPE
+                    double scale = lim * pow(T, 3);
+                    for (int sg = 0; sg < 2; sg++) {
+                        double sign = sg == 0 ? 1.0 : -1.0;
+                        o.n = base + sg * 2 * n3 + 2 * p + j;
+                        put(&o, k, (sign * val - scale) / scale, scale, th, mo.h[k],
+                            sign * gs / scale, sign * gw / scale, sign * ga / scale,
+                            sign * gj / scale, (sign * gT - 3 * lim * T * T) / scale);
+                    }
+                }
+            }
+            o.n = base + 4 * n3;
+            n_third += 4 * n3;
+        }
+        result = Py_BuildValue("nnnn", n_second, has_cap ? n2 : (Py_ssize_t)0, n2, n_third);
+    }
+done:
+    if (held_k)
+        PyBuffer_Release(&kv);
+    if (held_z)
+        PyBuffer_Release(&zv);
+    release_buffers(v, NIN + NOUT);
+    return result;
+}
+
+/* numpy.gradient(f, dx, axis=0) of the columns of f (n x p, n >= 2) into g */
+static void gradient(const double *f, double *g, Py_ssize_t n, Py_ssize_t p, double dx)
+{
+    for (Py_ssize_t i = 1; i + 1 < n; i++)
+        for (Py_ssize_t j = 0; j < p; j++)
+            g[i * p + j] = (f[(i + 1) * p + j] - f[(i - 1) * p + j]) / (2.0 * dx);
+    for (Py_ssize_t j = 0; j < p; j++) {
+        g[j] = (f[p + j] - f[j]) / dx;
+        g[(n - 1) * p + j] = (f[(n - 1) * p + j] - f[(n - 2) * p + j]) / dx;
+    }
+}
+
+static PyObject *monitor(PyObject *self, PyObject *args)
+{
+    (void)self;
+    PyObject *objs[9];
+    double dt;
+    if (!PyArg_ParseTuple(args, "OOOOOOOOdO", &objs[0], &objs[1], &objs[2], &objs[3],
+                          &objs[4], &objs[5], &objs[6], &objs[7], &dt, &objs[8]))
+        return NULL;
+    static const char *const names[9] = {"grid", "lo", "hi", "s", "v", "a", "kinds", "lims",
+                                         "c2"};
+    Py_buffer b[9];
+    if (get_buffers(objs, b, 9, 8, names) < 0)
+        return NULL;
+    PyObject *result = NULL;
+    double *P = NULL;
+    Py_ssize_t n1 = b[0].len / 8, n = b[3].len / 8, np_ = b[6].len / 8;
+    Py_ssize_t nc = n1 >= 2 ? b[1].len / 8 / (n1 - 1) : 0, p = 2 * np_;
+    if (n1 < 2 || nc < 10 || b[1].len / 8 != (n1 - 1) * nc || b[2].len != b[1].len
+        || b[4].len / 8 != n || b[5].len / 8 != n || b[7].len / 8 != p || b[8].len / 8 != n
+        || n < 2 || (double)n * (double)p > 1e15) {
+        PyErr_SetString(PyExc_ValueError, "monitor: inconsistent array sizes");
+        goto done;
+    }
+    if (p > 0) {
+        P = malloc((size_t)(2 * n * p) * sizeof(double));
+        if (P == NULL) {
+            PyErr_NoMemory();
+            goto done;
+        }
+    }
+    {
+        const double *grid = b[0].buf, *lo = b[1].buf, *hi = b[2].buf, *s = b[3].buf;
+        const double *v = b[4].buf, *a = b[5].buf, *kinds = b[6].buf, *lims = b[7].buf;
+        double *c2 = b[8].buf, *G = p > 0 ? P + n * p : NULL;
+        for (Py_ssize_t i = 0; i < n && p > 0; i++) {
+            Py_ssize_t k = segment(grid, n1, s[i], 0);
+            double ds = grid[k + 1] - grid[k];
+            double u = (np_clip(s[i], grid[0], grid[n1 - 1]) - grid[k]) / ds;
+            double vv = v[i], aa = a[i];
+            for (int j = 0; j < 2; j++) {
+#define VAL(c) ((hi[k * nc + (c) + j] - lo[k * nc + (c) + j]) * u + lo[k * nc + (c) + j])
+                double q1 = VAL(Q1), q2 = VAL(Q2);
+                for (Py_ssize_t c = 0; c < np_; c++) {
+                    double x, lim = lims[2 * c + j];
+                    double kind = kinds[c];  /* (compared as start.py does) */
+                    if (kind == 0.0)
+                        x = (q1 * aa + q2 * vv * vv) / lim;
+                    else if (kind == 1.0)
+                        x = (VAL(CA) * aa + VAL(CB) * vv * vv) / lim;
+                    else if (kind == 2.0)
+                        x = (3 * q2 * vv * aa + VAL(Q3) * pow(vv, 3)) / lim;
+                    else
+                        x = q1 * vv / lim;
+                    P[i * p + 2 * c + j] = x;
+                }
+#undef VAL
+            }
+        }
+        if (p > 0) {
+            gradient(P, G, n, p, dt);
+            gradient(G, P, n, p, dt);
+        }
+        for (Py_ssize_t i = 0; i < n; i++) {
+            double m = 0.0;
+            for (Py_ssize_t j = 0; j < p; j++) {
+                double x = fabs(P[i * p + j]);
+                m = np_max(x, m);
+            }
+            c2[i] = m;
+        }
+        result = Py_None;
+        Py_INCREF(result);
+    }
+done:
+    free(P);
+    release_buffers(b, 9);
+    return result;
+}
+
+static PyMethodDef methods[] = {
+    {"block", block, METH_VARARGS,
+     "block(grid, pcols, tlo, thi, h, J, Tk, sigma, w, alpha, kinds, lims, fric, F, norm, C, "
+     "k, sizes, m, has_cap, k0, k1, cfloor, S, neg_inv_S, grad) -> (second, cap, w, third): "
+     "the rows of the intervals k0 to k1 written into F, norm, C, k and sizes."},
+    {"monitor", monitor, METH_VARARGS,
+     "monitor(grid, lo, hi, s, v, a, kinds, lims, dt, c2): start.fractions' monitor, the "
+     "largest second difference of its parts at each sample, into c2."},
+    {NULL, NULL, 0, NULL}
+};
+
+static struct PyModuleDef module = {
+    PyModuleDef_HEAD_INIT, "_rows",
+    "The jerk-limited law's rows, compiled.", -1, methods, NULL, NULL, NULL, NULL
+};
+
+PyMODINIT_FUNC PyInit__rows(void)
+{
+    PyObject *mod = PyModule_Create(&module);
+    if (mod == NULL)
+        return NULL;
+    if (PyModule_AddIntConstant(mod, "VERSION", ROWS_VERSION) < 0) {
+        Py_DECREF(mod);
+        return NULL;
+    }
+    return mod;
+}
