@@ -6,7 +6,8 @@ pyproject.toml:
   (benchmarks/bench_dynamics.py);
 * the time-optimal law's reachability analysis (src/dextar/laws/_reach.c) of
   dextar.laws.time_optimal: without it the Python passes, the same law to the last bit,
-  slower (benchmarks/bench_time_optimal.py);
+  slower (benchmarks/bench_time_optimal.py); with it Clenshaw's recurrence for
+  dextar.laws.optimal's long Chebyshev series (numpy's chebval otherwise, the same values);
 * the jerk-limited law's banded interior point (src/dextar/laws/smooth/_ipm.c) of
   dextar.laws.smooth.banded: without it the numpy solver, the same solutions to the
   programmes' tolerances, slower (benchmarks/bench_smooth.py);

@@ -179,3 +179,30 @@ def test_an_old_build_of_the_compiled_passes_is_not_used():
     assert usable(SimpleNamespace(VERSION=version), version)
     if time_optimal._compiled is not None:
         assert usable(time_optimal._compiled, version)
+
+
+@pytest.mark.parametrize("terms", [1, 2, 3, 1029])
+def test_the_compiled_chebyshev_series_is_numpys(terms, monkeypatch):
+    """The optimal law's series at many points (a forward re-simulation's windows: the
+    compiled Clenshaw recurrence, chebval of _reach.c) is numpy's chebval: the same
+    operations, the same values (to 1e-15 of their scale here; NaN and inf where numpy's
+    are), on series of 1 to 1029 terms at 353 points in and beyond [-1, 1]."""
+    from numpy.polynomial import chebyshev
+
+    from dextar.laws import optimal
+
+    if optimal._compiled is None:
+        pytest.skip("the compiled part is not built here")
+    rng = np.random.default_rng(terms)
+    c = rng.normal(size=terms) / np.arange(1, terms + 1) ** 2
+    x = np.concatenate([rng.uniform(-1.2, 1.2, 351), [np.nan, np.inf]])
+    monkeypatch.setattr(optimal, "MATRIX_LIMIT", 0)  # (Clenshaw's at any size)
+    with np.errstate(invalid="ignore"):
+        want = chebyshev.chebval(x, c)
+        got = optimal._chebval(x, c)
+    assert np.array_equal(np.isnan(got), np.isnan(want))
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-15 * np.nanmax(np.abs(want[:-1])))
+    monkeypatch.setattr(optimal, "USE_COMPILED", False)  # (numpy's, the same)
+    np.testing.assert_array_equal(optimal._chebval(x[:-2], c), want[:-2])
+    with pytest.raises(ValueError, match="chebval"):
+        optimal._compiled.chebval(x, c, np.empty(3))

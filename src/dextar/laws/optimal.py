@@ -49,6 +49,7 @@ import numpy as np
 from numpy.polynomial import chebyshev as cheb
 
 from .._arrays import Array
+from .._compiled import usable
 from .._lazy import lazy_module
 from ..errors import ConvergenceError, ParameterError
 from ..params import Param
@@ -56,6 +57,21 @@ from ..paths import Path
 from ..units import Units
 from .base import Law, _positive, law_cost
 from .registry import LawType, register_law
+
+try:  # Clenshaw's recurrence compiled (chebval of _reach.c), built where a C compiler is
+    from . import _reach as _compiled
+except ImportError:  # pragma: no cover - installed without a C compiler: numpy's chebval
+    _compiled = None  # type: ignore[assignment]  # the module or None, as USE_COMPILED says
+
+#: The compiled part's interface this module calls (``REACH_VERSION`` in _reach.c, the first
+#: with ``chebval``): another version's build (an old one left in place) is not used.
+REACH_VERSION = 2
+if not usable(_compiled, REACH_VERSION):
+    _compiled = None  # type: ignore[assignment]  # an old build: numpy's chebval instead
+
+#: Whether a series at many points is evaluated compiled (where it was built): False gives
+#: numpy's chebval (the same values to the last bit; the tests compare the two).
+USE_COMPILED = _compiled is not None
 
 integrate = lazy_module("scipy.integrate")
 interpolate = lazy_module("scipy.interpolate")
@@ -228,11 +244,22 @@ def _chebyshev_matrix(x: Array, degree: int) -> Array:
     return T
 
 
+#: :func:`_chebval`'s matrix of the terms up to this many values (points times terms),
+#: Clenshaw's recurrence beyond.
+MATRIX_LIMIT = 40_000
+
+
 def _chebval(x: Array, c: Array) -> Array:
     """The Chebyshev series ``c`` at ``x``: through :func:`_chebyshev_matrix` for a few
-    points, Clenshaw's recurrence for many."""
+    points, Clenshaw's recurrence for many (compiled where built: numpy's loop over the terms
+    costs ~3 us a term)."""
     x = np.asarray(x, dtype=float)
-    if x.size * c.size > 40_000:
+    if x.size * c.size > MATRIX_LIMIT:
+        if USE_COMPILED and _compiled is not None and c.ndim == 1 and c.size:
+            out = np.empty(x.shape)
+            _compiled.chebval(np.ascontiguousarray(x), np.ascontiguousarray(c, dtype=float),
+                              out)
+            return out
         return np.asarray(cheb.chebval(x, c))
     values: Array = _chebyshev_matrix(x, c.size - 1) @ c
     return values.reshape(x.shape)

@@ -68,7 +68,7 @@ except ImportError:  # pragma: no cover - installed without a C compiler: the Py
 
 #: The compiled passes' interface this module calls (``REACH_VERSION`` in _reach.c): a build
 #: of another version (an old one left in place) is not used.
-REACH_VERSION = 1
+REACH_VERSION = 2
 if not usable(_compiled, REACH_VERSION):
     _compiled = None  # type: ignore[assignment]  # an old build: the Python passes instead
 
