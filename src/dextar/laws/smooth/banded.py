@@ -159,7 +159,7 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
                                       f64(lp.ra), f64(lp.rg), f64(lp.rb), f64(lp.E),
                                       f64(lp.e), f64(lp.lo), f64(lp.hi), f64(x0), x, tol,
                                       dual_tol, gap_tol, maxiter)
-        return LPResult(x, float(lp.c @ x), status, nit)
+        return LPResult(x, objective(lp.c, x), status, nit)
     c, rk, ra, rg, rb, E, lo, hi = (lp.c, lp.rk, lp.ra, lp.rg, lp.rb, lp.E, lp.lo, lp.hi)
     e = np.asarray(lp.e, float).reshape(-1)
     nx = len(c)
@@ -358,7 +358,14 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
         del newton, lu, ab, abT, dx, dy, dz, ds, Dz, Dr, rp
     if status != 0 and best[0] <= 100.0:
         status, x = 0, best[1]
-    return LPResult(x, float(c @ x), status, it)
+    return LPResult(x, objective(c, x), status, it)
+
+
+def objective(c: Array, x: Array) -> float:
+    """``c . x`` by numpy's own summation, not BLAS: OpenBLAS runs a dot product of more
+    than a few thousand terms on its threads, which then spin on the other cores while the
+    next rows are built (a third more CPU time at 4000 knots on 2 cores)."""
+    return float(np.multiply(c, x).sum())
 
 
 @dataclass(frozen=True)

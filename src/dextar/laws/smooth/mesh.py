@@ -147,4 +147,7 @@ def projected(mesh: Mesh, j: Array, Tk: Array, length: float) -> Array:
     knots exactly (over the intervals' durations ``h T_k``)."""
     E, e = ends(mesh, Tk, length)
     miss = E @ j - e
-    return np.asarray(j - E.T @ np.linalg.lstsq(E @ E.T, miss, rcond=None)[0])
+    # E E^T by einsum's own loop, not BLAS: OpenBLAS runs that product on its threads from
+    # a few thousand knots, and they then spin on the other cores for a while
+    EEt = np.einsum("ij,kj->ik", E, E)
+    return np.asarray(j - E.T @ np.linalg.lstsq(EEt, miss, rcond=None)[0])
