@@ -255,10 +255,10 @@ def _chebval(x: Array, c: Array) -> Array:
     costs ~3 us a term)."""
     x = np.asarray(x, dtype=float)
     if x.size * c.size > MATRIX_LIMIT:
-        if USE_COMPILED and _compiled is not None and c.ndim == 1 and c.size:
+        if (USE_COMPILED and _compiled is not None and c.ndim == 1 and c.size
+                and c.dtype == np.float64):
             out = np.empty(x.shape)
-            _compiled.chebval(np.ascontiguousarray(x), np.ascontiguousarray(c, dtype=float),
-                              out)
+            _compiled.chebval(np.ascontiguousarray(x), np.ascontiguousarray(c), out)
             return out
         return np.asarray(cheb.chebval(x, c))
     values: Array = _chebyshev_matrix(x, c.size - 1) @ c
