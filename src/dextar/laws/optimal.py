@@ -57,15 +57,13 @@ from ..paths import Path
 from ..units import Units
 from .base import Law, _positive, law_cost
 from .registry import LawType, register_law
+from .time_optimal import REACH_VERSION  # (_reach.c's interface: one number for its callers)
 
 try:  # Clenshaw's recurrence compiled (chebval of _reach.c), built where a C compiler is
     from . import _reach as _compiled
 except ImportError:  # pragma: no cover - installed without a C compiler: numpy's chebval
     _compiled = None  # type: ignore[assignment]  # the module or None, as USE_COMPILED says
 
-#: The compiled part's interface this module calls (``REACH_VERSION`` in _reach.c, the first
-#: with ``chebval``): another version's build (an old one left in place) is not used.
-REACH_VERSION = 2
 if not usable(_compiled, REACH_VERSION):
     _compiled = None  # type: ignore[assignment]  # an old build: numpy's chebval instead
 

@@ -66,8 +66,9 @@ try:  # the reachability analysis compiled (_reach.c), built by pip where a C co
 except ImportError:  # pragma: no cover - installed without a C compiler: the Python passes
     _compiled = None  # type: ignore[assignment]  # the module or None, as USE_COMPILED says
 
-#: The compiled passes' interface this module calls (``REACH_VERSION`` in _reach.c): a build
-#: of another version (an old one left in place) is not used.
+#: The compiled passes' interface this module and :mod:`.optimal` (its ``chebval``) call
+#: (``REACH_VERSION`` in _reach.c): a build of another version (an old one left in place) is
+#: not used.
 REACH_VERSION = 2
 if not usable(_compiled, REACH_VERSION):
     _compiled = None  # type: ignore[assignment]  # an old build: the Python passes instead
