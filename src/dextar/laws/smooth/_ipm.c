@@ -185,14 +185,17 @@ static void ETy_add(const Prog *p, const double *y, double *out)
 static Py_ssize_t xband(Py_ssize_t v) { return BLOCK * (v / D) + PERM[v % D]; }
 
 /* LU factorisation with partial pivoting within the band (rows j .. j + KL at column j),
- * in place: the multipliers below the diagonal, the pivots' rows in piv, the last column
- * of each row of U in ext (as LAPACK's dgbtf2, the updates stop at the last column the
- * pivots so far can have filled: without a row exchange, the band's own KU); -1 when a
- * pivot is zero */
-static int band_lu(double *L, Py_ssize_t n, Py_ssize_t *piv, Py_ssize_t *ext)
+ * of the columns j0 .. j1 - 1 (ju_io: the reach of the updates so far), in place: the
+ * multipliers below the diagonal, the pivots' rows in piv, the last column of each row of
+ * U in ext (as LAPACK's dgbtf2, the updates stop at the last column the pivots so far can
+ * have filled: without a row exchange, the band's own KU); along with it, the forward
+ * substitution of the right-hand sides b and bb (L^-1 P b, rows up to j1 - 1 + KL made);
+ * -1 when a pivot is zero */
+static int band_lu(double *L, Py_ssize_t n, Py_ssize_t *piv, Py_ssize_t *ext,
+                   Py_ssize_t j0, Py_ssize_t j1, Py_ssize_t *ju_io, double *b, double *bb)
 {
-    Py_ssize_t ju = 0;
-    for (Py_ssize_t j = 0; j < n; j++) {
+    Py_ssize_t ju = *ju_io;
+    for (Py_ssize_t j = j0; j < j1; j++) {
         Py_ssize_t last = j + KL < n - 1 ? j + KL : n - 1;
         Py_ssize_t p = j;
         double best = fabs(AT(L, j, j));
@@ -214,15 +217,27 @@ static int band_lu(double *L, Py_ssize_t n, Py_ssize_t *piv, Py_ssize_t *ext)
                 AT(L, j, c) = AT(L, p, c);
                 AT(L, p, c) = t;
             }
-        const double inv = 1.0 / AT(L, j, j);
+        if (p != j) {
+            double t = b[j];
+            b[j] = b[p];
+            b[p] = t;
+            t = bb[j];
+            bb[j] = bb[p];
+            bb[p] = t;
+        }
+        const double inv = 1.0 / AT(L, j, j), bj = b[j], bbj = bb[j];
         for (Py_ssize_t i = j + 1; i <= last; i++) {
             double l = AT(L, i, j) * inv;
             AT(L, i, j) = l;
+            /* the forward substitution of b and bb, in band_solve2's operations and order */
+            b[i] -= l * bj;
+            bb[i] -= l * bbj;
             if (l != 0.0)
                 for (Py_ssize_t c = j + 1; c <= ju; c++)
                     AT(L, i, c) -= l * AT(L, j, c);
         }
     }
+    *ju_io = ju;
     return 0;
 }
 
@@ -260,28 +275,11 @@ static void band_solve(const double *L, Py_ssize_t n, const Py_ssize_t *piv,
     }
 }
 
-/* b := A^-1 b and c := A^-1 c in one sweep over the factors (band_solve twice) */
-static void band_solve2(const double *L, Py_ssize_t n, const Py_ssize_t *piv,
-                        const Py_ssize_t *ext, double *b, double *c)
+/* b := U^-1 b and c := U^-1 c in one sweep over the factors (the back substitution of
+ * band_solve, twice: band_lu made the forward one) */
+static void band_back2(const double *L, Py_ssize_t n, const Py_ssize_t *ext, double *b,
+                       double *c)
 {
-    for (Py_ssize_t j = 0; j < n; j++) {
-        Py_ssize_t p = piv[j];
-        if (p != j) {
-            double t = b[j];
-            b[j] = b[p];
-            b[p] = t;
-            t = c[j];
-            c[j] = c[p];
-            c[p] = t;
-        }
-        const double bj = b[j], cj = c[j];
-        Py_ssize_t last = j + KL < n - 1 ? j + KL : n - 1;
-        for (Py_ssize_t i = j + 1; i <= last; i++) {
-            const double l = AT(L, i, j);
-            b[i] -= l * bj;
-            c[i] -= l * cj;
-        }
-    }
     for (Py_ssize_t j = n - 1; j >= 0; j--) {
         double s0 = b[j], s1 = 0.0, t0 = c[j], t1 = 0.0;
         const double *row = L + j * W - j + KL;
@@ -408,6 +406,7 @@ static int newton_matrix(const Prog *p, Newton *nw, const double *Dz, double *di
      * interval, see solve), the equalities of both intervals, the diagonal, the fixed
      * variables' rows */
     double corner = 0.0;
+    Py_ssize_t done = 0, ju = 0;  /* the band's columns factorised, band_lu's reach */
     double Hp[6][6] = {{0.0}}, up[6] = {0.0};  /* interval k - 1's sums */
     Py_ssize_t r = 0;
     for (Py_ssize_t k = 0; k <= p->M; k++) {
@@ -483,9 +482,20 @@ static int newton_matrix(const Prog *p, Newton *nw, const double *Dz, double *di
         }
         memcpy(Hp, Hc, sizeof Hp);
         memcpy(up, uc, sizeof up);
+        /* the columns whose rows (to KL below the diagonal) are all made: factorised now,
+         * while the block is in cache (no second pass over the band), with the forward
+         * substitution of the border's column (BU, a copy of U) and of the predictor's
+         * right-hand side (full) */
+        memcpy(nw->BU + b0, U + b0, (size_t)here * sizeof(double));
+        const Py_ssize_t ready = b0 + here - KL;
+        if (ready > done) {
+            if (band_lu(L, nb, nw->piv, nw->ext, done, ready, &ju, nw->BU, nw->full) < 0)
+                return -1;
+            done = ready;
+        }
     }
     nw->corner = corner + diag[nk];
-    return band_lu(L, nb, nw->piv, nw->ext);
+    return band_lu(L, nb, nw->piv, nw->ext, done, nb, &ju, nw->BU, nw->full);
 }
 
 /* The solve (see the file's doc); -1 (a Python error set) when interrupted or out of
@@ -575,20 +585,20 @@ static int ipm(Prog *p, const double *x0, double *x, double tol, double dual_tol
             done = 1;
         } else {
             double mu = gap / (double)m;
-            for (Py_ssize_t i = 0; i < m; i++)
+            for (Py_ssize_t i = 0; i < m; i++) {
                 Dz[i] = z[i] / sl[i];
+                cc[i] = sl[i] * z[i];  /* the predictor's (affine) targets */
+            }
+            /* the predictor's right-hand side first: the factorisation substitutes it and
+             * the border's column forward as it goes */
+            step_rhs(p, &nw, Dz, rd, rp, re, z, cc, dz, ds);
             if (newton_matrix(p, &nw, Dz, diag) < 0) {
                 status = 2;
                 singular = 1;
             } else {
-                /* the predictor (affine) step, then the corrector's targets */
-                for (Py_ssize_t i = 0; i < m; i++)
-                    cc[i] = sl[i] * z[i];
-                step_rhs(p, &nw, Dz, rd, rp, re, z, cc, dz, ds);
-                /* the border's solve and the predictor's in one sweep, then the Schur
-                 * complement of the border */
-                memcpy(nw.BU, nw.U, (size_t)nb * sizeof(double));
-                band_solve2(nw.L, nb, nw.piv, nw.ext, nw.BU, nw.full);
+                /* the border's solve and the predictor's in one sweep back, then the Schur
+                 * complement of the border, then the corrector's targets */
+                band_back2(nw.L, nb, nw.ext, nw.BU, nw.full);
                 nw.schur = nw.corner - dot(nw.U, nw.BU, nb);
                 step_end(p, &nw, Dz, z, sl, cc, dz, ds);
                 double ap = fmin(1.0, to_bound(sl, ds, m));
