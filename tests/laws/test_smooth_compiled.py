@@ -69,6 +69,23 @@ def test_the_compiled_interior_point_solves_as_the_numpy_one(setup, monkeypatch)
         assert [r.nit for r in early] == [3, 3]
 
 
+def test_each_stopping_rule_stops_both_solvers_alike(setup, monkeypatch):  # noqa: F811
+    """With the other two tolerances out of play, each rule alone (the primal residuals, the
+    dual ones, the gap) stops the compiled solver at the numpy solver's iteration, give or
+    take one (their iterates agree to rounding): a rule the compiled passes dropped or
+    miscomputed stops it elsewhere."""
+    if banded._compiled is None:
+        pytest.skip("the compiled interior point is not built here")
+    loose = 1e3  # (the gap's rule also ends a solve whose gap is below 1e-6 of its bound)
+    for lp, x0 in programmes(setup):
+        for kw in (dict(dual_tol=loose, gap_tol=loose), dict(tol=loose, gap_tol=loose),
+                   dict(tol=loose, dual_tol=loose)):
+            python, compiled = both(monkeypatch, lp, x0, **kw)
+            assert python.status == compiled.status == 0, kw
+            assert python.nit >= 3, kw  # (the rule had work to do: 3-4, 4 and 11-13 here)
+            assert abs(python.nit - compiled.nit) <= 1, (kw, python.nit, compiled.nit)
+
+
 def test_the_compiled_interior_point_meets_the_programme(setup, monkeypatch):  # noqa: F811
     """Its solution is within the rows, the equalities and the bounds; a programme whose
     Newton matrix cannot be factorised (a NaN in a row) is status 2, not a solution."""

@@ -97,61 +97,88 @@ static void G(const Prog *p, const double *x, double *out)
         out[p->R + p->nu + i] = -x[p->il[i]];
 }
 
-/* G(x) into gx and GT(z) into out in one pass over the rows */
-static void G_GT(const Prog *p, const double *x, double *gx, const double *z, double *out)
+/* the larger of two, NaN when either is (as Python's max of NumPy's maxima here) */
+static double nan_max(double a, double b)
 {
-    memset(out, 0, p->nx * sizeof(double));
-    const double xb = x[p->nk];
-    double b = 0.0;
-    for (Py_ssize_t r = 0; r < p->R; r++) {
+    return (isnan(a) || isnan(b)) ? NAN : (a > b ? a : b);
+}
+
+/* The residuals at the iterate in one pass over the rows and the bounds: rp = G x + s - h
+ * and rd = G^T z (the fixed variables' entries zero; c and E^T y are added after); returns
+ * the gap s . z and the largest |rp| in *maxrp. In the same pass, the predictor's part of
+ * the step's right-hand side: the barrier terms Dz = z / s, the targets cc = s z,
+ * t = rp - cc / z into ds, Dz t into dz and G^T dz into rhs (work of no use when the
+ * iterate has converged, in one iteration of a solve's). Each sum in the order of G, GT
+ * and dot: the same bits as those passes one after another. */
+static double residuals(const Prog *p, const double *x, const double *sl, const double *z,
+                        double *rp, double *rd, double *maxrp, double *Dz, double *cc,
+                        double *ds, double *dz, double *rhs)
+{
+    const Py_ssize_t R = p->R, nu = p->nu, nl = p->nl, nk = p->nk;
+    memset(rd, 0, p->nx * sizeof(double));
+    memset(rhs, 0, p->nx * sizeof(double));
+    const double xb = x[nk];
+    double b = 0.0, bt = 0.0, gap = 0.0, mx = 0.0;
+#define PREDICTOR(i, res)                       \
+    const double d_ = z[i] / sl[i];             \
+    const double c_ = sl[i] * z[i];             \
+    const double t_ = (res) - c_ / z[i];        \
+    const double e_ = d_ * t_;                  \
+    Dz[i] = d_;                                 \
+    cc[i] = c_;                                 \
+    ds[i] = t_;                                 \
+    dz[i] = e_;
+    for (Py_ssize_t r = 0; r < R; r++) {
         const double *a = p->ra + 6 * r;
         const Py_ssize_t o = D * p->rk[r];
         const double *xs = x + o;
-        double *os = out + o;
+        double *os = rd + o, *ts = rhs + o;
         const double zr = z[r];
-        double s = p->rg[r] * xb;
+        double g = p->rg[r] * xb;
         for (int j = 0; j < 6; j++) {
-            s += a[j] * xs[ROW_X[j]];
+            g += a[j] * xs[ROW_X[j]];
             os[ROW_X[j]] += a[j] * zr;
         }
-        gx[r] = s;
         b += p->rg[r] * zr;
-    }
-    out[p->nk] += b;
-    for (Py_ssize_t i = 0; i < p->nu; i++) {
-        gx[p->R + i] = x[p->iu[i]];
-        out[p->iu[i]] += z[p->R + i];
-    }
-    for (Py_ssize_t i = 0; i < p->nl; i++) {
-        gx[p->R + p->nu + i] = -x[p->il[i]];
-        out[p->il[i]] -= z[p->R + p->nu + i];
-    }
-    for (Py_ssize_t i = 0; i < p->nx; i++)
-        if (p->fixed[i])
-            out[i] = 0.0;
-}
-
-/* sum z g over the inequalities (the fixed variables' entries zero) */
-static void GT(const Prog *p, const double *z, double *out)
-{
-    memset(out, 0, p->nx * sizeof(double));
-    double b = 0.0;
-    for (Py_ssize_t r = 0; r < p->R; r++) {
-        const double *a = p->ra + 6 * r;
-        double *o = out + D * p->rk[r];
-        const double zr = z[r];
+        const double res = g + (sl[r] - p->rb[r]);
+        rp[r] = res;
+        gap += sl[r] * zr;
+        mx = nan_max(mx, fabs(res));
+        PREDICTOR(r, res)
         for (int j = 0; j < 6; j++)
-            o[ROW_X[j]] += a[j] * zr;
-        b += p->rg[r] * zr;
+            ts[ROW_X[j]] += a[j] * e_;
+        bt += p->rg[r] * e_;
     }
-    out[p->nk] += b;
-    for (Py_ssize_t i = 0; i < p->nu; i++)
-        out[p->iu[i]] += z[p->R + i];
-    for (Py_ssize_t i = 0; i < p->nl; i++)
-        out[p->il[i]] -= z[p->R + p->nu + i];
+    rd[nk] += b;
+    rhs[nk] += bt;
+    for (Py_ssize_t k = 0; k < nu; k++) {
+        const Py_ssize_t i = R + k, v = p->iu[k];
+        rd[v] += z[i];
+        const double res = x[v] + (sl[i] - p->hi[v]);
+        rp[i] = res;
+        gap += sl[i] * z[i];
+        mx = nan_max(mx, fabs(res));
+        PREDICTOR(i, res)
+        rhs[v] += e_;
+    }
+    for (Py_ssize_t k = 0; k < nl; k++) {
+        const Py_ssize_t i = R + nu + k, v = p->il[k];
+        rd[v] -= z[i];
+        const double res = -x[v] + (sl[i] - -p->lo[v]);
+        rp[i] = res;
+        gap += sl[i] * z[i];
+        mx = nan_max(mx, fabs(res));
+        PREDICTOR(i, res)
+        rhs[v] -= e_;
+    }
+#undef PREDICTOR
     for (Py_ssize_t i = 0; i < p->nx; i++)
-        if (p->fixed[i])
-            out[i] = 0.0;
+        if (p->fixed[i]) {
+            rd[i] = 0.0;
+            rhs[i] = 0.0;
+        }
+    *maxrp = mx;
+    return gap;
 }
 
 /* the equalities' residuals E x - e (3 M) */
@@ -299,25 +326,6 @@ static void band_back2(const double *L, Py_ssize_t n, const Py_ssize_t *ext, dou
     }
 }
 
-/* the largest a with v + a dv >= 0 (inf when none is limited) */
-static double to_bound(const double *v, const double *dv, Py_ssize_t n)
-{
-    double a = INFINITY;
-    for (Py_ssize_t i = 0; i < n; i++)
-        if (dv[i] < 0) {
-            double t = -v[i] / dv[i];
-            if (t < a)
-                a = t;
-        }
-    return a;
-}
-
-/* the larger of two, NaN when either is (as Python's max of NumPy's maxima here) */
-static double nan_max(double a, double b)
-{
-    return (isnan(a) || isnan(b)) ? NAN : (a > b ? a : b);
-}
-
 static double max_abs(const double *v, Py_ssize_t n)
 {
     double m = 0.0;
@@ -341,20 +349,58 @@ typedef struct {
     double corner, schur;
 } Newton;
 
+/* The corrector's part of the step's right-hand side from the rows and the bounds, in one
+ * pass: for every inequality i its target cc[i] = s z + ds dz - target (from the
+ * predictor's ds and dz), t = rp - cc / z into ds, Dz t into dz, and rhs = G^T dz (the
+ * fixed variables' entries zero); each sum in the order of GT, the same bits as the loops
+ * over the inequalities one after another, without their traffic over the arrays. */
+static void targets(const Prog *p, const double *Dz, const double *rp, const double *sl,
+                    const double *z, double target, double *cc, double *dz, double *ds,
+                    double *rhs)
+{
+    const Py_ssize_t R = p->R, nu = p->nu, nl = p->nl, nk = p->nk;
+    memset(rhs, 0, p->nx * sizeof(double));
+    double b = 0.0;
+#define TARGET(i)                                                                 \
+    const double c_ = sl[i] * z[i] + ds[i] * dz[i] - target;                     \
+    const double t_ = rp[i] - c_ / z[i], d_ = Dz[i] * t_;                        \
+    cc[i] = c_;                                                                   \
+    ds[i] = t_;                                                                   \
+    dz[i] = d_;
+    for (Py_ssize_t r = 0; r < R; r++) {
+        TARGET(r)
+        const double *a = p->ra + 6 * r;
+        double *o = rhs + D * p->rk[r];
+        for (int j = 0; j < 6; j++)
+            o[ROW_X[j]] += a[j] * d_;
+        b += p->rg[r] * d_;
+    }
+    rhs[nk] += b;
+    for (Py_ssize_t k = 0; k < nu; k++) {
+        const Py_ssize_t i = R + k;
+        TARGET(i)
+        rhs[p->iu[k]] += d_;
+    }
+    for (Py_ssize_t k = 0; k < nl; k++) {
+        const Py_ssize_t i = R + nu + k;
+        TARGET(i)
+        rhs[p->il[k]] -= d_;
+    }
+#undef TARGET
+    for (Py_ssize_t i = 0; i < p->nx; i++)
+        if (p->fixed[i])
+            rhs[i] = 0.0;
+}
+
 /* The step (dx, dy, dz, ds) for the complementarity targets s z + ds z + s dz = -cc of
  * every inequality (banded._Newton.step), in two halves around the band's solve:
- * step_rhs makes its right-hand side in nw->full (ds holds t = rp - cc / z on the way),
- * step_end takes the band's solution there to the step. */
-static void step_rhs(const Prog *p, Newton *nw, const double *Dz, const double *rd,
-                     const double *rp, const double *re, const double *z, const double *cc,
-                     double *dz, double *ds)
+ * step_rhs makes its right-hand side in nw->full from the G^T dz in nw->rhs (residuals'
+ * for the predictor, targets' for the corrector; ds holds t = rp - cc / z on the way),
+ * step_end takes the band's solution there to the step and gives the largest steps to the
+ * bounds of s and of z (s + a ds >= 0, z + a dz >= 0; inf when none), in the same pass. */
+static void step_rhs(const Prog *p, Newton *nw, const double *rd, const double *re)
 {
-    const Py_ssize_t m = p->m, nk = p->nk;
-    for (Py_ssize_t i = 0; i < m; i++) {
-        ds[i] = rp[i] - cc[i] / z[i];
-        dz[i] = Dz[i] * ds[i];
-    }
-    GT(p, dz, nw->rhs);
+    const Py_ssize_t nk = p->nk;
     for (Py_ssize_t v = 0; v < p->nx; v++)
         nw->rhs[v] = -rd[v] - nw->rhs[v];
     for (Py_ssize_t v = 0; v < nk; v++)
@@ -365,24 +411,56 @@ static void step_rhs(const Prog *p, Newton *nw, const double *Dz, const double *
 }
 
 static void step_end(const Prog *p, Newton *nw, const double *Dz, const double *z,
-                     const double *s, const double *cc, double *dz, double *ds)
+                     const double *s, const double *cc, double *dz, double *ds,
+                     double *to_s, double *to_z)
 {
-    const Py_ssize_t m = p->m, nk = p->nk, nb = p->nb;
+    const Py_ssize_t nk = p->nk, nb = p->nb, R = p->R, nu = p->nu, nl = p->nl;
     double r = nw->rhs[nk] - dot(nw->U, nw->full, nb);
     double dp = r / nw->schur;
     for (Py_ssize_t i = 0; i < nb; i++)
         nw->full[i] -= nw->BU[i] * dp;
+    const double *dx = nw->dx;
     for (Py_ssize_t v = 0; v < nk; v++)
         nw->dx[v] = p->fixed[v] ? 0.0 : nw->full[xband(v)];
     nw->dx[nk] = p->fixed[nk] ? 0.0 : dp;
     for (Py_ssize_t k = 0; k < p->M; k++)
         for (int q = 0; q < Q; q++)
             nw->dy[k * Q + q] = nw->full[BLOCK * k + D + q];
-    G(p, nw->dx, dz);
-    for (Py_ssize_t i = 0; i < m; i++) {
-        dz[i] = Dz[i] * (dz[i] + ds[i]);
-        ds[i] = -(s[i] * dz[i] + cc[i]) / z[i];
+    /* G dx inequality by inequality (G's sums), then dz, ds and the bounds' ratios */
+    double as = INFINITY, az = INFINITY;
+#define STEP_END(i, g)                                      \
+    {                                                       \
+        const double d_ = Dz[i] * ((g) + ds[i]);            \
+        const double e_ = -(s[i] * d_ + cc[i]) / z[i];      \
+        dz[i] = d_;                                         \
+        ds[i] = e_;                                         \
+        if (e_ < 0) {                                       \
+            const double t_ = -s[i] / e_;                   \
+            if (t_ < as)                                    \
+                as = t_;                                    \
+        }                                                   \
+        if (d_ < 0) {                                       \
+            const double t_ = -z[i] / d_;                   \
+            if (t_ < az)                                    \
+                az = t_;                                    \
+        }                                                   \
     }
+    const double xb = dx[nk];
+    for (Py_ssize_t i = 0; i < R; i++) {
+        const double *a = p->ra + 6 * i;
+        const double *xs = dx + D * p->rk[i];
+        double g = p->rg[i] * xb;
+        for (int j = 0; j < 6; j++)
+            g += a[j] * xs[ROW_X[j]];
+        STEP_END(i, g)
+    }
+    for (Py_ssize_t k = 0; k < nu; k++)
+        STEP_END(R + k, dx[p->iu[k]])
+    for (Py_ssize_t k = 0; k < nl; k++)
+        STEP_END(R + nu + k, -dx[p->il[k]])
+#undef STEP_END
+    *to_s = as;
+    *to_z = az;
 }
 
 /* Assemble and factorise the Newton matrix at the barrier terms Dz (the border's column in
@@ -563,15 +641,14 @@ static int ipm(Prog *p, const double *x0, double *x, double tol, double dual_tol
         }
         int singular = 0, done = 0;
         Py_BEGIN_ALLOW_THREADS
-        G_GT(p, x, rp, z, rd);
+        double maxrp;
+        double gap = residuals(p, x, sl, z, rp, rd, &maxrp, Dz, cc, ds, dz, nw.rhs);
         for (Py_ssize_t v = 0; v < nx; v++)
             rd[v] += p->c[v];
         ETy_add(p, y, rd);
-        for (Py_ssize_t i = 0; i < m; i++)
-            rp[i] += sl[i] - h_of(p, i);
         Ex(p, x, re);
-        double gap = dot(sl, z, m), cx = fabs(dot(p->c, x, nx));
-        double prim = nan_max(max_abs(rp, m), max_abs(re, nE)) / (tol * scale_p);
+        double cx = fabs(dot(p->c, x, nx));
+        double prim = nan_max(maxrp, max_abs(re, nE)) / (tol * scale_p);
         double miss = nan_max(nan_max(prim, max_abs(rd, nx) / (dual_tol * scale_d)),
                               gap / (gap_tol * (1.0 + cx)));
         if (miss < best_miss) {
@@ -584,14 +661,11 @@ static int ipm(Prog *p, const double *x0, double *x, double tol, double dual_tol
         } else if (it == maxiter || gap <= 1e-6 * gap_tol * (1.0 + cx)) {
             done = 1;
         } else {
-            double mu = gap / (double)m;
-            for (Py_ssize_t i = 0; i < m; i++) {
-                Dz[i] = z[i] / sl[i];
-                cc[i] = sl[i] * z[i];  /* the predictor's (affine) targets */
-            }
-            /* the predictor's right-hand side first: the factorisation substitutes it and
-             * the border's column forward as it goes */
-            step_rhs(p, &nw, Dz, rd, rp, re, z, cc, dz, ds);
+            double mu = gap / (double)m, to_s, to_z;
+            /* the predictor's (affine) right-hand side first (residuals made its rows'
+             * part, targets s z): the factorisation substitutes it and the border's column
+             * forward as it goes */
+            step_rhs(p, &nw, rd, re);
             if (newton_matrix(p, &nw, Dz, diag) < 0) {
                 status = 2;
                 singular = 1;
@@ -600,22 +674,21 @@ static int ipm(Prog *p, const double *x0, double *x, double tol, double dual_tol
                  * complement of the border, then the corrector's targets */
                 band_back2(nw.L, nb, nw.ext, nw.BU, nw.full);
                 nw.schur = nw.corner - dot(nw.U, nw.BU, nb);
-                step_end(p, &nw, Dz, z, sl, cc, dz, ds);
-                double ap = fmin(1.0, to_bound(sl, ds, m));
-                double ad = fmin(1.0, to_bound(z, dz, m));
+                step_end(p, &nw, Dz, z, sl, cc, dz, ds, &to_s, &to_z);
+                double ap = fmin(1.0, to_s);
+                double ad = fmin(1.0, to_z);
                 double mu_aff = 0.0;
                 for (Py_ssize_t i = 0; i < m; i++)
                     mu_aff += (sl[i] + ap * ds[i]) * (z[i] + ad * dz[i]);
                 mu_aff /= (double)m;
                 double sigma = mu_aff / mu;
                 double target = sigma * sigma * sigma * mu;
-                for (Py_ssize_t i = 0; i < m; i++)
-                    cc[i] = sl[i] * z[i] + ds[i] * dz[i] - target;
-                step_rhs(p, &nw, Dz, rd, rp, re, z, cc, dz, ds);
+                targets(p, Dz, rp, sl, z, target, cc, dz, ds, nw.rhs);
+                step_rhs(p, &nw, rd, re);
                 band_solve(nw.L, nb, nw.piv, nw.ext, nw.full);
-                step_end(p, &nw, Dz, z, sl, cc, dz, ds);
-                ap = fmin(1.0, ETA * to_bound(sl, ds, m));
-                ad = fmin(1.0, ETA * to_bound(z, dz, m));
+                step_end(p, &nw, Dz, z, sl, cc, dz, ds, &to_s, &to_z);
+                ap = fmin(1.0, ETA * to_s);
+                ad = fmin(1.0, ETA * to_z);
                 for (Py_ssize_t v = 0; v < nx; v++)
                     x[v] += ap * nw.dx[v];
                 for (Py_ssize_t i = 0; i < m; i++) {
