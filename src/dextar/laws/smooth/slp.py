@@ -360,7 +360,7 @@ def slp(model: RowModel, J: Array, Tk: Array, budget: int, delta: float) -> Run:
                 rp = model.rows(mp, gradients=False)
                 php = merit(mp.T, T_ref, rp.F, lp.ahead(mp))
                 model_p = (mo.T + part * (mn.T - mo.T)) / T_ref + PENALTY * max(
-                    0.0, float((rows.F + part * (lin1 - rows.F))[use].max())) - PROGRESS * (
+                    0.0, float((rows.F + part * (lin1 - rows.F))[use].max(initial=0.0))) - PROGRESS * (
                     ahead0 + part * (lp.ahead(mn) - ahead0))
                 pp = phi - model_p
                 rp_ratio = (phi - php) / pp if pp > 0 else -1.0

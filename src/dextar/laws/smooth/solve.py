@@ -92,7 +92,8 @@ def solve_jerk_limited_law(dynamics: PathDynamics, *, motors: MotorLimits | None
         where the path's dynamics change fast, refined where the check needs).
     grid : int or ndarray, shape (N + 1,)
         The coefficient table along the path: a number of equal segments or its arc lengths
-        (from 0 to the length; the second-order start law takes every few of them).
+        (from 0 to the length; the second-order start law takes every few of them); a
+        composite path's joints are added (:func:`with_joints`).
     tol, rate_tol : float
         Allowed relative excess of a torque, speed or acceleration (``tol``) and of a jerk
         or torque rate (``rate_tol``) over its limit on the check samples.
@@ -127,9 +128,7 @@ def solve_jerk_limited_law(dynamics: PathDynamics, *, motors: MotorLimits | None
     if not third:
         raise ParameterError("a jerk-limited law needs a jerk or torque-rate limit")
     length = float(dynamics.length)
-    pts = (np.linspace(0.0, length, int(grid) + 1) if np.ndim(grid) == 0
-           else np.asarray(grid, float))
-    table = make_table(dynamics, pts)
+    table = make_table(dynamics, with_joints(dynamics, grid))
     base = _second_order(dynamics, table, second, units)
     T2 = float(base.duration)
     # the start: the second-order law, slower where the path's own third-order terms
@@ -211,6 +210,32 @@ def solve_jerk_limited_law(dynamics: PathDynamics, *, motors: MotorLimits | None
     if best is not None and (bad.any() or best.law.duration <= law.duration):
         last = best
     return _verdict(last, scales, programmes, T2)
+
+
+#: A path's joint closer than this fraction of its length to a grid point is that point.
+JOINT_GAP = 1e-9
+
+
+def with_joints(dynamics: PathDynamics, grid: int | Array) -> Array:
+    """The table's grid (``grid`` equal segments, or the arc lengths given) with the path's
+    joints added: where its pieces meet (a composite path's ``starts``: the ends of a
+    blend), the curvature's derivative, and so the joints' third derivatives, jump. Between
+    two grid points the table's columns are linear, so a jump inside a segment would become
+    a ramp as steep as the segment is short, and the rows of a point crossing it would jump
+    with the smallest change of the motion (the programmes' linear models then wrong at any
+    trust region: 2 to 5 times the duration found, or no answer). A program's grids have
+    them already (:func:`dextar.program.plan.chain_grid`)."""
+    length = float(dynamics.length)
+    pts = (np.linspace(0.0, length, int(grid) + 1) if np.ndim(grid) == 0
+           else np.asarray(grid, float))
+    starts = getattr(getattr(dynamics, "path", None), "starts", None)
+    if starts is None:
+        return pts
+    inner = np.asarray(starts, float)[1:-1]
+    gap = JOINT_GAP * length
+    near = np.abs(inner[:, None] - pts[None, :]).min(axis=1, initial=np.inf) <= gap
+    new = inner[(inner > gap) & (inner < length - gap) & ~near]
+    return np.sort(np.concatenate([pts, new])) if new.size else pts
 
 
 def _second_order(dynamics: PathDynamics, table: Table, second: Sequence[Constraint],
