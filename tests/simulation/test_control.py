@@ -68,3 +68,34 @@ def test_a_wrong_model_leaves_an_error_and_saturation_clips(traj):
 def test_bad_settings_named(traj, kw, word):
     with pytest.raises(dx.ParameterError, match=word):
         simulate_computed_torque(traj, MODEL, MODEL, **kw)
+
+
+def test_a_step_that_does_not_advance_is_a_convergence_error(monkeypatch):
+    """An integrator step that leaves the time where it was (it underflowed: the fuzz's
+    robot of zero masses and a rotor inertia of 5e-324 against its friction) ends the
+    simulation with the integrator's words, not with scipy's ValueError about the dense
+    solution's times."""
+    from types import SimpleNamespace
+
+    from scipy.integrate import OdeSolution
+
+    from dextar.errors import ConvergenceError
+    from dextar.simulation import control
+
+    class Stuck:  # advances once, then stays
+        def __init__(self, fun, t0, y0, t_bound, **kw):
+            self.t, self.status, self.moves = t0, "running", 1
+
+        def step(self):
+            if self.moves:
+                self.t += 1e-3
+                self.moves -= 1
+
+        def dense_output(self):
+            return lambda t: np.zeros(4)
+
+    monkeypatch.setattr(control, "integrate",
+                        SimpleNamespace(**{control.SOLVER: Stuck, "OdeSolution": OdeSolution}))
+    with pytest.raises(ConvergenceError, match="step became too small"):
+        control._integrate(lambda t, y: y, np.array([0.0, 1.0]), np.zeros(4), rtol=1e-6,
+                           max_step=0.01)

@@ -255,7 +255,9 @@ def _integrate(rhs: Callable[[float, Array], Array], t: Array, y0: Array, *, rto
         except SingularityError as exc:
             stop = str(exc)
             break
-        if solver.status == "failed":
+        if solver.status == "failed" or solver.t <= times[-1]:
+            # (a step that did not advance: it underflowed, e.g. a plant whose inertia is
+            # next to nothing against its friction)
             raise ConvergenceError(f"control simulation failed at t = {solver.t * time_s:.6g} s: "
                                    "the integrator's step became too small")
         times.append(solver.t)
