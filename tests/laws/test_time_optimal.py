@@ -189,3 +189,18 @@ def test_a_graded_grid_holds_the_limits_and_converges_with_the_uniform_one():
 def test_bad_grids_are_named(grid, words):
     with pytest.raises(dx.DextarError, match=words):
         solve_time_optimal_law(MODEL, SEMI, torque_limit=(20.0, 20.0), grid=grid)
+
+
+@pytest.mark.parametrize("third, words", [
+    (dict(max_jerk=(3000.0, 2500.0)), "max_jerk (3000, 2500) rad/s^3"),
+    (dict(max_torque_rate=(40.0, 40.0)), "max_torque_rate (40, 40) N m/s")])
+def test_a_third_order_limit_is_refused_by_the_second_order_law(third, words):
+    """The second-order law cannot hold a jerk or torque-rate limit: it says so and names
+    the law that can (its check had measured the jerk, 2e12 times over, and asked for a
+    finer grid, which never helps); the same motors without it plan."""
+    from dextar.errors import ParameterError
+    from dextar.motors import MotorLimits
+
+    with pytest.raises(ParameterError, match=re.escape(words) + ".*solve_jerk_limited_law"):
+        solve_time_optimal_law(MODEL, SEMI, motors=MotorLimits((20.0, 20.0), **third))
+    assert solve_time_optimal_law(MODEL, SEMI, motors=MotorLimits((20.0, 20.0))).status == 0

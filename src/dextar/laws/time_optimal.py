@@ -188,6 +188,9 @@ def solve_time_optimal_law(dynamics: PathDynamics, *,
     InfeasibleError
         No motion within the limits exists: names the point (mm), the arc length, the motor
         and the torque needed against the limit.
+    ParameterError
+        No torque limit, a bad tolerance, or a third-order limit (jerk, torque rate: see
+        :func:`~dextar.laws.solve_jerk_limited_law`).
     """
     cons = _constraints(torque_limit, speed_limit, motors, constraints)
     if not (0 < tol < 1):
@@ -254,7 +257,25 @@ def _constraints(torque_limit: tuple[float, float] | None,
         raise ParameterError("a time-optimal law needs torque limits (or motors)")
     if not any(c.torque_limit is not None for c in cons):
         raise ParameterError("a time-optimal law needs a torque limit among its constraints")
+    third = [c for c in cons if c.order == 3]
+    if third:  # (its check measured them, and a refined grid never met them)
+        raise ParameterError(
+            "a second-order time-optimal law cannot hold a third-order limit ("
+            + ", ".join(_third_words(c) for c in third) + "): "
+            "dextar.laws.solve_jerk_limited_law plans within it (the registered "
+            "time-optimal law takes it when the motors have one)")
     return cons
+
+
+def _third_words(c: Constraint) -> str:
+    """A third-order limit in words, with its values in SI."""
+    jerk = getattr(c, "max_jerk", None)
+    if jerk is not None:
+        return f"max_jerk ({jerk[0]:g}, {jerk[1]:g}) rad/s^3"
+    rate = getattr(c, "max_torque_rate", None)
+    if rate is not None:
+        return f"max_torque_rate ({rate[0]:g}, {rate[1]:g}) N m/s"
+    return c.kind
 
 
 def _torque_limit(cons: Sequence[Constraint]) -> tuple[float, float]:
