@@ -2,7 +2,8 @@
 to the second-order law as the jerk limit grows, its planning time per pick-and-place move
 against the second-order law's, the issue's programs, and its growth with the knots.
 
-Run: python benchmarks/bench_smooth.py [ruckig] [convergence] [moves] [programs] [scaling]
+Run: python benchmarks/bench_smooth.py [ruckig] [convergence] [moves] [programs] [blends]
+[scaling]
 (all sections without arguments; ruckig: pip install -e '.[bench]').
 
 Floors (issue 29):
@@ -20,6 +21,10 @@ Floors (issue 29):
   warm-up, its CPU time); one programme of about 1000 knots solved by the banded
   interior point (compiled where built) and by HiGHS (scipy's linprog, dual simplex and
   IPX) on the same rows, which is why the programmes have their own solver.
+
+The blends section plans 40 random blended corners through the API (no floor: how often the
+programmes settle, at what cost, how far from the second-order law and from the same corner
+on a program's grid).
 
 The moves section also times the jerk-limited law without any compiled part (an install
 without a C compiler: laws/smooth/_ipm.c and _rows.c, dynamics/_kernel.c and laws/_reach.c not
@@ -235,6 +240,62 @@ def section_programs(rounds: int = 5) -> None:
                   f"[{np.median(t2):.3f}]: {out2[:100]}; ratio {np.median(np.array(t3) / t2):.1f}x")
 
 
+def corners(n: int, seed: int = 0) -> list:
+    """``n`` blended corners of the jerk example's workspace: two lines of at least 30 mm
+    between random points (x in +-70 mm, y in 150-210 mm), rounded within 3 to 12 mm
+    (corners that turn back, which a blend cannot round, drawn again)."""
+    from dextar.errors import ParameterError
+    from dextar.paths.composite import blended
+
+    rng = np.random.default_rng(seed)
+    out: list = []
+    while len(out) < n:
+        p = [(rng.uniform(-0.07, 0.07), rng.uniform(0.15, 0.21)) for _ in range(3)]
+        if min(np.hypot(*np.subtract(p[1], p[0])), np.hypot(*np.subtract(p[2], p[1]))) < 0.03:
+            continue
+        try:
+            out.append(blended((Line(p[0], p[1]), Line(p[1], p[2])),
+                               (rng.uniform(0.003, 0.012),))[0])
+        except ParameterError:
+            continue
+    return out
+
+
+def section_blends(n: int = 40) -> None:
+    """Random blended corners planned through the API (``grid=400``): whether the programmes
+    settle, what they cost, the duration against the second-order law's (the same motors
+    without the jerk limit: a lower bound), and the duration on the grid a program gives
+    the same corner (``chain_grid``): two grids, two nearby starts of a non-convex search;
+    their difference is how far the law is from settling on one answer."""
+    from dextar.program.plan import chain_grid
+
+    sc = load_scenario(JERK_EXAMPLE)
+    motors = sc.si_motors
+    assert motors is not None
+    plain = MotorLimits(motors.peak_torque, motors.max_speed, motors.knee_speed)
+    rows = []
+    for path in corners(n):
+        dyn = RobotAlongPath(sc.si_model, path, sc.mode)
+        t0 = time.process_time()
+        law = solve_jerk_limited_law(dyn, motors=motors, grid=400)
+        cpu = time.process_time() - t0
+        other = solve_jerk_limited_law(dyn, motors=motors, grid=chain_grid(path, 400))
+        second = solve_time_optimal_law(dyn, motors=plain, grid=400)
+        rows.append((law.status, "did not settle" not in law.message, law.solves, cpu,
+                     law.duration / second.duration, abs(other.duration / law.duration - 1)))
+    st, settled, progs, cpu, ratio, spread = (np.array(c) for c in zip(*rows, strict=True))
+    print(f"{n} random blended corners (2 lines of 30-150 mm, 3-12 mm blends; the jerk "
+          f"example's motors; load {load()}):\n"
+          f"  status 0: {int((st == 0).sum())}, settled: {int(settled.sum())}; programmes "
+          f"median {np.median(progs):.0f}, largest {progs.max()}; CPU {cpu.sum():.2f} s in "
+          f"all, largest {cpu.max():.3f} s\n"
+          f"  duration / second-order law's: median {np.median(ratio):.2f}, {ratio.min():.2f} "
+          f"to {ratio.max():.2f}\n"
+          f"  on the program's grid instead: differs by median {np.median(spread):.2%}, "
+          f"mean {spread.mean():.2%}, largest {spread.max():.2%}; within 1 %: "
+          f"{int((spread <= 0.01).sum())} of {n}")
+
+
 def one_size(segments: int) -> dict[str, float]:
     """Plan the pick-and-place line with at least ``segments`` intervals, in this process:
     CPU and wall time, peak resident memory above the process's after a warm-up (Linux:
@@ -357,7 +418,8 @@ def section_scaling(repeats: int = 3) -> None:
 
 
 SECTIONS = {"ruckig": section_ruckig, "convergence": section_convergence,
-            "moves": section_moves, "programs": section_programs, "scaling": section_scaling}
+            "moves": section_moves, "programs": section_programs, "blends": section_blends,
+            "scaling": section_scaling}
 
 
 def main(argv: list[str]) -> None:
