@@ -332,14 +332,17 @@ def test_without_pymoo_the_extra_is_named(tmp_path, capsys, monkeypatch):
     assert not (tmp_path / "o").exists()
 
 
-def test_no_warning_where_the_time_optimal_law_names_an_unreachable_stage():
+def test_no_warning_where_the_time_optimal_law_names_an_unreachable_stage(monkeypatch):
     """A pick-and-place design whose time-optimal plan fails at a stage after its torque
     limit was tightened to nothing: the reason is a row, no RuntimeWarning (numpy's divide
-    by zero reached the terminal from every worker)."""
+    by zero reached the terminal from every worker). The law now first refines its grid
+    where the check finds an excess, and this design then fits its motors (near the
+    envelope's top speed): the tightening path is taken here with the refinement off."""
     from pathlib import Path
 
     from dextar.config import load_toml
     from dextar.design.evaluate import evaluate_design
+    from dextar.laws import time_optimal
 
     from ..robustness.harness import toml_text
 
@@ -348,10 +351,14 @@ def test_no_warning_where_the_time_optimal_law_names_an_unreachable_stage():
     path = Path(__import__("tempfile").mkdtemp()) / "pp.toml"
     path.write_text(toml_text(doc))
     task, _ = load_scenario(path).design_task()
+    x = [53.501671366393566, 133.4673346579075, 93.27383426949382, 62.73520674556494,
+         21.362981339916587]
+    refined = evaluate_design(task, x)
+    assert refined["feasible"], refined["reason"]
+    monkeypatch.setattr(time_optimal, "MAX_SPLIT", 0)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        row = evaluate_design(task, [53.501671366393566, 133.4673346579075, 93.27383426949382,
-                                     62.73520674556494, 21.362981339916587])
+        row = evaluate_design(task, x)
     # (the law's last motion beyond its tightened limits is now returned and sized: the
     # envelope's limit named with its units; before, no motion was found)
     assert not row["feasible"], row

@@ -204,3 +204,29 @@ def test_a_third_order_limit_is_refused_by_the_second_order_law(third, words):
     with pytest.raises(ParameterError, match=re.escape(words) + ".*solve_jerk_limited_law"):
         solve_time_optimal_law(MODEL, SEMI, motors=MotorLimits((20.0, 20.0), **third))
     assert solve_time_optimal_law(MODEL, SEMI, motors=MotorLimits((20.0, 20.0))).status == 0
+
+
+def test_the_grid_is_refined_where_the_check_finds_an_excess():
+    """A corner blended within 7.4 mm (a 2 mm quintic between two lines) on 400 equal
+    segments: the segments where the check samples exceed the torque limit are split, and
+    the law uses its torque (ratio 1.0002) within 2 % of the law on 6400 segments (0.1946
+    against 0.1914 s). Tightening alone (no split) used 63 % of the torque and took 0.56 s,
+    three times as long, with status 0."""
+    from dextar.config import load_scenario
+    from dextar.dynamics import RobotAlongPath
+    from dextar.laws import solve_time_optimal_law as solve
+    from dextar.motors import MotorLimits
+    from dextar.paths.composite import blended
+
+    from ..program.test_program import EXAMPLES
+
+    model = load_scenario(str(EXAMPLES / "jerk_pick_place.toml")).si_model
+    path, _ = blended((Line((-0.0681, 0.176), (0.0367, 0.1868)),
+                       Line((0.0367, 0.1868), (-0.0246, 0.193))), (0.00736,))
+    dyn = RobotAlongPath(model, path, "+-")
+    motors = MotorLimits((1.5, 1.5))
+    law, fine = solve(dyn, motors=motors, grid=400), solve(dyn, motors=motors, grid=6400)
+    assert law.status == fine.status == 0
+    assert law.max_torque_ratio >= 0.98, law.message  # (0.63 without the split)
+    assert law.duration <= 1.02 * fine.duration, (law.duration, fine.duration)  # (2.9 x)
+    assert len(law.knots_s) > 401  # (split where the excess was)

@@ -51,6 +51,7 @@ from .base import Law
 from .constraints import (
     Constraint,
     DegeneracyCondition,
+    JointSamples,
     PathCoefficients,
     PathDynamics,
     Tangent,
@@ -85,6 +86,14 @@ MAX_SOLVES = 8
 #: of the pick-and-place sweep, 3e-2 moved the cycle times by at most 1.8e-5 relative against
 #: 1e-3, far below the grid's own loss (about 1e-3 at 400 segments).
 TANGENT_RTOL = 3e-2
+#: Rounds of refinement before the limits are tightened: the segments whose check samples
+#: exceed a limit are split (the excess between grid points falls with the square of the
+#: segment) into as many pieces as bring it to a quarter of the tolerance, at most
+#: :data:`SPLIT_MOST` each (a short blend on an equal grid has few points: the law tightened
+#: every limit by its excess there, 62 % on a 2 mm blend of 400 segments, three times slower
+#: than on a grid fine there).
+MAX_SPLIT = 2
+SPLIT_MOST = 8
 #: Where the output check samples each segment (fractions of its duration): both ends
 #: (the acceleration jumps at the knots) and seven interior points.
 CHECK_FRACTIONS = np.concatenate([[1e-9], np.linspace(0.125, 0.875, 7), [1.0 - 1e-9]])
@@ -214,13 +223,16 @@ def solve_time_optimal_law(dynamics: PathDynamics, *,
     # the tangent points of the speed-dependent bounds, first at the speed limits
     x0 = _first_tangent(speed_cap(cons, co)) if tangent else None
     limits = (_torque_limit(cons), _speed_limit(cons))
+    split = 0
     for solve in range(1, MAX_SOLVES + 1):
         try:
             x = _reachability(co, ds, [c.scaled(scales) for c in cons], x0, units, tmax)
         except InfeasibleError:
-            if law is None or all(v == 1.0 for v in scales.values()):
+            if law is None or (split == 0 and all(v == 1.0 for v in scales.values())):
                 raise  # no motion within the user's own limits
-            break  # the limits tightened for the grid leave none: the last law, beyond them
+            # the limits tightened (or the grid refined) leave none: the last law, beyond them
+            ds = np.diff(law.knots_s)
+            break
 
         tangent_moved = tangent and (x0 is None or np.abs(np.sqrt(x) - np.sqrt(x0)).max()
                                      > TANGENT_RTOL * np.sqrt(x).max())
@@ -232,10 +244,27 @@ def solve_time_optimal_law(dynamics: PathDynamics, *,
         law = _law(length, co.s, x, *limits, solve)
         dts = np.diff(law.knots_t)
         times = (law.knots_t[:-1, None] + dts[:, None] * CHECK_FRACTIONS[None, :]).reshape(-1)
-        ratio = ratios_by_kind(cons, dynamics.samples(law, times))
+        js = dynamics.samples(law, times)
+        ratio = ratios_by_kind(cons, js)
         law = _with(law, ratio.get("torque", 0.0), ratio.get("speed", 0.0), 0, "")
         if all(r <= 1 + tol for r in ratio.values()):
             break
+        if bounded and split < MAX_SPLIT and solve < MAX_SOLVES:
+            # where the excess is: those segments split (the same limits on a finer grid)
+            seg = _segment_ratios(cons, js, len(ds))
+            pieces = np.where(seg > 1 + tol, np.clip(np.ceil(np.sqrt(
+                4.0 * np.maximum(seg - 1.0, 0.0) / tol)), 2, SPLIT_MOST), 1).astype(int)
+            if pieces.max() > 1:
+                split += 1
+                s_new = split_segments(co.s, pieces)
+                if adjust is not None:
+                    s_new = adjust(s_new)
+                if x0 is not None:
+                    x0 = np.interp(s_new, co.s, x0)
+                co = dynamics.coefficients(s_new)
+                _check_holding(co, tmax, units)
+                ds = np.diff(co.s)
+                continue
         if bounded:  # discretisation excess: tighten by it
             for kind, r in ratio.items():
                 scales[kind] *= min(1.0, (1 + 0.25 * tol) / max(r, 1e-300))
@@ -313,6 +342,26 @@ def _verdict(law: TimeOptimalLaw, ratio: dict[str, float], scales: dict[str, flo
     msg = (f"limits exceeded on the check samples after {law.solves} solves: {ratios} "
            f"(tolerance {1 + tol:g}); refine the grid")
     return _with(law, law.max_torque_ratio, law.max_speed_ratio, 1, msg)
+
+
+def _segment_ratios(cons: Sequence[Constraint], js: JointSamples, n: int) -> Array:
+    """Each segment's largest ratio of a limited quantity to its limit (n,) on the check
+    samples (:data:`CHECK_FRACTIONS` of each segment, in order)."""
+    out = np.zeros(n)
+    for c in cons:
+        r = np.asarray(c.sample_ratios(js), float)
+        if r.size == n * len(CHECK_FRACTIONS):
+            out = np.maximum(out, r.reshape(n, -1).max(axis=1))
+    return out
+
+
+def split_segments(s: Array, pieces: Array) -> Array:
+    """The grid ``s`` with segment ``k`` split into ``pieces[k]`` equal ones."""
+    many = pieces > 1
+    n = pieces[many]
+    k = np.repeat(np.flatnonzero(many), n - 1)
+    j = np.concatenate([np.arange(1, v) for v in n])
+    return np.sort(np.concatenate([s, s[k] + (s[k + 1] - s[k]) * j / np.repeat(n, n - 1)]))
 
 
 def _first_tangent(x: Array) -> Array | None:

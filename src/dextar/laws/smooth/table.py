@@ -12,6 +12,7 @@ import numpy as np
 from ..._arrays import Array
 from ..base import Law
 from ..constraints import JointSamples, PathCoefficients, PathDynamics
+from ..time_optimal import split_segments
 
 #: The table's columns (2 each): q', q'', q''' and a, b, g, a', b', g'.
 Q1, Q2, Q3, A, B, G, DA, DB, DG = (slice(2 * i, 2 * i + 2) for i in range(9))
@@ -91,19 +92,10 @@ def make_table(dynamics: PathDynamics, s: Array) -> Table:
         if not bad.any():
             break
         pieces = np.where(bad, np.clip(np.ceil(np.sqrt(err / TABLE_TOL)), 2, 8), 1)
-        s = _split(s, pieces.astype(int))
+        s = split_segments(s, pieces.astype(int))
     else:
         co, lo, hi, joint = _columns(s, *_coefficients(dynamics, [s], length)[0])
     return Table(co, lo, hi, co.s[joint])
-
-
-def _split(s: Array, pieces: Array) -> Array:
-    """The grid with segment ``k`` split into ``pieces[k]`` equal ones."""
-    many = pieces > 1
-    n = pieces[many]
-    k = np.repeat(np.flatnonzero(many), n - 1)
-    j = np.concatenate([np.arange(1, v) for v in n])
-    return np.sort(np.concatenate([s, s[k] + (s[k + 1] - s[k]) * j / np.repeat(n, n - 1)]))
 
 
 def _coefficients(dynamics: PathDynamics, grids: list[Array], length: float
