@@ -6,7 +6,9 @@ third-order limits (joint jerk, torque rate).
 Method: direct transcription in normalised time with piecewise-constant jerk, solved by
 sequential linear programming (SLP) with a trust region, the duration a variable of every
 programme; the start is the second-order time-optimal law passed through a moving-average
-filter; the transcription is refined where the output check finds a limit exceeded. The
+filter; the transcription is refined where the output check finds a limit exceeded. Where the
+jerk rules the motion, a second search starts from the second-order law with the joint
+accelerations capped below the first motion's peak, and the faster law is kept. The
 modules, in the order of the solve:
 
 * :mod:`.table`: the path's coefficients on the grid and their slopes along the path.

@@ -16,7 +16,7 @@ from ...errors import InfeasibleError, ParameterError
 from ...motors import MotorLimits
 from ...units import Units
 from ..base import Law
-from ..constraints import Constraint, PathDynamics, motor_constraints
+from ..constraints import AccelerationLimit, Constraint, PathDynamics, motor_constraints
 from ..time_optimal import TimeOptimalLaw, solve_time_optimal_law
 from .check import RATE_KINDS, check
 from .law import JerkLimitedLaw
@@ -83,6 +83,12 @@ def solve_jerk_limited_law(dynamics: PathDynamics, *, motors: MotorLimits | None
     """The fastest rest-to-rest law along a path, with zero acceleration at both ends, within
     the motors' limits including jerk and torque rate (see :mod:`dextar.laws.smooth`).
 
+    The search is local (the problem is not convex). Where the jerk rules the motion (its
+    duration above :data:`SECOND_START` times the second-order law's) a second search
+    starts from the second-order law with the joint accelerations capped at
+    :data:`CAP_FRACTION` of the first motion's peak, and the faster law is returned (its
+    message says so).
+
     Parameters
     ----------
     dynamics : PathDynamics
@@ -128,12 +134,58 @@ def solve_jerk_limited_law(dynamics: PathDynamics, *, motors: MotorLimits | None
         raise ParameterError(f"segments = {segments!r} must be a whole number of at least 16")
     if not (0 < tol < 1 and 0 < rate_tol < 1):
         raise ParameterError(f"tolerances {tol!r}, {rate_tol!r} must be in (0, 1)")
+    if not any(c.order == 3 for c in cons):
+        raise ParameterError("a jerk-limited law needs a jerk or torque-rate limit")
+    table = make_table(dynamics, with_joints(dynamics, grid))
+    law = _solve(dynamics, table, cons, int(segments), tol, rate_tol, units)
+    if law.status != 0 or law.duration <= SECOND_START * law.second_order_duration:
+        return law
+    # the jerk rules the motion: a second search from a start whose joint accelerations are
+    # capped below the first motion's peak (the second-order law's are far above a
+    # jerk-limited motion's, and its filtered start leads the programmes to a slower motion)
+    js = dynamics.samples(law, np.linspace(0.0, law.duration, CHECK_SAMPLES))
+    if js.ddq is None:
+        return law
+    peak = CAP_FRACTION * np.abs(js.ddq).max(axis=0)
+    cap = AccelerationLimit((float(peak[0]), float(peak[1])), kind=CAP_KIND)
+    try:
+        other = _solve(dynamics, table, (*cons, cap), int(segments), tol, rate_tol, units)
+    except InfeasibleError:
+        return law
+    if other.status != 0 or other.duration >= law.duration:
+        return replace(law, solves=law.solves + other.solves)
+    ratio, excess = check(dynamics, cons, other, tol, rate_tol)  # the user's limits alone
+    if np.any(excess > 0):
+        return replace(law, solves=law.solves + other.solves)
+    words = ", ".join(f"{k} ratio {r:.5f}" for k, r in ratio.items())
+    how = other.message[other.message.index(" on the check samples ("):]
+    return replace(other, ratios=ratio, solves=law.solves + other.solves,
+                   message=(f"jerk-limited time-optimal within the limits: {words}{how}; "
+                            f"from a second start, the joint accelerations capped at "
+                            f"{CAP_FRACTION:g} of the first motion's peak ({law.duration:.6g} s "
+                            f"before)"))
+
+
+#: A second search (see :func:`solve_jerk_limited_law`) where the first motion's duration is
+#: above this multiple of the second-order law's (the jerk rules it), from the second-order
+#: law with the joint accelerations capped at :data:`CAP_FRACTION` of the first motion's peak
+#: (on :data:`CHECK_SAMPLES` samples); the faster of the two is returned (the cap only ever
+#: narrows the limits). Measured on 40 random blended corners (``bench_smooth.py blends``):
+#: the first search alone 4.5 % above the best of five starts on average, up to 12.9 %; the
+#: faster of the two 1.1 %, up to 4.3 % (caps at 0.3 and 0.5 of the peak: 27 % and 8.7 %).
+SECOND_START = 1.2
+CAP_FRACTION = 0.7
+CHECK_SAMPLES = 2001
+CAP_KIND = "second start's acceleration cap"
+
+
+def _solve(dynamics: PathDynamics, table: Table, cons: Sequence[Constraint], segments: int,
+           tol: float, rate_tol: float, units: Units | None) -> JerkLimitedLaw:
+    """One search of :func:`solve_jerk_limited_law` on the table, from the second-order law
+    within ``cons`` filtered."""
     second = [c for c in cons if c.order == 2]
     third = [c for c in cons if c.order == 3]
-    if not third:
-        raise ParameterError("a jerk-limited law needs a jerk or torque-rate limit")
     length = float(dynamics.length)
-    table = make_table(dynamics, with_joints(dynamics, grid))
     base = _second_order(dynamics, table, second, units)
     T2 = float(base.duration)
     # the start: the second-order law, slower where the path's own third-order terms
