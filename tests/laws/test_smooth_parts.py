@@ -399,13 +399,16 @@ def test_a_second_start_where_the_jerk_rules(chain):
     them. Margin: 3 %."""
     dyn, path = chain
     tab = table.make_table(dyn, solve.with_joints(dyn, grid(path)))
-    first = solve._solve(dyn, tab, motor_constraints(MOTORS), 32, 1e-3, 1e-2, None)
+    first = solve._solve(dyn, tab, motor_constraints(MOTORS), 32, 1e-3, 1e-2, None).law
     law = solve_jerk_limited_law(dyn, motors=MOTORS, grid=grid(path))
     assert first.duration > solve.SECOND_START * first.second_order_duration
     assert law.status == 0 and "from a second start" in law.message, law.message
     assert law.duration <= 0.97 * first.duration, (law.duration, first.duration)
     assert set(law.ratios) == {"torque", "jerk"} and solve.CAP_KIND not in law.message
     assert max(law.ratios.values()) <= 1.01
+    # (compared with the first search's second-order law, not the capped one's)
+    assert law.second_order_duration == first.second_order_duration
+    assert f"{law.duration / first.second_order_duration - 1:+.2%} against" in law.message
 
 
 def test_the_second_start_keeps_the_faster_law(chain, monkeypatch):
@@ -418,7 +421,7 @@ def test_the_second_start_keeps_the_faster_law(chain, monkeypatch):
     a = solve._solve(dyn, tab, cons, 32, 1e-3, 1e-2, None)
     b = solve._solve(dyn, tab, (*cons, AccelerationLimit((100.0, 100.0))), 32, 1e-3, 1e-2,
                      None)
-    fast, slow = (a, b) if a.duration < b.duration else (b, a)
+    fast, slow = (a, b) if a.law.duration < b.law.duration else (b, a)
 
     def stored(*laws):
         it = iter(laws)
@@ -433,11 +436,12 @@ def test_the_second_start_keeps_the_faster_law(chain, monkeypatch):
     for first, second in ((slow, fast), (fast, slow)):
         monkeypatch.setattr(solve, "_solve", stored(first, second))
         law = solve_jerk_limited_law(dyn, motors=MOTORS, grid=grid(path))
-        assert law.duration == fast.duration
-        assert law.solves == a.solves + b.solves
+        assert law.duration == fast.law.duration
+        assert law.solves == a.programmes + b.programmes
+        assert law.second_order_duration == first.T2
     monkeypatch.setattr(solve, "_solve", stored(slow, InfeasibleError("none")))
     law = solve_jerk_limited_law(dyn, motors=MOTORS, grid=grid(path))
-    assert law is slow
-    quick = replace(slow, second_order_duration=slow.duration)  # (the jerk does not rule)
+    assert law is slow.law
+    quick = replace(slow, T2=slow.law.duration)  # (the jerk does not rule)
     monkeypatch.setattr(solve, "_solve", stored(quick))
-    assert solve_jerk_limited_law(dyn, motors=MOTORS, grid=grid(path)) is quick
+    assert solve_jerk_limited_law(dyn, motors=MOTORS, grid=grid(path)) is quick.law

@@ -137,8 +137,9 @@ def solve_jerk_limited_law(dynamics: PathDynamics, *, motors: MotorLimits | None
     if not any(c.order == 3 for c in cons):
         raise ParameterError("a jerk-limited law needs a jerk or torque-rate limit")
     table = make_table(dynamics, with_joints(dynamics, grid))
-    law = _solve(dynamics, table, cons, int(segments), tol, rate_tol, units)
-    if law.status != 0 or law.duration <= SECOND_START * law.second_order_duration:
+    first = _solve(dynamics, table, cons, int(segments), tol, rate_tol, units)
+    law = first.law
+    if law.status != 0 or law.duration <= SECOND_START * first.T2:
         return law
     # the jerk rules the motion: a second search from a start whose joint accelerations are
     # capped below the first motion's peak (the second-order law's are far above a
@@ -152,18 +153,19 @@ def solve_jerk_limited_law(dynamics: PathDynamics, *, motors: MotorLimits | None
         other = _solve(dynamics, table, (*cons, cap), int(segments), tol, rate_tol, units)
     except InfeasibleError:
         return law
-    if other.status != 0 or other.duration >= law.duration:
-        return replace(law, solves=law.solves + other.solves)
-    ratio, excess = check(dynamics, cons, other, tol, rate_tol)  # the user's limits alone
+    both = first.programmes + other.programmes
+    if other.law.status != 0 or other.law.duration >= law.duration:
+        return replace(law, solves=both)
+    ratio, excess = check(dynamics, cons, other.law, tol, rate_tol)  # the user's limits alone
     if np.any(excess > 0):
-        return replace(law, solves=law.solves + other.solves)
-    words = ", ".join(f"{k} ratio {r:.5f}" for k, r in ratio.items())
-    how = other.message[other.message.index(" on the check samples ("):]
-    return replace(other, ratios=ratio, solves=law.solves + other.solves,
-                   message=(f"jerk-limited time-optimal within the limits: {words}{how}; "
-                            f"from a second start, the joint accelerations capped at "
-                            f"{CAP_FRACTION:g} of the first motion's peak ({law.duration:.6g} s "
-                            f"before)"))
+        return replace(law, solves=both)
+    # its words: the user's limits (the cap's kind and its tightening left out) and the
+    # second-order law of the first search (the capped one's is slower)
+    scales = {k: v for k, v in other.scales.items() if k != CAP_KIND}
+    note = (f"; from a second start, the joint accelerations capped at {CAP_FRACTION:g} of "
+            f"the first motion's peak ({law.duration:.6g} s from the first)")
+    return _verdict(replace(other.last, ratio=ratio, bad=excess > 0), scales, both,
+                    first.T2, note)
 
 
 #: A second search (see :func:`solve_jerk_limited_law`) where the first motion's duration is
@@ -179,8 +181,19 @@ CHECK_SAMPLES = 2001
 CAP_KIND = "second start's acceleration cap"
 
 
+@dataclass(frozen=True)
+class _Search:
+    """A search's law (with its verdict) and what its verdict was made of."""
+
+    law: JerkLimitedLaw
+    last: _Round
+    scales: dict[str, float]
+    programmes: int
+    T2: float
+
+
 def _solve(dynamics: PathDynamics, table: Table, cons: Sequence[Constraint], segments: int,
-           tol: float, rate_tol: float, units: Units | None) -> JerkLimitedLaw:
+           tol: float, rate_tol: float, units: Units | None) -> _Search:
     """One search of :func:`solve_jerk_limited_law` on the table, from the second-order law
     within ``cons`` filtered."""
     second = [c for c in cons if c.order == 2]
@@ -266,7 +279,7 @@ def _solve(dynamics: PathDynamics, table: Table, cons: Sequence[Constraint], seg
     last = _Round(law, ratio, bad, mesh, run, refined, stretched)
     if best is not None and (bad.any() or best.law.duration <= law.duration):
         last = best
-    return _verdict(last, scales, programmes, T2)
+    return _Search(_verdict(last, scales, programmes, T2), last, scales, programmes, T2)
 
 
 #: A path's joint closer than this fraction of its length to a grid point is that point.
@@ -383,9 +396,10 @@ class _Round:
     stretched: int
 
 
-def _verdict(r: _Round, scales: dict[str, float], programmes: int, T2: float
+def _verdict(r: _Round, scales: dict[str, float], programmes: int, T2: float, note: str = ""
              ) -> JerkLimitedLaw:
-    """The law with its ratios, status and message."""
+    """The law with its ratios, status and message (``note`` at its end); ``T2`` the
+    second-order law's duration it is compared with."""
     law, ratio, bad, mesh, run = r.law, r.ratio, r.bad, r.mesh, r.run
     refined, stretched = r.refined, r.stretched
     ok = not bad.any()
@@ -408,7 +422,8 @@ def _verdict(r: _Round, scales: dict[str, float], programmes: int, T2: float
         msg = f"limits exceeded on the check samples ({how}): {words}"
     if not run.converged:
         msg += "; the linear programmes did not settle"
-    return replace(law, ratios=ratio, status=0 if ok else 1, message=msg, solves=programmes)
+    return replace(law, ratios=ratio, status=0 if ok else 1, message=msg + note,
+                   solves=programmes, second_order_duration=T2)
 
 
 def _build(r: Any) -> Law:
