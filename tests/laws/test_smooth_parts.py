@@ -438,6 +438,7 @@ def test_the_second_start_keeps_the_faster_law(chain, monkeypatch):
         law = solve_jerk_limited_law(dyn, motors=MOTORS, grid=grid(path))
         assert law.duration == fast.law.duration
         assert law.solves == a.programmes + b.programmes
+        assert f"{law.solves} linear programmes" in law.message, law.message
         assert law.second_order_duration == first.T2
     monkeypatch.setattr(solve, "_solve", stored(slow, InfeasibleError("none")))
     law = solve_jerk_limited_law(dyn, motors=MOTORS, grid=grid(path))
@@ -445,3 +446,31 @@ def test_the_second_start_keeps_the_faster_law(chain, monkeypatch):
     quick = replace(slow, T2=slow.law.duration)  # (the jerk does not rule)
     monkeypatch.setattr(solve, "_solve", stored(quick))
     assert solve_jerk_limited_law(dyn, motors=MOTORS, grid=grid(path)) is quick.law
+
+
+def test_a_second_start_leaves_a_still_joint_uncapped():
+    """A joint move in which one joint stays still: the jerk rules it, its peak acceleration
+    is 0 on that joint, and the second start caps the other joint only (a cap of 0 made
+    0 / 0 ratios and a ValueError in the knots' placement)."""
+    from dextar.dynamics import RobotAlongJointLine
+    from dextar.trajectory import JointLine
+
+    m = load_scenario(str(EXAMPLES / "pick_place.toml")).si_model
+    dyn = RobotAlongJointLine(m, JointLine((2.2, 0.9), (1.6, 0.9)))
+    law = solve_jerk_limited_law(dyn, motors=MotorLimits((50.0, 50.0), (3.0, 3.0), None,
+                                                         (40.0, 30.0), (50.0, 50.0)))
+    assert law.status == 0 and law.duration > solve.SECOND_START * law.second_order_duration
+    assert "second start" in law.message, law.message
+
+
+def test_a_cap_of_its_own_kind_is_tightened_by_its_own_scale():
+    """The second start's acceleration cap is tightened by its own kind's scale, not by the
+    user's acceleration limit's (nor is the user's by the cap's)."""
+    from dextar.laws.constraints import AccelerationLimit
+
+    cap = AccelerationLimit((10.0, 20.0), kind=solve.CAP_KIND)
+    assert cap.scaled({"acceleration": 0.5}).max_acceleration == (10.0, 20.0)
+    assert cap.scaled({solve.CAP_KIND: 0.5}).max_acceleration == (5.0, 10.0)
+    user = AccelerationLimit((10.0, 20.0))
+    assert user.scaled({solve.CAP_KIND: 0.5}).max_acceleration == (10.0, 20.0)
+    assert user.scaled({"acceleration": 0.5}).max_acceleration == (5.0, 10.0)

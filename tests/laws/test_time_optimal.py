@@ -230,3 +230,38 @@ def test_the_grid_is_refined_where_the_check_finds_an_excess():
     assert law.max_torque_ratio >= 0.98, law.message  # (0.63 without the split)
     assert law.duration <= 1.02 * fine.duration, (law.duration, fine.duration)  # (2.9 x)
     assert len(law.knots_s) > 401  # (split where the excess was)
+
+
+def test_a_refined_grid_without_motion_goes_back_to_the_grid_before(monkeypatch):
+    """Where the refined grid finds no motion (its friction tangent interpolated) but the grid
+    before found one, the law goes back to that grid and tightens the limits as without a
+    split (never a new "no motion"): the same law as with the split off."""
+    from dextar.config import load_scenario
+    from dextar.dynamics import RobotAlongPath
+    from dextar.errors import InfeasibleError
+    from dextar.laws import solve_time_optimal_law as solve
+    from dextar.laws import time_optimal
+    from dextar.motors import MotorLimits
+    from dextar.paths.composite import blended
+
+    from ..program.test_program import EXAMPLES
+
+    model = load_scenario(str(EXAMPLES / "jerk_pick_place.toml")).si_model
+    path, _ = blended((Line((-0.0681, 0.176), (0.0367, 0.1868)),
+                       Line((0.0367, 0.1868), (-0.0246, 0.193))), (0.00736,))
+    dyn = RobotAlongPath(model, path, "+-")
+    motors = MotorLimits((1.5, 1.5))
+    monkeypatch.setattr(time_optimal, "MAX_SPLIT", 0)
+    plain = solve(dyn, motors=motors, grid=400)
+    monkeypatch.setattr(time_optimal, "MAX_SPLIT", 2)
+    real = time_optimal._reachability
+
+    def none_when_refined(co, *a, **kw):
+        if len(co.s) > 401:
+            raise InfeasibleError("no motion on the refined grid")
+        return real(co, *a, **kw)
+
+    monkeypatch.setattr(time_optimal, "_reachability", none_when_refined)
+    law = solve(dyn, motors=motors, grid=400)
+    assert law.status == plain.status == 0
+    assert law.duration == plain.duration and len(law.knots_s) == 401

@@ -392,9 +392,10 @@ class AccelerationLimit(Constraint):
                           .max(axis=1))
 
     def scaled(self, scales: Mapping[str, float]) -> AccelerationLimit:
-        """The accelerations tightened by ``scales["acceleration"]``."""
+        """The accelerations tightened by the scale of its kind (``scales["acceleration"]``;
+        a cap of another kind by its own)."""
         return replace(self, max_acceleration=_pair(np.asarray(self.max_acceleration, float)
-                                                    * scales.get("acceleration", 1.0)))
+                                                    * scales.get(self.kind, 1.0)))
 
 
 @dataclass(frozen=True)

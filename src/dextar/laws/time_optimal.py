@@ -224,13 +224,19 @@ def solve_time_optimal_law(dynamics: PathDynamics, *,
     x0 = _first_tangent(speed_cap(cons, co)) if tangent else None
     limits = (_torque_limit(cons), _speed_limit(cons))
     split = 0
+    coarse: tuple[PathCoefficients, Array, Array | None] | None = None  # (before a split)
     for solve in range(1, MAX_SOLVES + 1):
         try:
             x = _reachability(co, ds, [c.scaled(scales) for c in cons], x0, units, tmax)
         except InfeasibleError:
-            if law is None or (split == 0 and all(v == 1.0 for v in scales.values())):
+            if coarse is not None and all(v == 1.0 for v in scales.values()):
+                # the refined grid (its friction tangent interpolated) found none where the
+                # grid before found one: back to that grid, and tightening as without a split
+                (co, ds, x0), coarse, split = coarse, None, MAX_SPLIT
+                continue
+            if law is None or all(v == 1.0 for v in scales.values()):
                 raise  # no motion within the user's own limits
-            # the limits tightened (or the grid refined) leave none: the last law, beyond them
+            # the limits tightened for the grid leave none: the last law, beyond them
             ds = np.diff(law.knots_s)
             break
 
@@ -256,6 +262,8 @@ def solve_time_optimal_law(dynamics: PathDynamics, *,
                 4.0 * np.maximum(seg - 1.0, 0.0) / tol)), 2, SPLIT_MOST), 1).astype(int)
             if pieces.max() > 1:
                 split += 1
+                if coarse is None:
+                    coarse = (co, ds, x0)
                 s_new = split_segments(co.s, pieces)
                 if adjust is not None:
                     s_new = adjust(s_new)

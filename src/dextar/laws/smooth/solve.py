@@ -148,17 +148,18 @@ def solve_jerk_limited_law(dynamics: PathDynamics, *, motors: MotorLimits | None
     if js.ddq is None:
         return law
     peak = CAP_FRACTION * np.abs(js.ddq).max(axis=0)
+    peak = np.where(peak > 0.0, peak, np.inf)  # (a joint that stays still: not capped)
     cap = AccelerationLimit((float(peak[0]), float(peak[1])), kind=CAP_KIND)
     try:
         other = _solve(dynamics, table, (*cons, cap), int(segments), tol, rate_tol, units)
     except InfeasibleError:
         return law
     both = first.programmes + other.programmes
-    if other.law.status != 0 or other.law.duration >= law.duration:
-        return replace(law, solves=both)
     ratio, excess = check(dynamics, cons, other.law, tol, rate_tol)  # the user's limits alone
-    if np.any(excess > 0):
-        return replace(law, solves=both)
+    if other.law.status != 0 or other.law.duration >= law.duration or np.any(excess > 0):
+        return _verdict(first.last, first.scales, both, first.T2,
+                        f"; a second start, the joint accelerations capped at "
+                        f"{CAP_FRACTION:g} of the peak, found no faster motion")
     # its words: the user's limits (the cap's kind and its tightening left out) and the
     # second-order law of the first search (the capped one's is slower)
     scales = {k: v for k, v in other.scales.items() if k != CAP_KIND}
@@ -304,7 +305,7 @@ def with_joints(dynamics: PathDynamics, grid: int | Array) -> Array:
     inner = np.asarray(starts, float)[1:-1]
     gap = JOINT_GAP * length
     near = np.abs(inner[:, None] - pts[None, :]).min(axis=1, initial=np.inf) <= gap
-    new = inner[(inner > gap) & (inner < length - gap) & ~near]
+    new = np.unique(inner[(inner > gap) & (inner < length - gap) & ~near])
     return np.sort(np.concatenate([pts, new])) if new.size else pts
 
 
