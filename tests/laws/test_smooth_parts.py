@@ -174,10 +174,10 @@ def test_an_equal_grid_gets_the_paths_joints(chain):
     assert np.allclose(np.sort(table.make_table(dyn, pts).joints), starts,
                        atol=1e-9 * dyn.length)
     given = grid(path)
-    assert solve.with_joints(dyn, given) is given
+    assert np.array_equal(solve.with_joints(dyn, given), given)
     near = np.sort(np.concatenate([np.linspace(0.0, dyn.length, 401),
                                    starts + 0.1 * solve.JOINT_GAP * dyn.length]))
-    assert solve.with_joints(dyn, near) is near
+    assert np.array_equal(solve.with_joints(dyn, near), near)
     line = RobotAlongPath(dyn.model, Line((-0.06, 0.16), (-0.06, 0.2)), "+-")
     assert np.array_equal(solve.with_joints(line, 400), np.linspace(0.0, line.length, 401))
 
@@ -474,3 +474,17 @@ def test_a_cap_of_its_own_kind_is_tightened_by_its_own_scale():
     user = AccelerationLimit((10.0, 20.0))
     assert user.scaled({solve.CAP_KIND: 0.5}).max_acceleration == (10.0, 20.0)
     assert user.scaled({"acceleration": 0.5}).max_acceleration == (5.0, 10.0)
+
+
+@pytest.mark.parametrize("bad, words", [
+    (5, "at least 10 segments"),
+    (np.linspace(0.0, 0.1, 20)[::-1], "strictly increasing"),
+    (np.linspace(0.0, 0.05, 20), "from 0 to the path's length")])
+def test_a_bad_grid_is_named(chain, bad, words):
+    """The jerk-limited law checks its grid as the second-order law does (an unsorted grid was
+    sorted only where a joint was added; a short path's grid went unchecked)."""
+    from dextar.errors import ParameterError
+
+    dyn, _ = chain
+    with pytest.raises(ParameterError, match=words):
+        solve_jerk_limited_law(dyn, motors=MOTORS, grid=bad)

@@ -205,7 +205,7 @@ def solve_time_optimal_law(dynamics: PathDynamics, *,
     if not (0 < tol < 1):
         raise ParameterError(f"tolerance {tol!r} must be in (0, 1)")
     length = float(dynamics.length)
-    s_grid = _grid(grid, length)
+    s_grid = grid_points(grid, length)
     adjust = getattr(dynamics, "adjust_grid", None)  # grid points a dynamics needs (crossings)
     if adjust is not None:
         s_grid = adjust(s_grid)
@@ -386,8 +386,10 @@ def _first_tangent(x: Array) -> Array | None:
     return np.asarray(np.where(finite, x, x[finite].max()))
 
 
-def _grid(grid: int | Array, length: float) -> Array:
-    """The grid's arc lengths (N + 1,) from a number of equal segments or given points."""
+def grid_points(grid: int | Array, length: float) -> Array:
+    """The grid's arc lengths (N + 1,) from a number of equal segments or given points
+    (checked: a whole number of at least 10 segments, or at least 11 finite increasing arc
+    lengths from 0 to ``length``)."""
     if np.ndim(grid) == 0:
         if int(grid) != grid or int(grid) < 10:
             raise ParameterError(f"grid = {grid} must be a whole number of at least 10 segments")

@@ -17,7 +17,7 @@ from ...motors import MotorLimits
 from ...units import Units
 from ..base import Law
 from ..constraints import AccelerationLimit, Constraint, PathDynamics, motor_constraints
-from ..time_optimal import TimeOptimalLaw, solve_time_optimal_law
+from ..time_optimal import TimeOptimalLaw, grid_points, solve_time_optimal_law
 from .check import RATE_KINDS, check
 from .law import JerkLimitedLaw
 from .mesh import Mesh, integrate, make_mesh
@@ -297,8 +297,7 @@ def with_joints(dynamics: PathDynamics, grid: int | Array) -> Array:
     trust region: 2 to 5 times the duration found, or no answer). A program's grids have
     them already (:func:`dextar.program.plan.chain_grid`)."""
     length = float(dynamics.length)
-    pts = (np.linspace(0.0, length, int(grid) + 1) if np.ndim(grid) == 0
-           else np.asarray(grid, float))
+    pts = grid_points(grid, length)
     starts = getattr(getattr(dynamics, "path", None), "starts", None)
     if starts is None:
         return pts
