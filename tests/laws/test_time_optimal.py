@@ -265,3 +265,38 @@ def test_a_refined_grid_without_motion_goes_back_to_the_grid_before(monkeypatch)
     law = solve(dyn, motors=motors, grid=400)
     assert law.status == plain.status == 0
     assert law.duration == plain.duration and len(law.knots_s) == 401
+
+
+@pytest.mark.parametrize("excess, split", [(0.005, False), (0.05, True)])
+def test_a_small_excess_is_tightened_and_a_large_one_split(monkeypatch, excess, split):
+    """The check's first ratio made ``1 + excess`` in one segment: at most 1e-2 over, the
+    limits are tightened (two solves, the grid as given: splitting every excess slowed the
+    design sweep by 16 %); above it, that segment is split."""
+    from dextar.laws import time_optimal
+
+    real = time_optimal._segment_ratios
+    calls = []
+
+    def once(cons, js, n):
+        out = real(cons, js, n)
+        if not calls:
+            out[n // 2] = 1 + excess
+        calls.append(n)
+        return out
+
+    real_ratios = time_optimal.ratios_by_kind
+
+    def ratios(cons, js):
+        out = dict(real_ratios(cons, js))
+        if len(calls) == 0 and not ratios.done:
+            out["torque"] = 1 + excess
+            ratios.done = True
+        return out
+
+    ratios.done = False
+    monkeypatch.setattr(time_optimal, "_segment_ratios", once)
+    monkeypatch.setattr(time_optimal, "ratios_by_kind", ratios)
+    law = solve_time_optimal_law(MODEL, SEMI, torque_limit=(20.0, 20.0), grid=400)
+    assert law.status == 0
+    assert (len(law.knots_s) > 401) == split, len(law.knots_s)
+    assert ("tightened" in law.message) != split, law.message
