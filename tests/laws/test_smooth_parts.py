@@ -184,10 +184,11 @@ def test_an_equal_grid_gets_the_paths_joints(chain):
 
 def test_a_blend_planned_on_an_equal_grid_settles():
     """A corner of 89 degrees blended within 10.8 mm, planned with ``grid=400`` through the
-    API: the programmes settle, in 14 (numpy and compiled alike), at 2.50 times the
-    second-order law. Without the joints in the table's grid they ran 138 programmes
-    without settling, to 3.32 times (the rows crossing the smoothed jump changed by their
-    whole limit with the smallest step); the margins: 2.9 times, 60 programmes."""
+    API: the programmes settle, in 53 over both starts (14 in the first; numpy and compiled
+    alike), at 2.33 times the second-order law. Without the joints in the table's grid they
+    ran 222 programmes without settling (138 before the second start and six re-timings),
+    to 3.25 times (the rows crossing the smoothed jump changed by their whole limit with
+    the smallest step); the margins: 2.9 times, 110 programmes."""
     m = load_scenario(str(EXAMPLES / "jerk_pick_place.toml")).si_model
     path, _ = blended((Line((0.058, 0.196), (0.058, 0.158)),
                        Line((0.058, 0.158), (-0.060, 0.154))), (0.0108,))
@@ -195,7 +196,7 @@ def test_a_blend_planned_on_an_equal_grid_settles():
     law = solve_jerk_limited_law(dyn, motors=MOTORS, grid=400)
     second = time_optimal.solve_time_optimal_law(dyn, torque_limit=MOTORS.peak_torque, grid=400)
     assert law.status == 0 and "did not settle" not in law.message, law.message
-    assert law.solves <= 60, law.solves
+    assert law.solves <= 110, law.solves
     assert law.duration <= 2.9 * second.duration, law.duration / second.duration
 
 
@@ -396,14 +397,15 @@ def test_a_second_start_where_the_jerk_rules(chain):
     accelerations capped below the first motion's peak finds a motion 5-8 % faster (0.4014
     against 0.4242 s on this grid, 0.4015 against 0.4358 on 400 equal segments, numpy and
     compiled alike); the law then states the user's limits only, the cap's kind not among
-    them. Margin: 3 %."""
+    them. Margin: 1 % (the second start's law is kept only when it is faster; without it,
+    the first law: ratio 1)."""
     dyn, path = chain
     tab = table.make_table(dyn, solve.with_joints(dyn, grid(path)))
     first = solve._solve(dyn, tab, motor_constraints(MOTORS), 32, 1e-3, 1e-2, None).law
     law = solve_jerk_limited_law(dyn, motors=MOTORS, grid=grid(path))
     assert first.duration > solve.SECOND_START * first.second_order_duration
     assert law.status == 0 and "from a second start" in law.message, law.message
-    assert law.duration <= 0.97 * first.duration, (law.duration, first.duration)
+    assert law.duration <= 0.99 * first.duration, (law.duration, first.duration)
     assert set(law.ratios) == {"torque", "jerk"} and solve.CAP_KIND not in law.message
     assert max(law.ratios.values()) <= 1.01
     # (compared with the first search's second-order law, not the capped one's)
