@@ -274,26 +274,21 @@ def test_a_small_excess_is_tightened_and_a_large_one_split(monkeypatch, excess, 
     design sweep by 16 %); above it, that segment is split."""
     from dextar.laws import time_optimal
 
-    real = time_optimal._segment_ratios
-    calls = []
+    real, real_ratios = time_optimal._segment_ratios, time_optimal.ratios_by_kind
+    first = {"segments": True, "ratios": True}  # (each faked at its first call only)
 
     def once(cons, js, n):
         out = real(cons, js, n)
-        if not calls:
+        if first.pop("segments", False):
             out[n // 2] = 1 + excess
-        calls.append(n)
         return out
-
-    real_ratios = time_optimal.ratios_by_kind
 
     def ratios(cons, js):
         out = dict(real_ratios(cons, js))
-        if len(calls) == 0 and not ratios.done:
+        if first.pop("ratios", False):
             out["torque"] = 1 + excess
-            ratios.done = True
         return out
 
-    ratios.done = False
     monkeypatch.setattr(time_optimal, "_segment_ratios", once)
     monkeypatch.setattr(time_optimal, "ratios_by_kind", ratios)
     law = solve_time_optimal_law(MODEL, SEMI, torque_limit=(20.0, 20.0), grid=400)

@@ -17,7 +17,12 @@ from ...motors import MotorLimits
 from ...units import Units
 from ..base import Law
 from ..constraints import AccelerationLimit, Constraint, PathDynamics, motor_constraints
-from ..time_optimal import TimeOptimalLaw, grid_points, solve_time_optimal_law
+from ..time_optimal import (
+    TimeOptimalLaw,
+    grid_points,
+    solve_time_optimal_law,
+    split_segments,
+)
 from .check import RATE_KINDS, check
 from .law import JerkLimitedLaw
 from .mesh import Mesh, integrate, make_mesh
@@ -155,18 +160,20 @@ def solve_jerk_limited_law(dynamics: PathDynamics, *, motors: MotorLimits | None
     except InfeasibleError:
         return law
     both = first.programmes + other.programmes
-    ratio, excess = check(dynamics, cons, other.law, tol, rate_tol)  # the user's limits alone
-    if other.law.status != 0 or other.law.duration >= law.duration or np.any(excess > 0):
-        return _verdict(first.last, first.scales, both, first.T2,
-                        f"; a second start, the joint accelerations capped at "
-                        f"{CAP_FRACTION:g} of the peak, found no faster motion")
-    # its words: the user's limits (the cap's kind and its tightening left out) and the
-    # second-order law of the first search (the capped one's is slower)
-    scales = {k: v for k, v in other.scales.items() if k != CAP_KIND}
-    note = (f"; from a second start, the joint accelerations capped at {CAP_FRACTION:g} of "
-            f"the first motion's peak ({law.duration:.6g} s from the first)")
-    return _verdict(replace(other.last, ratio=ratio, bad=excess > 0), scales, both,
-                    first.T2, note)
+    if other.law.status == 0 and other.law.duration < law.duration:
+        ratio, excess = check(dynamics, cons, other.law, tol, rate_tol)  # the user's alone
+        if not np.any(excess > 0):
+            # its words: the user's limits (the cap's kind and its tightening left out) and
+            # the second-order law of the first search (the capped one's is slower)
+            scales = {k: v for k, v in other.scales.items() if k != CAP_KIND}
+            note = (f"; from a second start, the joint accelerations capped at "
+                    f"{CAP_FRACTION:g} of the first motion's peak ({law.duration:.6g} s from "
+                    f"the first)")
+            return _verdict(replace(other.last, ratio=ratio, bad=excess > 0), scales, both,
+                            first.T2, note)
+    return _verdict(first.last, first.scales, both, first.T2,
+                    f"; a second start, the joint accelerations capped at {CAP_FRACTION:g} "
+                    f"of the peak, found no faster motion")
 
 
 #: A second search (see :func:`solve_jerk_limited_law`) where the first motion's duration is
@@ -359,13 +366,7 @@ def _start(dynamics: PathDynamics, table: Table, second: Sequence[Constraint],
 def _split(mesh: Mesh, J: Array, Tk: Array, pieces: Array) -> tuple[Mesh, Array, Array]:
     """The mesh with interval ``k`` split into ``pieces[k]`` equal ones, and the same motion
     (each piece keeps its interval's jerk and duration)."""
-    h = mesh.h
-    many = pieces > 1
-    n = pieces[many]
-    idx = np.repeat(np.flatnonzero(many), n - 1)
-    j = np.concatenate([np.arange(1, m) for m in n]) if n.size else np.zeros(0)
-    inner = mesh.f[idx] + h[idx] * j / np.repeat(n, n - 1)
-    f = np.sort(np.concatenate([mesh.f, inner]))
+    f = split_segments(mesh.f, pieces)
     return (make_mesh(f, mesh.f[mesh.pins], mesh.pin_s), np.repeat(J, pieces),
             np.repeat(Tk, pieces))
 
