@@ -338,6 +338,24 @@ def test_rows_kept_for_the_same_motion_only(setup):
     assert model.rows(mo, gradients=False).C.shape[0] == 0
 
 
+@pytest.mark.parametrize("faster", [0.99, 0.9])
+def test_time_scaling_takes_the_powers_step_first(setup, monkeypatch, faster):
+    """A start a little beyond its limits is scaled by its rows' powers (a jerk row 3 % over
+    its limit: T by its cube root), within them in two evaluations of the rows (the second
+    kept for the SLP), not first slowed by half and brought back (four); a start 10 %
+    faster likewise."""
+    model, me, J, Tk, _ = setup
+    calls = []
+    real = model._rows
+    monkeypatch.setattr(model, "_rows", lambda mo, g: calls.append(g) or real(mo, g))
+    out = slp.time_scaled(model, J, Tk * faster)
+    assert len(calls) == 2
+    assert calls[-1] is (faster > 0.95)  # (a last factor near 1: with gradients, kept)
+    F = model.rows(mesh.motion(me, J, out, model.length)).F
+    assert -2e-3 <= F.max() <= 0.0
+    assert out[0] / Tk[0] == pytest.approx(1.0, abs=2e-3)
+
+
 @pytest.mark.parametrize("n", [2, 3, 50])
 def test_knot_placement_differences_are_numpy_gradient(n):
     """start._gradient (the knot placement's differences, without temporaries) is

@@ -271,6 +271,7 @@ def time_scaled(model: RowModel, J: Array, Tk: Array) -> Array:
     # their gradients, when the last factor was near 1 (likely the last round; the same rows
     # without gradients cost nearly as much)
     last = np.inf
+    beyond = False  # the last round's scaling left a row beyond its limit
     for _ in range(40):
         near = abs(last - 1.0) < 0.1 and model.mesh.M <= TRIAL_GRADIENTS
         rows = model.rows(motion(model.mesh, J, Tk, model.length), gradients=near, keep=near)
@@ -285,7 +286,11 @@ def time_scaled(model: RowModel, J: Array, Tk: Array) -> Array:
         if worst > 0.0:
             if p[i] == 0:
                 break  # a row the duration does not change
-            factor = max(factor, 1.5)
+            if beyond:  # the powers' factor did not bring it within (gravity, friction)
+                factor = max(factor, 1.5)
+            beyond = True
+        else:
+            beyond = False
         Tk = Tk * (factor * (1 + 1e-4))
         last = factor
     return Tk
