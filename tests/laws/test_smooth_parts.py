@@ -2,7 +2,9 @@
 integration of the transcription, the path table's derivatives and joints, the rows' linear
 model against finite differences, and the start's fall-backs (never a false "no motion")."""
 
+import gc
 import logging
+import weakref
 from dataclasses import replace
 
 import numpy as np
@@ -354,6 +356,58 @@ def test_time_scaling_takes_the_powers_step_first(setup, monkeypatch, faster):
     F = model.rows(mesh.motion(me, J, out, model.length)).F
     assert -2e-3 <= F.max() <= 0.0
     assert out[0] / Tk[0] == pytest.approx(1.0, abs=2e-3)
+
+
+def test_a_long_mesh_holds_one_set_of_gradients_at_a_time(setup, monkeypatch):
+    """Above TRIAL_GRADIENTS intervals the SLP lets its rows go while a programme is solved
+    and makes a set of rows with their gradients only when no other is alive, for the same
+    run as a short mesh's; its one more evaluation of the rows is where a step is turned
+    down (the motion's rows again, for the way back along the step). It used to make the
+    rows again after every programme, and each step's rows twice (without gradients, then
+    with them once taken)."""
+    model, me, J, Tk, _ = setup
+    refs: list[weakref.ref[rows.Rows]] = []
+    made: list[tuple[bool, int]] = []  # (with gradients, sets with them alive then)
+    during: list[int] = []
+    back = []
+
+    def alive() -> int:
+        gc.collect()
+        return sum(r() is not None for r in refs)
+
+    real_rows, real_solve, real_model = model._rows, slp.solve_staged, slp.Programme.model
+
+    def counted(mo, gradients):
+        made.append((gradients, alive()))
+        out = real_rows(mo, gradients)
+        if gradients:
+            refs.append(weakref.ref(out))
+        return out
+
+    def solve(*args, **kw):
+        during.append(alive())
+        return real_solve(*args, **kw)
+
+    def linear(self, *args):  # (a lean run's linear models: the way back along a step)
+        back.append(1)
+        return real_model(self, *args)
+
+    monkeypatch.setattr(model, "_rows", counted)
+    monkeypatch.setattr(slp, "solve_staged", solve)
+    short = slp.slp(model, J, Tk, 8, slp.START_DELTA)
+    n_short = len(made)
+    made.clear()
+    during.clear()
+    refs.clear()
+    monkeypatch.setattr(slp, "TRIAL_GRADIENTS", 0)
+    monkeypatch.setattr(slp.Programme, "model", linear)
+    long = slp.slp(model, J, Tk, 8, slp.START_DELTA)
+    assert short.programmes == long.programmes == 8
+    np.testing.assert_array_equal(long.J, short.J)
+    np.testing.assert_array_equal(long.Tk, short.Tk)
+    assert during == [0] * 8
+    assert all(n == 0 for g, n in made if g)
+    assert 0 < len(back) < 8 and len(made) == n_short + len(back)  # (6 turned down here)
 
 
 @pytest.mark.parametrize("n", [2, 3, 50])

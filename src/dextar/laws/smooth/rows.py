@@ -177,6 +177,7 @@ class RowModel:
         if kept is not None and (kept[1].C.shape[0] == kept[1].F.shape[0] or not gradients) \
                 and all(np.array_equal(x, y) for x, y in zip(kept[0], _key(mo), strict=True)):
             return kept[1]
+        del kept  # (one set at a time)
         out = self._rows(mo, gradients)
         if keep:
             self._last = (_key(mo), out)

@@ -54,10 +54,10 @@ PROGRESS = 1e-4
 #: inside the trust region. Near the solution the SLP converges fast (the programmes'
 #: solutions are near vertices), so the next step would be far smaller still.
 STEP_TOL = 1e-4
-#: The largest mesh (intervals) whose trial steps' rows are built with their gradients and
-#: whose rows are kept while a programme is solved (a larger one makes them again after:
-#: four more evaluations of the rows in a run of two programmes, for the peak memory of a
-#: long path; at 8192 intervals a set of rows with their gradients is about 26 MB).
+#: The largest mesh (intervals) whose rows are kept while a programme is solved (a larger
+#: one lets them go, for the peak memory of a long path, and makes them again only where
+#: the step is turned down; at 8192 intervals a set of rows with their gradients is about
+#: 26 MB) and whose start's last rows are built with their gradients.
 TRIAL_GRADIENTS = 8192
 FEAS_TOL = 1e-4
 
@@ -272,8 +272,10 @@ def time_scaled(model: RowModel, J: Array, Tk: Array) -> Array:
     # without gradients cost nearly as much)
     last = np.inf
     beyond = False  # the last round's scaling left a row beyond its limit
+    rows: Rows | None = None
     for _ in range(40):
-        near = abs(last - 1.0) < 0.1 and model.mesh.M <= TRIAL_GRADIENTS
+        near = abs(last - 1.0) < 0.1
+        rows = None  # (one set of gradients at a time)
         rows = model.rows(motion(model.mesh, J, Tk, model.length), gradients=near, keep=near)
         i = int(np.argmax(rows.F))
         worst = float(rows.F[i])
@@ -303,29 +305,34 @@ def slp(model: RowModel, J: Array, Tk: Array, budget: int, delta: float) -> Run:
     lp = Programme(mesh, S)
     mo = motion(mesh, J, Tk, S)
     T_ref = mo.T
-    rows = model.rows(mo)
-    phi = merit(mo.T, T_ref, rows.F, lp.ahead(mo))
+    first = model.rows(mo)
+    phi = merit(mo.T, T_ref, first.F, lp.ahead(mo))
+    rows: Rows | None = first
+    del first
     n = 0
     converged = False
     scale = max(float(np.abs(mo.alpha).max()), 1e-300)
     jscale = max(float(np.abs(mo.J).max()), 1e-300)
     debug = log.isEnabledFor(logging.DEBUG)
     # a large mesh holds one set of rows' gradients at a time (each is tens of megabytes at
-    # 16k knots): a trial step's rows without them, and none while a programme is solved
+    # 16k knots): none while a programme is solved (made again only where its step is
+    # turned down), and the rows left out of it are not checked for a crossing (they
+    # cannot reach their limits within the trust region, so a crossing is rounding; the
+    # step's own rows are evaluated next)
     lean = mesh.M > TRIAL_GRADIENTS
     while n < budget:
+        if rows is None:
+            rows = model.rows(mo)
         use = rows.F + lp.reach(rows, mo, delta, scale, jscale) > -1e-9
         res = None
         for _ in range(5):  # a row left out and crossed (rounding only) joins
             prog = lp.build(rows, use, mo, T_ref, delta, scale, jscale)
             if lean:  # the rows are in the programme: not kept while it is solved
-                del rows
+                rows = None
             res = solve_staged(*prog)
             del prog
-            if lean:  # (the same rows again, for those left out)
-                rows = model.rows(mo)
             n += 1
-            if res.status != 0:
+            if res.status != 0 or rows is None:
                 break
             crossed = ~use & (lp.model(rows, res.x, mo) > res.x[-1] + 1e-9)
             if not crossed.any():
@@ -342,10 +349,9 @@ def slp(model: RowModel, J: Array, Tk: Array, budget: int, delta: float) -> Run:
         eps = float(res.x[-1])
         pred = phi - res.fun
         mn = lp.motion(res.x, S)
-        # the rows at the step; with their gradients when the mesh is small (most steps
-        # are taken, and then they serve the next programme), else once it is taken (two
-        # sets of gradients at once would raise the peak memory of a long path)
-        new = model.rows(mn, gradients=not lean)
+        # the rows at the step, with their gradients (most steps are taken, and then they
+        # serve the next programme)
+        new = model.rows(mn)
         phin = merit(mn.T, T_ref, new.F, lp.ahead(mn))
         actual = phi - phin
         ratio = actual / pred if pred > 0 else (1.0 if actual >= 0 else -1.0)
@@ -357,6 +363,10 @@ def slp(model: RowModel, J: Array, Tk: Array, budget: int, delta: float) -> Run:
                       "delta %.2g iterations %d", mn.T, eps, new.F.max(), new.kind_of(i),
                       int(use.sum()), len(use), pred, ratio, delta, res.nit)
         if ratio <= 0.1:  # back along the step: the rows are evaluated, no programme
+            if rows is None:  # (lean: the rows at the motion again, one set at a time)
+                new = Rows(new.F, new.k, np.zeros((0, 5)), new.norm,
+                           np.zeros((0, 5), np.float32), new.kinds)
+                rows = model.rows(mo)
             x0 = lp.x0(mo)
             lin1 = lp.model(rows, res.x, mo)
             ahead0 = lp.ahead(mo)
@@ -377,7 +387,7 @@ def slp(model: RowModel, J: Array, Tk: Array, budget: int, delta: float) -> Run:
             del lin1, rp
         if ratio > 0.1:
             T_prev, delta_prev = mo.T, delta
-            del rows
+            rows = None
             mo, rows, phi = mn, (new if len(new.C) == len(new.F) else model.rows(mn)), phin
             del new
             if ratio > 0.75 and step > 0.5 * delta:
@@ -394,4 +404,6 @@ def slp(model: RowModel, J: Array, Tk: Array, budget: int, delta: float) -> Run:
             del new
         if delta < 1e-9:
             break
+    if rows is None:
+        rows = model.rows(mo, gradients=False)
     return Run(mo.J, mo.Tk, n, converged, float(rows.F.max()))
