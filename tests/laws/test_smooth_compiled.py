@@ -78,11 +78,15 @@ def test_each_stopping_rule_stops_both_solvers_alike(setup, monkeypatch):  # noq
         pytest.skip("the compiled interior point is not built here")
     loose = 1e3  # (the gap's rule also ends a solve whose gap is below 1e-6 of its bound)
     for lp, x0 in programmes(setup):
-        for kw in (dict(dual_tol=loose, gap_tol=loose), dict(tol=loose, gap_tol=loose),
-                   dict(tol=loose, dual_tol=loose)):
+        for least, kw in ((1, dict(dual_tol=loose, gap_tol=loose)),
+                          (3, dict(tol=loose, gap_tol=10.0)),
+                          (3, dict(tol=loose, dual_tol=loose))):
             python, compiled = both(monkeypatch, lp, x0, **kw)
             assert python.status == compiled.status == 0, kw
-            assert python.nit >= 3, kw  # (the rule had work to do: 3-4, 4 and 11-13 here)
+            # (the rule had work to do: 1-2, 8 and 14 iterations here; a full primal step
+            # meets the equalities and rows to rounding, so the primal rule is met at once
+            # after it: the start's slacks of SLACK_FLOOR make the start nearly feasible)
+            assert python.nit >= least, (kw, python.nit)
             assert abs(python.nit - compiled.nit) <= 1, (kw, python.nit, compiled.nit)
 
 

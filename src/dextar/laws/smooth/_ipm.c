@@ -35,7 +35,7 @@
 #endif
 
 /* The interface version: banded.py uses a build of this version only. */
-#define IPM_VERSION 1
+#define IPM_VERSION 2
 
 /* States per knot, equalities per interval, band positions per knot, the band's
  * half-widths and its storage's width with the fill-in of the pivoting (banded.py's D, Q,
@@ -49,6 +49,10 @@
 #define REG 1e-11
 #define ETA 0.99
 #define MU0 1e-3
+/* the start's slacks at least this much: of 1 + |rb| for a row, of the width for a bound
+ * (SLACK_FLOOR, BOUND_FLOOR in banded.py) */
+#define SLACK_FLOOR 1e-3
+#define BOUND_FLOOR 1e-4
 
 /* a row's variables relative to its interval's first knot (as x indices, band positions),
  * each state's band position in its knot's block, an equality's band positions */
@@ -618,12 +622,12 @@ static int ipm(Prog *p, const double *x0, double *x, double tol, double dual_tol
     for (Py_ssize_t i = 0; i < m; i++) {
         double floor;
         if (i < R)
-            floor = 1e-2 * (1.0 + fabs(p->rb[i]));
+            floor = SLACK_FLOOR * (1.0 + fabs(p->rb[i]));
         else {
             Py_ssize_t v = i < R + p->nu ? p->iu[i - R] : p->il[i - R - p->nu];
             double width = (isfinite(p->hi[v]) && isfinite(p->lo[v])) ? p->hi[v] - p->lo[v]
                                                                       : fabs(x[v]) + 1.0;
-            floor = 1e-3 * width;
+            floor = BOUND_FLOOR * width;
         }
         double s = h_of(p, i) - sl[i];
         sl[i] = s > floor ? s : floor;
