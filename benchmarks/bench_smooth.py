@@ -18,7 +18,8 @@ Floors (issue 29):
 * at M = 1k, 4k and 16k knots: peak memory at most 200 MB at 16k, time growing no faster
   than M log M (the CPU time's exponent between sizes at most M log M's + 0.05; each size
   in a new process, three times; its peak resident memory above the process's after a
-  warm-up, its CPU time); one programme of about 1000 knots solved by the banded
+  warm-up, its CPU time), and at 4k and 16k on three other lines (the floor read on each);
+  one programme of about 1000 knots solved by the banded
   interior point (compiled where built) and by HiGHS (scipy's linprog, dual simplex and
   IPX) on the same rows, which is why the programmes have their own solver.
 
@@ -60,6 +61,11 @@ JOINT_MOVES = [((2.2, 0.9), (1.6, 0.5), (3.0, 2.5), (40.0, 30.0), (800.0, 600.0)
 #: The scaling's sizes (knots, at least: the transcription's fewest intervals).
 SIZES = (1000, 4000, 16000)
 MOVE = ((-0.04, 0.11), (0.04, 0.09))
+#: Other lines of the scaling (4k and 16k knots): the two pick-and-place moves of the moves
+#: section and a longer diagonal. Their programmes' iteration counts, and so the growth,
+#: differ from line to line: the floor is read on every one.
+OTHER_LINES = (((-0.04, 0.11), (-0.04, 0.09)), ((0.04, 0.09), (0.04, 0.11)),
+               ((-0.06, 0.12), (0.05, 0.10)))
 
 
 def load() -> str:
@@ -296,24 +302,29 @@ def section_blends(n: int = 40) -> None:
           f"{int((spread <= 0.01).sum())} of {n}")
 
 
-def one_size(segments: int) -> dict[str, float]:
-    """Plan the pick-and-place line with at least ``segments`` intervals, in this process:
-    CPU and wall time, peak resident memory above the process's after a warm-up (Linux:
-    the high-water mark reset through /proc/self/clear_refs), programmes, intervals."""
+def one_size(segments: int, line: int = -1) -> dict[str, float]:
+    """Plan the pick-and-place line (or ``OTHER_LINES[line]``) with at least ``segments``
+    intervals, in this process: CPU and wall time, peak resident memory above the
+    process's after a warm-up (Linux: the high-water mark reset through
+    /proc/self/clear_refs), programmes and their interior-point iterations, intervals."""
     from dextar.laws.smooth import slp
 
     sc = load_scenario(EXAMPLE)
     limits = sc.si_motors
     assert limits is not None
-    mv = RobotAlongPath(sc.si_model, Line(*MOVE), sc.mode)
+    mv = RobotAlongPath(sc.si_model, Line(*(MOVE if line < 0 else OTHER_LINES[line])),
+                        sc.mode)
     solve_jerk_limited_law(mv, motors=jerky(limits), grid=400)  # (warm)
     captured = []
+    iterations = []
     real = slp.solve_staged
 
     def keep(lp, x0, **kw):
         if not captured:
             captured.append((lp, x0))
-        return real(lp, x0, **kw)
+        out = real(lp, x0, **kw)
+        iterations.append(out.nit)
+        return out
 
     def status(key: str) -> float:
         for line in Path("/proc/self/status").read_text().splitlines():
@@ -330,8 +341,9 @@ def one_size(segments: int) -> dict[str, float]:
     peak = status("VmHWM") - base
     slp.solve_staged = real
     out = {"M": law.jerk.size, "cpu": cpu, "wall": wall, "peak_MB": peak,
-           "programmes": law.solves, "duration": law.duration, "status": law.status}
-    if segments == SIZES[0]:  # one programme of that size, by HiGHS too
+           "programmes": law.solves, "iterations": iterations, "duration": law.duration,
+           "status": law.status}
+    if segments == SIZES[0] and line < 0:  # one programme of that size, by HiGHS too
         out.update(highs(*captured[0]))
     return out
 
@@ -409,6 +421,28 @@ def section_scaling(repeats: int = 3) -> None:
     last = rows[-1]
     print(f"  peak memory at {last['M']} knots {last['peak_max']:.0f} MB (the largest of the "
           f"runs; floor 200 MB: {'met' if last['peak_max'] <= 200 else 'NOT met'})")
+    print("  other lines, 4000 and 16000 knots (each in a new process, twice, interleaved; "
+          "best CPU time; the programmes' interior-point iterations):")
+    met = []
+    for i, line in enumerate(OTHER_LINES):
+        best = {}
+        for _ in range(2):
+            for n in SIZES[1:]:
+                p = subprocess.run([sys.executable, __file__, "--one-size", str(n), str(i)],
+                                   check=True, capture_output=True, text=True)
+                r = json.loads(p.stdout.splitlines()[-1])
+                if n not in best or r["cpu"] < best[n]["cpu"]:
+                    best[n] = r
+        a, b = best[SIZES[1]], best[SIZES[2]]
+        lm = np.log(b["M"] / a["M"])
+        mlogm = np.log(b["M"] * np.log(b["M"]) / (a["M"] * np.log(a["M"]))) / lm
+        pt = np.log(b["cpu"] / a["cpu"]) / lm
+        met.append(pt <= mlogm + 0.05)
+        print(f"    {line[0]} -> {line[1]} m: {a['cpu']:.2f} s {a['iterations']}, "
+              f"{b['cpu']:.2f} s {b['iterations']}: time M^{pt:.2f} (M log M: M^{mlogm:.2f}: "
+              f"{'met' if met[-1] else 'NOT met'}), peak {b['peak_MB']:.0f} MB")
+    print(f"  the growth floor on every line: {'met' if all(met) else 'NOT met'} "
+          f"({sum(met)} of {len(met)} other lines)")
     h = rows[0]
     if "banded" in h:
         print(f"  one programme of {h['lp_M']} knots, {h['lp_rows']} rows: banded interior "
@@ -424,7 +458,7 @@ SECTIONS = {"ruckig": section_ruckig, "convergence": section_convergence,
 
 def main(argv: list[str]) -> None:
     if argv[:1] == ["--one-size"]:
-        print(json.dumps(one_size(int(argv[1]))))
+        print(json.dumps(one_size(int(argv[1]), int(argv[2]) if len(argv) > 2 else -1)))
         return
     for name in argv or list(SECTIONS):
         SECTIONS[name]()
