@@ -41,6 +41,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -302,7 +303,7 @@ def section_blends(n: int = 40) -> None:
           f"{int((spread <= 0.01).sum())} of {n}")
 
 
-def one_size(segments: int, line: int = -1) -> dict[str, float]:
+def one_size(segments: int, line: int = -1) -> dict[str, Any]:
     """Plan the pick-and-place line (or ``OTHER_LINES[line]``) with at least ``segments``
     intervals, in this process: CPU and wall time, peak resident memory above the
     process's after a warm-up (Linux: the high-water mark reset through
@@ -441,8 +442,14 @@ def section_scaling(repeats: int = 3) -> None:
         print(f"    {line[0]} -> {line[1]} m: {a['cpu']:.2f} s {a['iterations']}, "
               f"{b['cpu']:.2f} s {b['iterations']}: time M^{pt:.2f} (M log M: M^{mlogm:.2f}: "
               f"{'met' if met[-1] else 'NOT met'}), peak {b['peak_MB']:.0f} MB")
-    print(f"  the growth floor on every line: {'met' if all(met) else 'NOT met'} "
-          f"({sum(met)} of {len(met)} other lines)")
+    own = rows[-2:]
+    lm = np.log(own[1]["M"] / own[0]["M"])
+    own_met = (np.log(own[1]["cpu"] / own[0]["cpu"]) / lm
+               <= np.log(own[1]["M"] * np.log(own[1]["M"])
+                         / (own[0]["M"] * np.log(own[0]["M"]))) / lm + 0.05)
+    print(f"  the growth floor from 4000 to 16000 knots on every line: "
+          f"{'met' if own_met and all(met) else 'NOT met'} ({int(own_met) + sum(met)} of "
+          f"{1 + len(met)} lines)")
     h = rows[0]
     if "banded" in h:
         print(f"  one programme of {h['lp_M']} knots, {h['lp_rows']} rows: banded interior "

@@ -13,7 +13,9 @@ slack; the equalities are the exact integration of each interval's constant jerk
 programme is banded (:mod:`.banded`, linear in the knots). A row joins a programme when the
 trust region lets it reach its limit: the box on the accelerations bounds how far the speeds
 and arc lengths can move (their integrals from the nearer end, both ends being fixed), so the
-rows left out cannot be crossed by the programme's solution (checked after each programme).
+rows left out cannot be crossed by the programme's solution, but for rounding and on an
+interval into a pinned knot, whose jerk is not boxed (checked after each programme: a row
+crossed joins, and the programme is solved again).
 """
 
 from __future__ import annotations
@@ -54,11 +56,13 @@ PROGRESS = 1e-4
 #: inside the trust region. Near the solution the SLP converges fast (the programmes'
 #: solutions are near vertices), so the next step would be far smaller still.
 STEP_TOL = 1e-4
-#: The largest mesh (intervals) whose rows are kept while a programme is solved (a larger
-#: one lets them go, for the peak memory of a long path, and makes them again only where
-#: the step is turned down; at 8192 intervals a set of rows with their gradients is about
-#: 26 MB) and whose start's last rows are built with their gradients.
-TRIAL_GRADIENTS = 8192
+#: The largest mesh (intervals) whose rows are all kept while a programme is solved. A
+#: longer one (at 8192 intervals a set of rows with their gradients is about 26 MB) keeps
+#: then only the rows left out that the programme may cross by more than rounding, those
+#: of an interval into a pinned knot (its jerk is not boxed, so :meth:`Programme.reach`
+#: does not bound them), and makes the rows again where a step is turned down or a
+#: programme fails: one set of gradients alive at a time.
+LEAN_ROWS = 8192
 FEAS_TOL = 1e-4
 
 
@@ -260,21 +264,22 @@ class Programme:
         return motion(mesh, j * Tk**3, Tk, length)
 
 
-def time_scaled(model: RowModel, J: Array, Tk: Array) -> Array:
+def time_scaled(model: RowModel, J: Array, Tk: Array, keep: bool = True) -> Array:
     """The durations that bring the normalised motion ``J`` just within its rows (a start
     that is slower than the limits allow is sped up, one beyond them slowed down), all
     scaled alike: each row's use scales about as ``T^-p`` (:meth:`Rows.powers`); exact
     where it does, so a few rounds, then stretching while a row is still beyond its limit
-    (gravity or friction rows that scale more slowly)."""
+    (gravity or friction rows that scale more slowly). With ``keep``, the last rows are
+    kept (:meth:`.RowModel.rows`) for the SLP that starts from the motion."""
     Tk = np.asarray(Tk, float)
-    # the rows of the motion it returns are the first programme's (:func:`slp`): kept, with
-    # their gradients, when the last factor was near 1 (likely the last round; the same rows
-    # without gradients cost nearly as much)
+    # the rows of the motion it returns are the first programme's (:func:`slp`): with
+    # ``keep``, kept with their gradients when the last factor was near 1 (likely the last
+    # round; the same rows without gradients cost nearly as much)
     last = np.inf
     beyond = False  # the last round's scaling left a row beyond its limit
     rows: Rows | None = None
     for _ in range(40):
-        near = abs(last - 1.0) < 0.1
+        near = keep and abs(last - 1.0) < 0.1
         rows = None  # (one set of gradients at a time)
         rows = model.rows(motion(model.mesh, J, Tk, model.length), gradients=near, keep=near)
         i = int(np.argmax(rows.F))
@@ -314,31 +319,39 @@ def slp(model: RowModel, J: Array, Tk: Array, budget: int, delta: float) -> Run:
     scale = max(float(np.abs(mo.alpha).max()), 1e-300)
     jscale = max(float(np.abs(mo.J).max()), 1e-300)
     debug = log.isEnabledFor(logging.DEBUG)
-    # a large mesh holds one set of rows' gradients at a time (each is tens of megabytes at
-    # 16k knots): none while a programme is solved (made again only where its step is
-    # turned down), and the rows left out of it are not checked for a crossing (they
-    # cannot reach their limits within the trust region, so a crossing is rounding; the
-    # step's own rows are evaluated next)
-    lean = mesh.M > TRIAL_GRADIENTS
+    # a long mesh holds one set of rows' gradients at a time (each is tens of megabytes at
+    # 16k knots): while a programme is solved only the rows left out that it may cross
+    # by more than rounding (see :data:`LEAN_ROWS`), the rest made again where needed
+    lean = mesh.M > LEAN_ROWS
     while n < budget:
         if rows is None:
             rows = model.rows(mo)
         use = rows.F + lp.reach(rows, mo, delta, scale, jscale) > -1e-9
         res = None
-        for _ in range(5):  # a row left out and crossed (rounding only) joins
+        for _ in range(5):  # a row left out and crossed joins
+            if rows is None:  # (lean: the rows again, for those that crossed)
+                rows = model.rows(mo)
             prog = lp.build(rows, use, mo, T_ref, delta, scale, jscale)
-            if lean:  # the rows are in the programme: not kept while it is solved
+            if lean:
+                watch = np.flatnonzero(~use & lp.into_pin[rows.k])
+                left = Rows(rows.F[watch], rows.k[watch], rows.C[watch], np.zeros(0),
+                            np.zeros((0, 5), np.float32))  # (what a linear model needs)
                 rows = None
             res = solve_staged(*prog)
             del prog
             n += 1
-            if res.status != 0 or rows is None:
+            if res.status != 0:
                 break
-            crossed = ~use & (lp.model(rows, res.x, mo) > res.x[-1] + 1e-9)
-            if not crossed.any():
+            if rows is None:
+                crossed = watch[lp.model(left, res.x, mo) > res.x[-1] + 1e-9]
+                del left
+            else:
+                crossed = np.flatnonzero(~use & (lp.model(rows, res.x, mo)
+                                                  > res.x[-1] + 1e-9))
+            if not crossed.size:
                 break
-            log.debug("      %d rows left out crossed", int(crossed.sum()))
-            use |= crossed
+            log.debug("      %d rows left out crossed", crossed.size)
+            use[crossed] = True
         assert res is not None
         if res.status != 0:  # numerical trouble: a smaller step
             log.debug("    programme status %d after %d iterations", res.status, res.nit)

@@ -230,7 +230,7 @@ def _solve(dynamics: PathDynamics, table: Table, cons: Sequence[Constraint], seg
         run = slp(model, J, Tk, MAX_PROGRAMMES if retimed == MAX_RETIME else FIRST_PROGRAMMES,
                   delta)
         if run.worst > FEAS_TOL:  # the programmes left a limit exceeded: slower instead
-            run = replace(run, Tk=time_scaled(model, run.J, run.Tk))
+            run = replace(run, Tk=time_scaled(model, run.J, run.Tk, keep=False))
         delta = RESTART_DELTA
         programmes += run.programmes
         J, Tk = run.J, run.Tk
