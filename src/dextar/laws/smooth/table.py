@@ -58,8 +58,9 @@ class Table:
 
 
 #: The table's grid is refined until every column's linear interpolation is within this
-#: fraction of the column's largest value at the segments' middles (the rows' coefficients,
-#: and so the limits' use, to about this much), in at most :data:`TABLE_ROUNDS` rounds.
+#: fraction of the column's largest value at the segments' middles (estimated from both
+#: ends, :func:`middle_miss`; the rows' coefficients, and so the limits' use, to about this
+#: much), in at most :data:`TABLE_ROUNDS` rounds.
 TABLE_TOL = 2e-4
 TABLE_ROUNDS = 4
 #: The step of the derivatives along the path (a fraction of the path's length): a central
@@ -75,44 +76,58 @@ def make_table(dynamics: PathDynamics, s: Array) -> Table:
     """The table of the dynamics' coefficients from the grid ``s`` (N + 1,) of arc lengths,
     refined where a column's linear interpolation misses its value at a segment's middle by
     more than :data:`TABLE_TOL` of its largest (a blend's dynamics change over a fraction of
-    a millimetre). The derivatives along the path (of ``q''``, ``a``, ``b``, ``g``) are
-    differences of the dynamics' coefficients a short step apart, one-sided at the joints
-    (both sides kept: the segment before a joint ends with its left derivative, the one
-    after starts with its right one)."""
+    a millimetre; the miss estimated from both ends, :func:`middle_miss`). The derivatives
+    along the path (of ``q''``, ``a``, ``b``, ``g``) are differences of the dynamics'
+    coefficients a short step apart, one-sided at the joints (both sides kept: the segment
+    before a joint ends with its left derivative, the one after starts with its right
+    one)."""
     s = np.asarray(s, float)
     length = float(s[-1])
     for _ in range(TABLE_ROUNDS):
-        mid = 0.5 * (s[1:] + s[:-1])
-        both = _coefficients(dynamics, [s, mid], length)  # (one evaluation of the model)
-        co, lo, hi, joint = _columns(s, *both[0])
-        m = _columns(mid, *both[1], central_only=True)[1]
+        co, lo, hi, joint = _columns(s, *_coefficients(dynamics, s, length))
         scale = np.abs(np.concatenate([lo, hi])).max(axis=0) + 1e-300
-        err = (np.abs(m - 0.5 * (lo + hi)) / scale).max(axis=1)
+        err = (np.abs(middle_miss(np.diff(s), lo, hi)) / scale).max(axis=1)
         bad = err > TABLE_TOL
         if not bad.any():
             break
         pieces = np.where(bad, np.clip(np.ceil(np.sqrt(err / TABLE_TOL)), 2, 8), 1)
         s = split_segments(s, pieces.astype(int))
     else:
-        co, lo, hi, joint = _columns(s, *_coefficients(dynamics, [s], length)[0])
+        co, lo, hi, joint = _columns(s, *_coefficients(dynamics, s, length))
     return Table(co, lo, hi, co.s[joint])
 
 
-def _coefficients(dynamics: PathDynamics, grids: list[Array], length: float
-                  ) -> list[tuple[PathCoefficients, PathCoefficients, PathCoefficients,
-                                  Array, Array]]:
-    """For each grid of arc lengths: the coefficients there and a short step
-    (:data:`DERIVATIVE_STEP`) before and after it (within the path), and those points, from
-    one evaluation of the dynamics (its cost is mostly per call)."""
+def middle_miss(h: Array, lo: Array, hi: Array) -> Array:
+    """How far each column's linear interpolation misses its value at the segments' middles
+    (N, 18), from the columns at both ends alone (the segments ``h`` (N,) long): every
+    column's derivative along the path is a column too, so for a value ``f`` with slope
+    ``d`` the miss is the cubic's through both ends' values and slopes, ``h (d0 - d1) / 8``,
+    and for a slope ``d`` of ``f`` the quartic's (with the middle's value, which drops out),
+    ``3 ((f1 - f0) - h (d0 + d1) / 2) / (2 h)``: both to order ``h^4``. Measured on 80
+    blended corners against the dynamics at the quarter points: the table's largest miss
+    2.01e-4 of a column's largest (2.00e-4 from the middles' own values, which cost twice
+    the model's evaluations), the same number of points."""
+    hh = h[:, None]
+    out = np.empty_like(lo)
+    for f, d in ((Q1, Q2), (Q2, Q3), (A, DA), (B, DB), (G, DG)):
+        out[:, f] = hh * (lo[:, d] - hi[:, d]) / 8
+    for f, d in ((Q2, Q3), (A, DA), (B, DB), (G, DG)):
+        out[:, d] = 1.5 * ((hi[:, f] - lo[:, f]) - hh * (lo[:, d] + hi[:, d]) / 2) / hh
+    return out
+
+
+def _coefficients(dynamics: PathDynamics, s: Array, length: float
+                  ) -> tuple[PathCoefficients, PathCoefficients, PathCoefficients, Array,
+                             Array]:
+    """The coefficients at the arc lengths ``s`` and a short step
+    (:data:`DERIVATIVE_STEP`) before and after them (within the path), and those points,
+    from one evaluation of the dynamics (its cost is mostly per call)."""
     step = DERIVATIVE_STEP * length
-    sets = [(x, np.maximum(x - step, 0.0), np.minimum(x + step, length)) for x in grids]
-    flat = [p for three in sets for p in three]
-    co = dynamics.coefficients(np.concatenate(flat))
-    ends = np.cumsum([0] + [len(p) for p in flat])
-    parts = [_rows_of(co, slice(int(i), int(j))) for i, j in zip(ends[:-1], ends[1:],
-                                                                  strict=True)]
-    return [(parts[3 * n], parts[3 * n + 1], parts[3 * n + 2], sets[n][1], sets[n][2])
-            for n in range(len(grids))]
+    left, right = np.maximum(s - step, 0.0), np.minimum(s + step, length)
+    co = dynamics.coefficients(np.concatenate([s, left, right]))
+    n = len(s)
+    return (_rows_of(co, slice(0, n)), _rows_of(co, slice(n, 2 * n)),
+            _rows_of(co, slice(2 * n, 3 * n)), left, right)
 
 
 def _rows_of(co: PathCoefficients, rows: slice) -> PathCoefficients:
@@ -123,12 +138,10 @@ def _rows_of(co: PathCoefficients, rows: slice) -> PathCoefficients:
 
 
 def _columns(s: Array, co: PathCoefficients, cl: PathCoefficients, cr: PathCoefficients,
-             left: Array, right: Array, central_only: bool = False
-             ) -> tuple[PathCoefficients, Array, Array, Array]:
+             left: Array, right: Array) -> tuple[PathCoefficients, Array, Array, Array]:
     """From the coefficients at ``s`` (N + 1,) and a step ``left`` and ``right`` of them
     (:func:`_coefficients`), the table's columns (see :class:`Table`) at the starts and the
-    ends of the segments (two arrays (N, 18)) and the joints (indices); with
-    ``central_only``, the columns at the points themselves (N + 1, 18), twice."""
+    ends of the segments (two arrays (N, 18)) and the joints (indices)."""
 
     def base(c: PathCoefficients) -> Array:  # the columns with derivatives
         return np.concatenate([c.ddq_ds, c.a, c.b, c.g], axis=1)
@@ -145,8 +158,6 @@ def _columns(s: Array, co: PathCoefficients, cl: PathCoefficients, cr: PathCoeff
         return np.concatenate([co.dq_ds, co.ddq_ds, d[:, :2], co.a, co.b, co.g, d[:, 2:]],
                               axis=1)
 
-    if central_only:
-        return co, table(central), table(central), np.zeros(0, int)
     scale = np.abs(central).max(axis=0) + 1e-300
     joint = (np.abs(dr - dl) > JOINT_JUMP * scale).any(axis=1)
     joint[[0, -1]] = False
