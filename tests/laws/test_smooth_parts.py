@@ -249,6 +249,47 @@ def test_the_rows_linear_model_matches_finite_differences(setup):
     assert errs[1][0] < errs[0][0] / 30
 
 
+@pytest.mark.parametrize("compiled", [False, True])
+def test_the_second_order_rows_at_the_quarters_are_the_knots_of_a_finer_mesh(
+        setup, compiled, monkeypatch):
+    """The second-order rows at an interval's first and third quarters, there where they are
+    near their limits (above -QUARTER_NEAR): the same rows as those at the knots of the mesh
+    split in four (the same motion: each piece keeps its interval's jerk and duration), to
+    rounding, and none missing; the knots' and middles' rows as before them. The start
+    twice as fast (the chain's start is ruled by its jerk: its torques are far from their
+    limits; twice as fast, a few pass them)."""
+    if compiled and rows._compiled is None:
+        pytest.skip("the compiled rows are not built here")
+    monkeypatch.setattr(rows, "USE_COMPILED", compiled)
+    model, me, J, Tk, tab = setup
+    Tk = 0.5 * Tk
+    mo = mesh.motion(me, J, Tk, model.length)
+    second = dict(model._rows(mo, False).kinds)["second-order"]
+    monkeypatch.setattr(rows, "QUARTER_NEAR", -np.inf)  # (none at the quarters)
+    plain = model._rows(mo, False)
+    n0 = dict(plain.kinds)["second-order"]
+    monkeypatch.setattr(rows, "QUARTER_NEAR", 0.02)
+    got = model._rows(mo, False)
+    np.testing.assert_array_equal(got.F[:n0], plain.F[:n0])
+    fine, J4, T4 = solve._split(me, J, Tk, np.full(me.M, 4))
+    ref = rows.RowModel(fine, tab, model.second, model.third, model.length)._rows(
+        mesh.motion(fine, J4, T4, model.length), False)
+    m = n0 // (2 * me.M - 1)  # (every row finite here: m at each knot and middle)
+    assert n0 == m * (2 * me.M - 1)
+    knots = ref.F[:m * (4 * me.M - 1)].reshape(4 * me.M - 1, m)  # inner knots 1 .. 4M - 1
+    want_F, want_k = [], []
+    for first in (1, 3):  # the quarters, then the third quarters: knots 4k + 1, 4k + 3
+        F = knots[np.arange(me.M) * 4 + first - 1]
+        near = F > -0.02
+        want_F.append(F[near])
+        want_k.append(np.repeat(np.arange(me.M), m).reshape(me.M, m)[near])
+    want_F, want_k = np.concatenate(want_F), np.concatenate(want_k)
+    assert 0 < len(want_F) < 2 * me.M * m  # some near their limits, some not
+    assert second == n0 + len(want_F)
+    np.testing.assert_array_equal(got.k[n0:second], want_k)
+    np.testing.assert_allclose(got.F[n0:second], want_F, rtol=0, atol=1e-9)
+
+
 @pytest.mark.slow
 def test_a_coarse_start_grid_that_finds_no_motion_is_retried_on_the_whole_grid(
         chain, monkeypatch):

@@ -139,12 +139,13 @@ def test_the_compiled_rows_leave_out_the_rows_without_a_limit(setup, monkeypatch
     mo = motions(model, J, Tk)[1]
     pr = point_rows(model.second, Tangent(model.table.moving, np.concatenate(
         [model.tangent(mo)[:1], model.tangent(mo), model.tangent(mo)[-1:]])))
+    every = PointRows(pr.pu[1:-1], pr.px[1:-1], pr.ph[1:-1])
     ph = pr.ph[1:-1].copy()
     ph[40:60, 1], ph[100:103, 2], ph[150, 0] = np.inf, -np.inf, np.nan
     pr = PointRows(pr.pu[1:-1], pr.px[1:-1], ph)
     finite = np.isfinite(pr.ph)
     phmax = float(np.abs(np.where(finite, pr.ph, 0.0)).max(initial=0.0))
-    m, M = pr.pu.shape[1], model.mesh.M
+    M = model.mesh.M
     for k0, k1 in ((0, M), (5, 17)):
         out = []
         for compiled in (False, True):
@@ -152,8 +153,10 @@ def test_the_compiled_rows_leave_out_the_rows_without_a_limit(setup, monkeypatch
             model._grad = True
             out.append(model._block(mo, pr, finite, phmax, k0, k1))
         assert_same(*out)
-        n2 = (k1 - max(k0, 1)) + (k1 - k0)
-        assert dict(out[1].kinds)["second-order"] < n2 * m  # some were left out
+        model._grad = True
+        full = model._block(mo, every, np.isfinite(every.ph), phmax, k0, k1)
+        # some were left out (the same block with every limit finite has more)
+        assert dict(out[1].kinds)["second-order"] < dict(full.kinds)["second-order"]
 
 
 @pytest.mark.parametrize("kinds", [[0.0], [1.0], [2.0], [3.0], [0.0, 1.0, 2.0, 3.0]])
@@ -190,7 +193,9 @@ def test_the_compiled_rows_refuse_inconsistent_sizes(setup, bad):  # noqa: F811
     mo = mesh.motion(model.mesh, J, Tk, model.length)
     M, m = model.mesh.M, 4
     kinds, lims, fric = model._third_spec
-    R = (2 * M - 1) * (m + 1) + 12 * M * len(kinds)  # the rows of the whole mesh
+    # the rows of the whole mesh: the second-order rows at the inner knots, the middles and
+    # the quarters (every one near its limit here: all zero), w >= 0 at the first two
+    R = (4 * M - 1) * m + (2 * M - 1) + 12 * M * len(kinds)
     short = {name: (R - 1 if bad == name else R) for name in ("F", "norm", "k", "C", "sizes")}
     pcols = np.zeros((len(tab.s), 4 * m))
     pcols[:, 3 * m:] = 1.0  # every limit finite: every row kept
@@ -206,7 +211,7 @@ def test_the_compiled_rows_refuse_inconsistent_sizes(setup, bad):  # noqa: F811
                                     mo.Tk, mo.sigma, mo.w, mo.alpha, kinds, lims, a["fric"],
                                     a["F"], a["norm"], a["C"], a["k"], a["sizes"], a["m"], 0,
                                     0, a["k1"], 1e-300, model.length, -1.0 / model.length,
-                                    True)
+                                    rows.QUARTER_NEAR, True)
 
     with pytest.raises(ValueError, match="inconsistent"):
         call()

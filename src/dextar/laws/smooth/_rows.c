@@ -1,6 +1,6 @@
 /* The jerk-limited law's rows compiled: RowModel._block of dextar.laws.smooth.rows (the
  * second-order rows interpolated between the table's points at the knots and the
- * intervals' middles, the speed cap, w >= 0, and the joint jerk and torque-rate rows at
+ * intervals' middles and quarters, the speed cap, w >= 0, and the joint jerk and torque-rate rows at
  * every interval's start, middle and end, with their gradients in the programme's
  * variables) in one call, each value by the same operations in the same order as the numpy
  * code (the same bits where the C library's pow and cosh are numpy's), without its few
@@ -10,7 +10,7 @@
  * dextar builds the rows with numpy).
  *
  * block(grid, pcols, tlo, thi, h, J, Tk, sigma, w, alpha, kinds, lims, fric,
- *       F, norm, C, k, sizes, m, has_cap, k0, k1, cfloor, S, neg_inv_S, grad)
+ *       F, norm, C, k, sizes, m, has_cap, k0, k1, cfloor, S, neg_inv_S, near, grad)
  *     -> (second, cap, w, third)
  *   grid (N + 1) the table's arc lengths; pcols (N + 1) x P the second-order rows'
  *   coefficients pu | px | ph | finite (m columns each) and, with has_cap, the speed cap's
@@ -41,7 +41,12 @@
 #endif
 
 /* The interface version: rows.py uses a build of this version only. */
-#define ROWS_VERSION 1
+#define ROWS_VERSION 2
+/* The second-order rows' points: the inner knots, and in every interval its middle, then
+ * its first and third quarters (rows.py's RowModel: the same offsets by the same
+ * operations; a row at a quarter only where it is near its limit, above -near). The speed
+ * cap's and w >= 0's rows: at the knots and the middles (the first two passes). */
+#define POINTS 4
 /* The table's columns (2 each): q', q'', q''', a, b, g, a', b', g' (table.py). */
 #define NCOL 18
 #define Q1 0
@@ -55,6 +60,12 @@
 
 /* numpy's maximum and clip where a NaN propagates (a tie of signed zeros, which numpy gives
  * as +0, is not met by the callers: a floor above zero, a magnitude against a maximum) */
+/* The offset into an interval of length h of a second-order point's pass (see POINTS). */
+static double offset(int pass, double h)
+{
+    return pass == 0 ? 0.0 : (pass == 1 ? h / 2 : (pass == 2 ? h / 4 : 3 * h / 4));
+}
+
 static double np_max(double a, double b)
 {
     return (a >= b || isnan(a)) ? a : b;
@@ -160,12 +171,12 @@ static PyObject *block(PyObject *self, PyObject *args)
     PyObject *objs[NIN + NOUT], *kobj, *zobj;
     Py_ssize_t m, k0, k1;
     int has_cap, grad;
-    double cfloor, S, neg_inv_S;
-    if (!PyArg_ParseTuple(args, "OOOOOOOOOOOOOOOOOOninnddd" "p", &objs[0], &objs[1],
+    double cfloor, S, neg_inv_S, near;
+    if (!PyArg_ParseTuple(args, "OOOOOOOOOOOOOOOOOOninndddd" "p", &objs[0], &objs[1],
                           &objs[2], &objs[3], &objs[4], &objs[5], &objs[6], &objs[7],
                           &objs[8], &objs[9], &objs[10], &objs[11], &objs[12], &objs[13],
                           &objs[14], &objs[15], &kobj, &zobj, &m, &has_cap, &k0, &k1,
-                          &cfloor, &S, &neg_inv_S, &grad))
+                          &cfloor, &S, &neg_inv_S, &near, &grad))
         return NULL;
     static const char *const names[NIN + NOUT] = {
         "grid", "pcols", "tlo", "thi", "h", "J", "Tk", "sigma", "w", "alpha", "kinds",
@@ -186,7 +197,7 @@ static PyObject *block(PyObject *self, PyObject *args)
         /* the sizes the rows need, bounded before any product (no overflow: m is at most
          * a quarter of pcols' values, the blocks within the mesh, fewer than 1e15 rows) */
         if (n1 < 2 || m < 0 || m > v[1].len / 8 / 4 || k0 < 0 || k1 > M || k1 < k0
-            || (double)(2 * (k1 - k0)) * (double)(m + 2) + 12.0 * (double)(k1 - k0) * nc
+            || (double)(POINTS * (k1 - k0)) * (double)(m + 2) + 12.0 * (double)(k1 - k0) * nc
                    > 1e15) {
             PyErr_SetString(PyExc_ValueError, "block: inconsistent array sizes");
             goto done;
@@ -194,7 +205,8 @@ static PyObject *block(PyObject *self, PyObject *args)
         Py_ssize_t P = 4 * m + (has_cap ? 1 : 0);
         Py_ssize_t inner = k1 - (k0 > 1 ? k0 : 1), nint = k1 - k0;
         Py_ssize_t n2 = (inner > 0 ? inner : 0) + nint, n3 = 3 * nint;
-        Py_ssize_t rmax = n2 * m + (has_cap ? n2 : 0) + n2 + 4 * n3 * nc;
+        Py_ssize_t rmax = (n2 + (POINTS - 2) * nint) * m + (has_cap ? n2 : 0) + n2
+                          + 4 * n3 * nc;
         if (v[1].len / 8 != n1 * P || v[2].len / 8 != (n1 - 1) * NCOL
             || v[3].len / 8 != (n1 - 1) * NCOL || v[5].len / 8 != M || v[6].len / 8 != M
             || v[7].len / 8 != M + 1 || v[8].len / 8 != M + 1 || v[9].len / 8 != M + 1
@@ -209,12 +221,13 @@ static PyObject *block(PyObject *self, PyObject *args)
         Motion mo = {v[4].buf, v[5].buf, v[6].buf, v[7].buf, v[8].buf, v[9].buf};
         Out o = {v[13].buf, v[14].buf, v[15].buf, kv.buf, zv.buf, 0, grad};
         const double lo_s = grid[0], hi_s = grid[n1 - 1];
-        /* the second-order rows at the inner knots, then at the intervals' middles */
+        /* the second-order rows at the inner knots, then at the intervals' middles, first
+         * quarters and third quarters (POINTS passes) */
         Py_ssize_t first = o.n;
-        for (int pass = 0; pass < 2; pass++) {
+        for (int pass = 0; pass < POINTS; pass++) {
             Py_ssize_t ka = pass == 0 ? (k0 > 1 ? k0 : 1) : k0;
             for (Py_ssize_t k = ka; k < k1; k++) {
-                double th = pass == 0 ? 0.0 : mo.h[k] / 2, sig, w, al;
+                double th = offset(pass, mo.h[k]), sig, w, al;
                 state_at(&mo, k, th, &sig, &w, &al);
                 Py_ssize_t s = segment(grid, n1, sig, 0);
                 double ds = grid[s + 1] - grid[s];
@@ -232,6 +245,8 @@ static PyObject *block(PyObject *self, PyObject *args)
                     double dph = (b[2 * m + j] - a[2 * m + j]) / ds;
                     double c = np_max(fabs(ph), cfloor) * T * T;
                     double F = (pu * al + px * w * w - ph * T * T) / c;
+                    if (pass >= 2 && !(F > -near))
+                        continue;
                     put(&o, k, F, c, th, mo.h[k], (dpu * al + dpx * w * w - dph * T * T) / c,
                         2 * px * w / c, pu / c, 0.0, -2 * ph * T / c);
                 }
@@ -243,7 +258,7 @@ static PyObject *block(PyObject *self, PyObject *args)
             for (int pass = 0; pass < 2; pass++) {
                 Py_ssize_t ka = pass == 0 ? (k0 > 1 ? k0 : 1) : k0;
                 for (Py_ssize_t k = ka; k < k1; k++) {
-                    double th = pass == 0 ? 0.0 : mo.h[k] / 2, sig, w, al;
+                    double th = offset(pass, mo.h[k]), sig, w, al;
                     state_at(&mo, k, th, &sig, &w, &al);
                     if (kind == 1) {
                         put(&o, k, -w / S, S, th, mo.h[k], 0.0, neg_inv_S, 0.0, 0.0, 0.0);
@@ -427,7 +442,8 @@ done:
 static PyMethodDef methods[] = {
     {"block", block, METH_VARARGS,
      "block(grid, pcols, tlo, thi, h, J, Tk, sigma, w, alpha, kinds, lims, fric, F, norm, C, "
-     "k, sizes, m, has_cap, k0, k1, cfloor, S, neg_inv_S, grad) -> (second, cap, w, third): "
+     "k, sizes, m, has_cap, k0, k1, cfloor, S, neg_inv_S, near, grad) -> (second, cap, w, "
+     "third): "
      "the rows of the intervals k0 to k1 written into F, norm, C, k and sizes."},
     {"monitor", monitor, METH_VARARGS,
      "monitor(grid, lo, hi, s, v, a, kinds, lims, dt, c2): start.fractions' monitor, the "

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -29,7 +30,7 @@ except ImportError:  # pragma: no cover - installed without a C compiler: the nu
 
 #: The compiled rows' interface this module calls (``ROWS_VERSION`` in _rows.c): a build of
 #: another version (an old one left in place) is not used.
-ROWS_VERSION = 1
+ROWS_VERSION = 2
 if not usable(_compiled, ROWS_VERSION):
     _compiled = None  # type: ignore[assignment]  # an old build: the numpy rows instead
 
@@ -38,6 +39,13 @@ if not usable(_compiled, ROWS_VERSION):
 #: numpy's; the tests compare the two).
 USE_COMPILED = _compiled is not None
 
+#: The second-order rows are at the inner knots and the intervals' middles, and at their
+#: first and third quarters where they are near their limits (above ``-QUARTER_NEAR``, in
+#: units of the limit): a limit's use between points a quarter of an interval apart exceeds
+#: theirs by a quarter of what points at the middles allow, about the check's tolerance at
+#: the knots' density of :func:`.start.fractions` (a pick-and-place move whose torque
+#: passed the envelope by 0.23 % between a middle and a knot, refined: now within it).
+QUARTER_NEAR = 0.02
 #: Intervals whose rows are built at once (the temporaries of a block are a few hundred
 #: bytes a row).
 CHUNK = 2048
@@ -138,12 +146,14 @@ class RowModel:
         self.second, self.third = list(second), list(third)
         M, h = mesh.M, mesh.h
         k = np.arange(M)
-        # the points of the second-order rows: the inner knots and every interval's middle
-        self.k2 = np.concatenate([k[1:], k])
-        self.t2 = np.concatenate([np.zeros(M - 1), h / 2])
+        # the points of the second-order rows: the inner knots and every interval's middle,
+        # then its first and third quarters (see :data:`QUARTER_NEAR`)
+        self.k2 = np.concatenate([k[1:], k, k, k])
+        self.t2 = np.concatenate([np.zeros(M - 1), h / 2, h / 4, 3 * h / 4])
+        self.quarter = np.arange(len(self.k2)) >= 2 * M - 1
         cap = speed_cap(second, table.co)
         self._grad = True
-        self._kept: dict[tuple[int, int, int], tuple[Array, ...]] = {}
+        self._kept: dict[tuple[int, int, int], tuple[Any, ...]] = {}
         self._last: tuple[tuple[Array, ...], Rows] | None = None
         self.root_cap = (None if not np.isfinite(cap).any()
                          else np.sqrt(np.where(np.isfinite(cap), cap, 1e300)))
@@ -220,11 +230,11 @@ class RowModel:
             return np.zeros((0, 5)), np.zeros((0, 5), np.float32)
         return local(self.mesh.h, *(np.concatenate([b[i] for b in blocks]) for i in range(7)))
 
-    def _points(self, k0: int, k1: int, m: int) -> tuple[Array, ...]:
+    def _points(self, k0: int, k1: int, m: int) -> tuple[Any, ...]:
         """The points of the intervals ``k0`` to ``k1`` (excluded), the same at every motion
-        (kept): the second-order rows' intervals and offsets, each repeated for the ``m``
-        rows at a point; the intervals; the third-order rows' intervals, offsets and which
-        are at an interval's end."""
+        (kept): the second-order rows' intervals and offsets, and which are quarters, each
+        repeated for the ``m`` rows at a point; the intervals; the third-order rows'
+        intervals, offsets and which are at an interval's end."""
         key = (k0, k1, m)
         if key not in self._kept:
             in2 = (self.k2 >= k0) & (self.k2 < k1)
@@ -232,7 +242,9 @@ class RowModel:
             kM = np.arange(k0, k1)
             n1 = k1 - k0
             h = self.mesh.h
-            self._kept[key] = (k, th, np.repeat(k, m), np.repeat(th, m), kM,
+            on = ~self.quarter[in2]  # (the first points: the knots and the middles)
+            self._kept[key] = (k, th, np.repeat(k, m), np.repeat(th, m),
+                               np.repeat(~on, m), int(on.sum()), kM,
                                np.concatenate([kM, kM, kM]),
                                np.concatenate([np.zeros(n1), h[kM] / 2, h[kM]]),
                                np.arange(3 * n1) >= 2 * n1)
@@ -246,7 +258,7 @@ class RowModel:
         mesh, tab, S = self.mesh, self.table, self.length
         h = mesh.h
         m = pr.pu.shape[1]
-        k, th, kk, tt, kM, k3, th3, end3 = self._points(k0, k1, m)
+        k, th, kk, tt, quarter, n2, kM, k3, th3, end3 = self._points(k0, k1, m)
         sig, w, al = mo.at(mesh, k, th)
         # the rows' coefficients, whether each is finite, and the speed cap's root: one
         # interpolation (each column's arithmetic as apart)
@@ -256,7 +268,6 @@ class RowModel:
         vals, slopes = interp(tab.s, np.concatenate(cols, axis=1), sig)
         pu, px, ph = vals[:, :m], vals[:, m:2 * m], vals[:, 2 * m:3 * m]
         dpu, dpx, dph = slopes[:, :m], slopes[:, m:2 * m], slopes[:, 2 * m:3 * m]
-        keep = (vals[:, 3 * m:4 * m] > 1 - 1e-12).reshape(-1)
         a_, w_, T = al[:, None], w[:, None], mo.Tk[k][:, None]
         c = np.maximum(np.abs(ph), 1e-9 * phmax + 1e-300) * T * T
         F = (pu * a_ + px * w_ * w_ - ph * T * T) / c
@@ -265,14 +276,18 @@ class RowModel:
         def flat(v: Array) -> Array:
             return np.asarray(v.reshape(-1))
 
+        # the finite rows, at a quarter only those near their limits
+        keep = (vals[:, 3 * m:4 * m] > 1 - 1e-12).reshape(-1) & (
+            ~quarter | (flat(F) > -QUARTER_NEAR))
+
         Cs = [self._loc(h, kk, tt, flat((dpu * a_ + dpx * w_ * w_ - dph * T * T) / c),
                         flat(2 * px * w_ / c), flat(pu / c), zero, flat(-2 * ph * T / c),
                         keep)]
         norms = [flat(np.broadcast_to(c, F.shape))[keep]]
         Fs, ks, names = [flat(F)[keep]], [kk[keep]], ["second-order"]
-        n2 = len(k)
+        k, th, w = k[:n2], th[:n2], w[:n2]  # (the speed's rows: at the knots and middles)
         if self.root_cap is not None:  # w <= sqrt(cap) T
-            rv, rs = vals[:, 4 * m], slopes[:, 4 * m]
+            rv, rs = vals[:n2, 4 * m], slopes[:n2, 4 * m]
             T = mo.Tk[k]
             c2 = np.maximum(rv, 1e-300) * T
             Fc = (w - rv * T) / c2
@@ -315,9 +330,9 @@ class RowModel:
             cols.append(self.root_cap[:, None])
         kinds, lims, fric = self._third_spec
         nint = k1 - k0
-        n2 = max(k1 - max(k0, 1), 0) + nint
+        n2 = max(k1 - max(k0, 1), 0) + nint  # (knots and middles; the quarters 2 nint)
         cap = self.root_cap is not None
-        rmax = n2 * m + (n2 if cap else 0) + n2 + 12 * nint * len(kinds)
+        rmax = (n2 + 2 * nint) * m + (n2 if cap else 0) + n2 + 12 * nint * len(kinds)
         F, norm, k = np.empty(rmax), np.empty(rmax), np.empty(rmax, np.int32)
         grad = self._grad
         C = np.empty((rmax if grad else 0, 5))
@@ -330,7 +345,7 @@ class RowModel:
             f64(tab.s), np.concatenate(cols, axis=1), f64(tab.lo), f64(tab.hi),
             f64(self.mesh.h), f64(mo.J), f64(mo.Tk), f64(mo.sigma), f64(mo.w), f64(mo.alpha),
             kinds, lims, fric, F, norm, C, k, sizes, m, int(cap), k0, k1,
-            1e-9 * phmax + 1e-300, self.length, -1.0 / self.length, grad)
+            1e-9 * phmax + 1e-300, self.length, -1.0 / self.length, QUARTER_NEAR, grad)
         R = n_second + n_cap + n_w + n_third
         names = [("second-order", n_second), *([("cap", n_cap)] if cap else []),
                  ("w>=0", n_w), ("third", n_third)]

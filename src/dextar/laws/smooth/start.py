@@ -139,8 +139,8 @@ def fractions(start: Start, table: Table, cons: Sequence[Constraint], segments: 
                tol: float = 2e-3) -> Array:
     """The knots' fractions of the duration (M + 1,): at least ``segments`` per duration,
     and where the rows change fast along the start motion as many as keep the rows between
-    the points they are imposed at (knots and middles) within about ``tol`` of their values
-    there.
+    the knots and the middles within about ``tol`` of their values there (the second-order
+    rows near their limits are at the quarters too: within about a quarter of it).
 
     The monitor is the second time derivative ``c`` of the motion's joint accelerations,
     torques (without friction) and joint jerks from the path's curvature (``q'' v^2``,
