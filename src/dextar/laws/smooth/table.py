@@ -109,11 +109,20 @@ def middle_miss(h: Array, lo: Array, hi: Array) -> Array:
     the model's evaluations), the same number of points."""
     hh = h[:, None]
     out = np.empty_like(lo)
-    for f, d in ((Q1, Q2), (Q2, Q3), (A, DA), (B, DB), (G, DG)):
-        out[:, f] = hh * (lo[:, d] - hi[:, d]) / 8
-    for f, d in ((Q2, Q3), (A, DA), (B, DB), (G, DG)):
-        out[:, d] = 1.5 * ((hi[:, f] - lo[:, f]) - hh * (lo[:, d] + hi[:, d]) / 2) / hh
+    out[:, _VALUES] = hh * (lo[:, _THEIR_SLOPES] - hi[:, _THEIR_SLOPES]) / 8
+    out[:, _SLOPES] = 1.5 * ((hi[:, _OF] - lo[:, _OF])
+                             - hh * (lo[:, _SLOPES] + hi[:, _SLOPES]) / 2) / hh
     return out
+
+
+def _columns_of(*parts: slice) -> Array:
+    return np.concatenate([np.arange(p.start, p.stop) for p in parts])
+
+
+# (for middle_miss: the value columns and their slopes' columns; the slope columns and the
+# columns they are the slopes of; q'' is both, its miss the value's)
+_VALUES, _THEIR_SLOPES = _columns_of(Q1, Q2, A, B, G), _columns_of(Q2, Q3, DA, DB, DG)
+_SLOPES, _OF = _columns_of(Q3, DA, DB, DG), _columns_of(Q2, A, B, G)
 
 
 def _coefficients(dynamics: PathDynamics, s: Array, length: float
