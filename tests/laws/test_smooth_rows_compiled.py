@@ -108,6 +108,56 @@ def test_the_compiled_rows_are_the_numpy_rows_with_a_torque_rate_limit(setup, mo
         assert_same(a, b)
 
 
+@pytest.mark.parametrize("motors", [
+    RATE, MotorLimits((1.5, 1.2), max_speed=(6.0, 7.0), knee_speed=(3.0, 2.5),
+                      max_jerk=(3000.0, 3000.0), max_acceleration=(400.0, 300.0))],
+    ids=["torque-speed-acceleration", "envelope"])
+def test_the_compiled_columns_are_the_constraints_rows(setup, motors, monkeypatch):  # noqa: F811
+    """The second-order rows' columns at the table's points (the built-in constraints: the
+    peak torque with the friction's tangent, the torque-speed envelope with its own, an
+    acceleration limit; the speed limit as the cap) are the constraint objects' rows to the
+    bit, with Coulomb and viscous friction on the table, at two motions' tangent points."""
+    needs_build()
+    model, me, J, Tk, tab = setup
+    co = replace(tab.co, coulomb=np.array([0.02, 0.03]), viscous=np.array([0.01, 0.02]),
+                 coulomb_speed=0.05)
+    cons = motor_constraints(motors)
+    rm = rows.RowModel(me, replace(tab, co=co), [c for c in cons if c.order == 2],
+                       [c for c in cons if c.order == 3], model.length)
+    assert rm._spec is not None
+    for mo in motions(model, J, Tk):
+        x0 = rm.tangent(mo)
+        out = []
+        for compiled in (False, True):
+            monkeypatch.setattr(rows, "USE_COMPILED", compiled)
+            out.append(rm._columns(x0))
+        (a, ma, pa), (b, mb, pb) = out
+        assert ma == mb == 4 * len([c for c in cons if c.order == 2 and c.kind != "speed"])
+        assert pa == pb > 0
+        np.testing.assert_array_equal(a, b)
+
+
+def test_a_constraint_of_another_class_keeps_its_own_rows(setup, monkeypatch):  # noqa: F811
+    """A constraint the compiled columns do not know (a plugin's, or a subclass of a built-in
+    one with rows of its own) has its own rows: the columns are then the objects' rows."""
+    from dextar.laws.constraints import TorqueLimit
+
+    class Derated(TorqueLimit):
+        def rows(self, tangent):
+            r = super().rows(tangent)
+            return PointRows(r.pu, r.px, 0.5 * r.ph)
+
+    model, me, J, Tk, tab = setup
+    mo = motions(model, J, Tk)[0]
+    plain = rows.RowModel(me, tab, [TorqueLimit((1.5, 1.5))], model.third, model.length)
+    own = rows.RowModel(me, tab, [Derated((1.5, 1.5))], model.third, model.length)
+    assert own._spec is None and (plain._spec is not None or rows._compiled is None)
+    x0 = own.tangent(mo)
+    a, b = plain._columns(x0)[0], own._columns(x0)[0]
+    m = 4
+    np.testing.assert_array_equal(b[:, 2 * m:3 * m], 0.5 * a[:, 2 * m:3 * m])
+
+
 def test_the_compiled_monitor_places_the_numpy_knots(chain, monkeypatch):  # noqa: F811
     """The knots of the chain's start (the monitor of its torques, accelerations, jerks and
     speeds) are those of the numpy monitor."""
@@ -142,19 +192,17 @@ def test_the_compiled_rows_leave_out_the_rows_without_a_limit(setup, monkeypatch
     every = PointRows(pr.pu[1:-1], pr.px[1:-1], pr.ph[1:-1])
     ph = pr.ph[1:-1].copy()
     ph[40:60, 1], ph[100:103, 2], ph[150, 0] = np.inf, -np.inf, np.nan
-    pr = PointRows(pr.pu[1:-1], pr.px[1:-1], ph)
-    finite = np.isfinite(pr.ph)
-    phmax = float(np.abs(np.where(finite, pr.ph, 0.0)).max(initial=0.0))
+    cols, m, phmax = rows.columns(PointRows(pr.pu[1:-1], pr.px[1:-1], ph), model.root_cap)
     M = model.mesh.M
     for k0, k1 in ((0, M), (5, 17)):
         out = []
         for compiled in (False, True):
             monkeypatch.setattr(rows, "USE_COMPILED", compiled)
             model._grad = True
-            out.append(model._block(mo, pr, finite, phmax, k0, k1))
+            out.append(model._block(mo, cols, m, phmax, k0, k1))
         assert_same(*out)
         model._grad = True
-        full = model._block(mo, every, np.isfinite(every.ph), phmax, k0, k1)
+        full = model._block(mo, *rows.columns(every, model.root_cap), k0, k1)
         # some were left out (the same block with every limit finite has more)
         assert dict(out[1].kinds)["second-order"] < dict(full.kinds)["second-order"]
 
@@ -231,3 +279,22 @@ def test_the_compiled_monitor_refuses_inconsistent_sizes(setup):  # noqa: F811
     z = np.zeros(4)
     with pytest.raises(ValueError, match="inconsistent"):
         rows._compiled.monitor(tab.s, tab.lo, tab.hi, z, z, z[:3], z[:1], z[:2], 0.1, z)
+
+
+@pytest.mark.parametrize("bad", ["cols", "pars", "m", "root"])
+def test_the_compiled_columns_refuse_inconsistent_sizes(setup, bad):  # noqa: F811
+    """The compiled columns' arrays of the wrong sizes are a ValueError (the same call with
+    every size right fills the columns)."""
+    needs_build()
+    assert rows._compiled is not None
+    model = setup[0]
+    pts, kinds, pars = model._spec
+    x0 = model.tangent(mesh.motion(model.mesh, setup[2], setup[3], model.length))
+    m, n = 4 * len(kinds), len(x0)
+    good = dict(cols=np.empty((n, 4 * m)), pars=pars, m=m, root=np.zeros(0))
+    assert rows._compiled.columns(pts, x0, kinds, pars, good["root"], good["cols"], m, 0) > 0
+    wrong = {**good, bad: {"cols": np.empty((n, 4 * m - 1)), "pars": pars[:-1], "m": m + 4,
+                           "root": np.zeros(n)}[bad]}
+    with pytest.raises(ValueError, match="inconsistent"):
+        rows._compiled.columns(pts, x0, kinds, wrong["pars"], wrong["root"], wrong["cols"],
+                              wrong["m"], 0)

@@ -1,8 +1,9 @@
 /* The jerk-limited law's rows compiled: RowModel._block of dextar.laws.smooth.rows (the
  * second-order rows interpolated between the table's points at the knots and the
- * intervals' middles and quarters, the speed cap, w >= 0, and the joint jerk and torque-rate rows at
- * every interval's start, middle and end, with their gradients in the programme's
- * variables) in one call, each value by the same operations in the same order as the numpy
+ * intervals' middles and quarters, the speed cap, w >= 0, and the joint jerk and
+ * torque-rate rows at every interval's start, middle and end, with their gradients in the
+ * programme's variables) and the second-order rows' columns at the table's points (the
+ * built-in constraints' point_rows) each in one call, each value by the same operations in the same order as the numpy
  * code (the same bits where the C library's pow and cosh are numpy's), without its few
  * hundred array operations per call: on a short move those cost more than the arithmetic.
  *
@@ -20,6 +21,14 @@
  *   limits. The rows of the intervals k0 to k1 (excluded) are written into F, norm, C
  *   (5 per row, with grad), k (int32) and sizes (float32, 5 per row, with grad); the counts
  *   of each kind are returned.
+ *
+ * columns(pts, x0, kinds, pars, root, cols, m, has_cap) -> phmax
+ *   RowModel._columns: pts (n x PTS) the table's a, b, g, q', q'', the friction's sides up
+ *   and down, the viscous slope and the Coulomb torque (2 each); x0 (n) the tangent points;
+ *   kinds (nc: 0 a torque limit, 1 the torque-speed envelope, 2 an acceleration limit) and
+ *   pars (6 per constraint: its limits, 2 each); root (n, with has_cap) the speed cap's root.
+ *   Written into cols (n x (4 m + has_cap), m = 4 nc): pu | px | ph (0 where not finite) |
+ *   finite | root; the largest finite |ph| returned.
  *
  * monitor(grid, lo, hi, s, v, a, kinds, lims, dt, c2)
  *   start.fractions' monitor: the parts (kinds: 0 a joint acceleration, 1 a torque without
@@ -41,12 +50,15 @@
 #endif
 
 /* The interface version: rows.py uses a build of this version only. */
-#define ROWS_VERSION 2
+#define ROWS_VERSION 3
 /* The second-order rows' points: the inner knots, and in every interval its middle, then
  * its first and third quarters (rows.py's RowModel: the same offsets by the same
  * operations; a row at a quarter only where it is near its limit, above -near). The speed
  * cap's and w >= 0's rows: at the knots and the middles (the first two passes). */
 #define POINTS 4
+/* The table's per-point columns columns() takes (2 each): a, b, g, q', q'', the friction's
+ * sides up and down, the viscous slope |q'| f_v, the Coulomb torque. */
+#define PTS 18
 /* The table's columns (2 each): q', q'', q''', a, b, g, a', b', g' (table.py). */
 #define NCOL 18
 #define Q1 0
@@ -348,6 +360,115 @@ done:
     return result;
 }
 
+/* The second-order rows' columns at the table's points (RowModel._columns: point_rows of
+ * the built-in constraints with the tangent of the friction and of the envelope at x0, the
+ * same operations in the same order) */
+static double np_min(double a, double b)
+{
+    return (a <= b || isnan(a)) ? a : b;
+}
+
+static PyObject *columns(PyObject *self, PyObject *args)
+{
+    (void)self;
+    PyObject *objs[6];
+    Py_ssize_t m;
+    int has_cap;
+    if (!PyArg_ParseTuple(args, "OOOOOOni", &objs[0], &objs[1], &objs[2], &objs[3],
+                          &objs[4], &objs[5], &m, &has_cap))
+        return NULL;
+    static const char *const names[6] = {"pts", "x0", "kinds", "pars", "root", "cols"};
+    Py_buffer b[6];
+    if (get_buffers(objs, b, 6, 5, names) < 0)
+        return NULL;
+    PyObject *result = NULL;
+    Py_ssize_t n = b[1].len / 8, nc = b[2].len / 8, P = 4 * m + (has_cap ? 1 : 0);
+    if (n < 1 || m != 4 * nc || b[0].len / 8 != n * PTS || b[3].len / 8 != 6 * nc
+        || b[4].len / 8 != (has_cap ? n : 0) || (double)n * (double)(P + 1) > 1e15
+        || b[5].len / 8 != n * P) {
+        PyErr_SetString(PyExc_ValueError, "columns: inconsistent array sizes");
+        goto done;
+    }
+    {
+        const double *pts = b[0].buf, *x0 = b[1].buf, *kinds = b[2].buf, *pars = b[3].buf;
+        const double *root = b[4].buf;
+        double *cols = b[5].buf;
+        double xmax = x0[0], phmax = 0.0;
+        for (Py_ssize_t i = 1; i < n; i++)  /* (numpy's max: a NaN wins) */
+            if (!isnan(xmax) && (x0[i] > xmax || isnan(x0[i])))
+                xmax = x0[i];
+        double floor_ = 1e-9 * np_max(xmax, 1e-300);
+        for (Py_ssize_t i = 0; i < n; i++) {
+            const double *q = pts + i * PTS;
+            double *out = cols + i * P;
+            double r = sqrt(np_max(x0[i], floor_));
+            for (int j = 0; j < 2; j++) {
+                double a = q[j], bb = q[2 + j], g = q[4 + j], dq = q[6 + j], ddq = q[8 + j];
+                double up = q[10 + j], down = q[12 + j], w = q[14 + j], coul = q[16 + j];
+                double far_phi = coul + 0.5 * w * r, far_psi = 0.5 * w / r;
+                double phi_lo = -down * far_phi, psi_lo = -down * far_psi;
+                double phi_hi = up * far_phi, psi_hi = up * far_psi;
+                for (Py_ssize_t c = 0; c < nc; c++) {
+                    const double *pc = pars + 6 * c;
+                    double pu, px_hi, px_lo, ph_hi, ph_lo;
+                    if (kinds[c] == 0.0) {  /* a torque limit */
+                        double tmax = pc[j];
+                        pu = a;
+                        px_hi = bb + psi_hi;
+                        px_lo = -(bb + psi_lo);
+                        ph_hi = tmax - g - phi_hi;
+                        ph_lo = tmax + g + phi_lo;
+                    } else if (kinds[c] == 1.0) {  /* the torque-speed envelope */
+                        double tmax = pc[j], wmax = pc[2 + j], knee = pc[4 + j];
+                        double sigma = tmax / (wmax - knee), qabs = fabs(dq);
+                        double xk = INFINITY, slope = 0.0, offset = 0.0;
+                        if (qabs > 0) {
+                            double t = knee / qabs;
+                            xk = t * t;
+                        }
+                        double rr = sqrt(np_min(np_max(x0[i], xk), 1e300));
+                        if (qabs > 0) {
+                            slope = sigma * qabs / (2 * rr);
+                            offset = sigma * qabs * rr / 2;
+                        }
+                        double cap = tmax + sigma * knee - offset;
+                        pu = a;
+                        px_hi = bb + psi_hi + slope;
+                        px_lo = -(bb + psi_lo) + slope;
+                        ph_hi = cap - g - phi_hi;
+                        ph_lo = cap + g + phi_lo;
+                    } else {  /* an acceleration limit */
+                        pu = dq;
+                        px_hi = ddq;
+                        px_lo = -ddq;
+                        ph_hi = ph_lo = pc[j];
+                    }
+                    Py_ssize_t hi_col = 4 * c + j, lo_col = 4 * c + 2 + j;
+                    out[hi_col] = pu;
+                    out[lo_col] = -pu;
+                    out[m + hi_col] = px_hi;
+                    out[m + lo_col] = px_lo;
+                    double ph[2] = {ph_hi, ph_lo};
+                    Py_ssize_t at[2] = {hi_col, lo_col};
+                    for (int e = 0; e < 2; e++) {
+                        int fin = isfinite(ph[e]);
+                        out[2 * m + at[e]] = fin ? ph[e] : 0.0;
+                        out[3 * m + at[e]] = fin ? 1.0 : 0.0;
+                        if (fin)
+                            phmax = np_max(fabs(ph[e]), phmax);
+                    }
+                }
+            }
+            if (has_cap)
+                out[4 * m] = root[i];
+        }
+        result = PyFloat_FromDouble(phmax);
+    }
+done:
+    release_buffers(b, 6);
+    return result;
+}
+
 /* numpy.gradient(f, dx, axis=0) of the columns of f (n x p, n >= 2) into g */
 static void gradient(const double *f, double *g, Py_ssize_t n, Py_ssize_t p, double dx)
 {
@@ -445,6 +566,9 @@ static PyMethodDef methods[] = {
      "k, sizes, m, has_cap, k0, k1, cfloor, S, neg_inv_S, near, grad) -> (second, cap, w, "
      "third): "
      "the rows of the intervals k0 to k1 written into F, norm, C, k and sizes."},
+    {"columns", columns, METH_VARARGS,
+     "columns(pts, x0, kinds, pars, root, cols, m, has_cap) -> phmax: the second-order rows' "
+     "columns at the table's points (pu | px | ph, 0 where not finite | finite | root cap)."},
     {"monitor", monitor, METH_VARARGS,
      "monitor(grid, lo, hi, s, v, a, kinds, lims, dt, c2): start.fractions' monitor, the "
      "largest second difference of its parts at each sample, into c2."},

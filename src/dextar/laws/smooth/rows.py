@@ -12,11 +12,16 @@ import numpy as np
 from ..._arrays import Array
 from ..._compiled import usable
 from ..constraints import (
+    AccelerationLimit,
     Constraint,
+    DegeneracyCondition,
     JerkLimit,
     PointRows,
+    SpeedLimit,
     Tangent,
+    TorqueLimit,
     TorqueRateLimit,
+    TorqueSpeedEnvelope,
     point_rows,
     speed_cap,
 )
@@ -30,7 +35,7 @@ except ImportError:  # pragma: no cover - installed without a C compiler: the nu
 
 #: The compiled rows' interface this module calls (``ROWS_VERSION`` in _rows.c): a build of
 #: another version (an old one left in place) is not used.
-ROWS_VERSION = 2
+ROWS_VERSION = 3
 if not usable(_compiled, ROWS_VERSION):
     _compiled = None  # type: ignore[assignment]  # an old build: the numpy rows instead
 
@@ -132,6 +137,56 @@ def local(h: Array, k: Array, theta: Array, gs: Array, gw: Array, ga: Array, gj:
     return C, sizes
 
 
+def columns(pr: PointRows, root_cap: Array | None) -> tuple[Array, int, float]:
+    """The second-order rows' columns at the table's points, side by side (N + 1, 4 m + 1):
+    ``pu``, ``px``, ``ph`` (0 where it is not finite), whether it is finite (1.0 or 0.0),
+    then the speed cap's root (with one); their number ``m``, and the largest finite
+    ``|ph|``."""
+    finite = np.isfinite(pr.ph)
+    phmax = float(np.abs(np.where(finite, pr.ph, 0.0)).max(initial=0.0))
+    cols = [pr.pu, pr.px, np.where(finite, pr.ph, 0.0), finite.astype(float)]
+    if root_cap is not None:
+        cols.append(root_cap[:, None])
+    return np.concatenate(cols, axis=1), pr.pu.shape[1], phmax
+
+
+def _compiled_columns(second: Sequence[Constraint], table: Table
+                     ) -> tuple[Array, Array, Array] | None:
+    """What the compiled :meth:`RowModel._columns` takes: the table's per-point columns and
+    each constraint's kind (0 a torque limit, 1 the torque-speed envelope, 2 an
+    acceleration limit) and limits; None where a constraint is of another class (its own
+    ``rows``: a plugin's, or a subclass's)."""
+    kinds: list[float] = []
+    pars: list[Array] = []
+    for c in second:
+        if type(c) is TorqueLimit:
+            kinds.append(0.0)
+            pars.append(np.concatenate([np.asarray(c.peak, float), np.zeros(4)]))
+        elif type(c) is TorqueSpeedEnvelope:
+            kinds.append(1.0)
+            pars.append(np.concatenate([np.asarray(x, float) for x in (c.peak, c.max_speed,
+                                                                      c.knee)]))
+        elif type(c) is AccelerationLimit:
+            kinds.append(2.0)
+            pars.append(np.concatenate([np.broadcast_to(np.asarray(c.max_acceleration, float),
+                                                        (2,)), np.zeros(4)]))
+        elif type(c) is SpeedLimit or (type(c) is DegeneracyCondition
+                                       and not table.co.conditions):
+            continue  # (no rows at the points)
+        else:
+            return None
+    if not kinds:
+        return None
+    co = table.moving
+    up, down = co.friction_sides
+    inner = slice(1, -1)
+    pts = np.concatenate([x[inner] for x in (
+        co.a, co.b, co.g, co.dq_ds, co.ddq_ds, up, down, co.viscous * np.abs(co.dq_ds),
+        np.broadcast_to(np.asarray(co.coulomb, float), co.dq_ds.shape))], axis=1)
+    return (np.ascontiguousarray(pts, dtype=float), np.array(kinds),
+            np.ascontiguousarray(np.concatenate(pars), dtype=float))
+
+
 def _key(mo: Motion) -> tuple[Array, ...]:
     """What the rows at a motion depend on (with the row model's mesh, table and limits)."""
     return (mo.J, mo.Tk, mo.sigma, mo.w, mo.alpha, mo.w_end, mo.alpha_end)
@@ -157,6 +212,7 @@ class RowModel:
         self._last: tuple[tuple[Array, ...], Rows] | None = None
         self.root_cap = (None if not np.isfinite(cap).any()
                          else np.sqrt(np.where(np.isfinite(cap), cap, 1e300)))
+        self._spec = _compiled_columns(self.second, table)
         # the third-order limits as the compiled rows take them: kind (0 jerk, 1 torque
         # rate), limits, and the friction (viscous, Coulomb, its regularisation speed)
         spec = [(0.0, c.max_jerk) if isinstance(c, JerkLimit) else (1.0, c.max_torque_rate)
@@ -196,14 +252,8 @@ class RowModel:
     def _rows(self, mo: Motion, gradients: bool) -> Rows:
         """All rows at the motion (:meth:`rows`)."""
         self._grad = gradients
-        x0 = self.tangent(mo)
-        tab = self.table
-        pr = point_rows(self.second, Tangent(tab.moving, np.concatenate([x0[:1], x0,
-                                                                           x0[-1:]])))
-        pr = PointRows(pr.pu[1:-1], pr.px[1:-1], pr.ph[1:-1])
-        finite = np.isfinite(pr.ph)
-        phmax = float(np.abs(np.where(finite, pr.ph, 0.0)).max(initial=0.0))
-        parts = [self._block(mo, pr, finite, phmax, k0, min(k0 + CHUNK, self.mesh.M))
+        cols, m, phmax = self._columns(self.tangent(mo))
+        parts = [self._block(mo, cols, m, phmax, k0, min(k0 + CHUNK, self.mesh.M))
                  for k0 in range(0, self.mesh.M, CHUNK)]
         if len(parts) == 1:
             return parts[0]
@@ -212,6 +262,25 @@ class RowModel:
                     np.concatenate([r.norm for r in parts]),
                     np.concatenate([r.sizes for r in parts]),
                     tuple(kind for r in parts for kind in r.kinds))
+
+    def _columns(self, x0: Array) -> tuple[Array, int, float]:
+        """The second-order rows' columns at the table's points with the tangent points
+        ``x0`` (:func:`columns`): compiled for the built-in constraints where built (the
+        same operations in the same order as their ``rows``; a few hundred array operations
+        of a few hundred points each cost more than their arithmetic), else by the
+        constraint objects."""
+        if USE_COMPILED and _compiled is not None and self._spec is not None:
+            pts, kinds, pars = self._spec
+            m = 4 * len(kinds)
+            root = (np.zeros(0) if self.root_cap is None
+                    else np.ascontiguousarray(self.root_cap, dtype=float))
+            cols = np.empty((len(x0), 4 * m + (0 if self.root_cap is None else 1)))
+            phmax = _compiled.columns(pts, np.ascontiguousarray(x0, dtype=float), kinds, pars,
+                                     root, cols, m, int(self.root_cap is not None))
+            return cols, m, phmax
+        pr = point_rows(self.second, Tangent(self.table.moving,
+                                             np.concatenate([x0[:1], x0, x0[-1:]])))
+        return columns(PointRows(pr.pu[1:-1], pr.px[1:-1], pr.ph[1:-1]), self.root_cap)
 
     def _loc(self, h: Array, k: Array, theta: Array, gs: Array, gw: Array, ga: Array,
              gj: Array, gT: Array, keep: Array | None = None) -> list[Array]:
@@ -250,22 +319,19 @@ class RowModel:
                                np.arange(3 * n1) >= 2 * n1)
         return self._kept[key]
 
-    def _block(self, mo: Motion, pr: PointRows, finite: Array, phmax: float, k0: int,
-               k1: int) -> Rows:
-        """The rows of the intervals ``k0`` to ``k1`` (excluded)."""
+    def _block(self, mo: Motion, cols: Array, m: int, phmax: float, k0: int, k1: int
+               ) -> Rows:
+        """The rows of the intervals ``k0`` to ``k1`` (excluded), from the second-order
+        rows' ``m`` columns at the table's points (:func:`columns`)."""
         if USE_COMPILED and _compiled is not None:
-            return self._block_compiled(mo, pr, finite, phmax, k0, k1)
+            return self._block_compiled(mo, cols, m, phmax, k0, k1)
         mesh, tab, S = self.mesh, self.table, self.length
         h = mesh.h
-        m = pr.pu.shape[1]
         k, th, kk, tt, quarter, n2, kM, k3, th3, end3 = self._points(k0, k1, m)
         sig, w, al = mo.at(mesh, k, th)
         # the rows' coefficients, whether each is finite, and the speed cap's root: one
         # interpolation (each column's arithmetic as apart)
-        cols = [pr.pu, pr.px, np.where(finite, pr.ph, 0.0), finite.astype(float)]
-        if self.root_cap is not None:
-            cols.append(self.root_cap[:, None])
-        vals, slopes = interp(tab.s, np.concatenate(cols, axis=1), sig)
+        vals, slopes = interp(tab.s, cols, sig)
         pu, px, ph = vals[:, :m], vals[:, m:2 * m], vals[:, 2 * m:3 * m]
         dpu, dpx, dph = slopes[:, :m], slopes[:, m:2 * m], slopes[:, 2 * m:3 * m]
         a_, w_, T = al[:, None], w[:, None], mo.Tk[k][:, None]
@@ -319,15 +385,11 @@ class RowModel:
                     np.concatenate(norms), sizes,
                     tuple((n, len(f)) for n, f in zip(names, Fs, strict=True)))
 
-    def _block_compiled(self, mo: Motion, pr: PointRows, finite: Array, phmax: float,
-                        k0: int, k1: int) -> Rows:
+    def _block_compiled(self, mo: Motion, cols: Array, m: int, phmax: float, k0: int,
+                        k1: int) -> Rows:
         """:meth:`_block` by the compiled rows (_rows.c: the same rows, the same order)."""
         assert _compiled is not None
         tab = self.table
-        m = pr.pu.shape[1]
-        cols = [pr.pu, pr.px, np.where(finite, pr.ph, 0.0), finite.astype(float)]
-        if self.root_cap is not None:
-            cols.append(self.root_cap[:, None])
         kinds, lims, fric = self._third_spec
         nint = k1 - k0
         n2 = max(k1 - max(k0, 1), 0) + nint  # (knots and middles; the quarters 2 nint)
@@ -342,7 +404,7 @@ class RowModel:
             return np.ascontiguousarray(x, dtype=float)
 
         n_second, n_cap, n_w, n_third = _compiled.block(
-            f64(tab.s), np.concatenate(cols, axis=1), f64(tab.lo), f64(tab.hi),
+            f64(tab.s), f64(cols), f64(tab.lo), f64(tab.hi),
             f64(self.mesh.h), f64(mo.J), f64(mo.Tk), f64(mo.sigma), f64(mo.w), f64(mo.alpha),
             kinds, lims, fric, F, norm, C, k, sizes, m, int(cap), k0, k1,
             1e-9 * phmax + 1e-300, self.length, -1.0 / self.length, QUARTER_NEAR, grad)
