@@ -295,3 +295,38 @@ def test_a_small_excess_is_tightened_and_a_large_one_split(monkeypatch, excess, 
     assert law.status == 0
     assert (len(law.knots_s) > 401) == split, len(law.knots_s)
     assert ("tightened" in law.message) != split, law.message
+
+
+def test_an_unchecked_law_is_the_reachability_law_and_says_so():
+    """``check=False`` (a start for another law): the law the check would have kept where it
+    passes (the same knots), never sampled through the exact model, status 2 and "not
+    checked"; the checked one's status 0. A grid too coarse for the check (it tightens the
+    limits) gives a faster unchecked law than the checked one, which holds them."""
+    from dextar.dynamics import RobotAlongPath
+    from dextar.laws import time_optimal
+
+    class Counted:
+        def __init__(self, dyn):
+            self.dyn, self.length, self.sampled = dyn, dyn.length, 0
+
+        def coefficients(self, s):
+            return self.dyn.coefficients(s)
+
+        def samples(self, law, times):
+            self.sampled += 1
+            return self.dyn.samples(law, times)
+
+    dyn = Counted(RobotAlongPath(MODEL, SEMI, "+-"))
+    checked = time_optimal.solve_time_optimal_law(dyn, torque_limit=(20.0, 20.0), grid=400)
+    assert checked.status == 0 and "tightened" not in checked.message and dyn.sampled > 0
+    dyn.sampled = 0
+    draft = time_optimal.solve_time_optimal_law(dyn, torque_limit=(20.0, 20.0), grid=400,
+                                                check=False)
+    assert draft.status == 2 and draft.message.startswith("not checked")
+    assert dyn.sampled == 0
+    np.testing.assert_array_equal(draft.knots_v, checked.knots_v)
+    coarse = time_optimal.solve_time_optimal_law(dyn, torque_limit=(20.0, 20.0), grid=12)
+    rough = time_optimal.solve_time_optimal_law(dyn, torque_limit=(20.0, 20.0), grid=12,
+                                                check=False)
+    assert coarse.status == 0 and "tightened" in coarse.message
+    assert rough.status == 2 and rough.duration < coarse.duration

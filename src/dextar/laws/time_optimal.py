@@ -117,7 +117,8 @@ class TimeOptimalLaw(Law):
     max_torque_ratio, max_speed_ratio : float
         Largest ``|tau_i| / limit_i`` and ``|qdot_i| / limit_i`` on the check samples.
     status : int
-        0 when the limits hold within the tolerance on the check samples, 1 otherwise.
+        0 when the limits hold within the tolerance on the check samples, 1 otherwise, 2
+        when not checked (``check=False``: a start for another law).
     message : str
         What the solver did, in words.
     solves : int
@@ -163,7 +164,7 @@ def solve_time_optimal_law(dynamics: PathDynamics, *,
                            motors: MotorLimits | None = None,
                            constraints: Sequence[Constraint] | None = None,
                            grid: int | Array = 400, tol: float = 1e-3,
-                           units: Units | None = None) -> TimeOptimalLaw:
+                           units: Units | None = None, check: bool = True) -> TimeOptimalLaw:
     """The fastest rest-to-rest law along a path within motor torque and speed limits.
 
     Parameters
@@ -191,6 +192,11 @@ def solve_time_optimal_law(dynamics: PathDynamics, *,
         Allowed relative excess of a torque or speed over its limit on the check samples.
     units : Units, optional
         Only for the words of an error (points in mm, torques in N m).
+    check : bool
+        False: the reachability analysis' law on the grid as it is (its friction tangent
+        settled), not sampled through the exact model, so neither tightened nor refined
+        between the grid points (status 2, "not checked"): a start for another law (the
+        jerk-limited law's), never a plan.
 
     Returns
     -------
@@ -253,6 +259,9 @@ def solve_time_optimal_law(dynamics: PathDynamics, *,
         if tangent_moved and solve < MAX_SOLVES:
             continue  # the check waits for the friction tangent to settle
         law = _law(length, co.s, x, *limits, solve)
+        if not check:
+            return _with(law, 0.0, 0.0, 2, "not checked: the reachability analysis' law on "
+                         f"the grid of {len(ds)} segments, not sampled between its points")
         dts = np.diff(law.knots_t)
         times = (law.knots_t[:-1, None] + dts[:, None] * CHECK_FRACTIONS[None, :]).reshape(-1)
         js = dynamics.samples(law, times)
