@@ -259,7 +259,7 @@ def test_the_compiled_rows_refuse_inconsistent_sizes(setup, bad):  # noqa: F811
                                     mo.Tk, mo.sigma, mo.w, mo.alpha, kinds, lims, a["fric"],
                                     a["F"], a["norm"], a["C"], a["k"], a["sizes"], a["m"], 0,
                                     0, a["k1"], 1e-300, model.length, -1.0 / model.length,
-                                    rows.QUARTER_NEAR, True)
+                                    rows.QUARTER_NEAR, -1.0, True)  # (every quarter kept)
 
     with pytest.raises(ValueError, match="inconsistent"):
         call()

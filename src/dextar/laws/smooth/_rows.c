@@ -11,7 +11,8 @@
  * dextar builds the rows with numpy).
  *
  * block(grid, pcols, tlo, thi, h, J, Tk, sigma, w, alpha, kinds, lims, fric,
- *       F, norm, C, k, sizes, m, has_cap, k0, k1, cfloor, S, neg_inv_S, near, grad)
+ *       F, norm, C, k, sizes, m, has_cap, k0, k1, cfloor, S, neg_inv_S, near, bulge,
+ *       grad)
  *     -> (second, cap, w, third)
  *   grid (N + 1) the table's arc lengths; pcols (N + 1) x P the second-order rows'
  *   coefficients pu | px | ph | finite (m columns each) and, with has_cap, the speed cap's
@@ -50,10 +51,11 @@
 #endif
 
 /* The interface version: rows.py uses a build of this version only. */
-#define ROWS_VERSION 3
+#define ROWS_VERSION 4
 /* The second-order rows' points: the inner knots, and in every interval its middle, then
  * its first and third quarters (rows.py's RowModel: the same offsets by the same
- * operations; a row at a quarter only where it is near its limit, above -near). The speed
+ * operations; a row at a quarter only where it is near its limit, above -near, and above
+ * the chord of its interval's rows on either side of it by more than bulge). The speed
  * cap's and w >= 0's rows: at the knots and the middles (the first two passes). */
 #define POINTS 4
 /* The table's per-point columns columns() takes (2 each): a, b, g, q', q'', the friction's
@@ -122,6 +124,38 @@ static void state_at(const Motion *mo, Py_ssize_t k, double th, double *sig, dou
     *al = a + th * J;
 }
 
+/* A second-order row's value (row j of the m, its columns in pc: P per table point) at the
+ * offset th into interval k, by the same operations as its row */
+static double row_at(const Motion *mo, const double *grid, Py_ssize_t n1, const double *pc,
+                     Py_ssize_t P, Py_ssize_t m, Py_ssize_t k, double th, Py_ssize_t j,
+                     double cfloor)
+{
+    double sig, w, al;
+    state_at(mo, k, th, &sig, &w, &al);
+    Py_ssize_t s = segment(grid, n1, sig, 0);
+    double ds = grid[s + 1] - grid[s];
+    double u = (np_clip(sig, grid[0], grid[n1 - 1]) - grid[s]) / ds;
+    const double *a = pc + s * P, *b = pc + (s + 1) * P;
+    double T = mo->Tk[k];
+    double pu = a[j] + (b[j] - a[j]) * u;
+    double px = a[m + j] + (b[m + j] - a[m + j]) * u;
+    double ph = a[2 * m + j] + (b[2 * m + j] - a[2 * m + j]) * u;
+    double c = np_max(fabs(ph), cfloor) * T * T;
+    return (pu * al + px * w * w - ph * T * T) / c;
+}
+
+/* The middle of the chord a quarter's row is measured against: the row at the interval's
+ * start and middle (first quarter, pass 2) or middle and end (third quarter) */
+static double chord(const Motion *mo, const double *grid, Py_ssize_t n1, const double *pc,
+                    Py_ssize_t P, Py_ssize_t m, Py_ssize_t k, int pass, Py_ssize_t j,
+                    double cfloor)
+{
+    double h = mo->h[k];
+    double fa = row_at(mo, grid, n1, pc, P, m, k, pass == 2 ? 0.0 : h / 2, j, cfloor);
+    double fb = row_at(mo, grid, n1, pc, P, m, k, pass == 2 ? h / 2 : h, j, cfloor);
+    return (fa + fb) / 2;
+}
+
 typedef struct {
     double *F, *norm, *C;
     int *k;
@@ -183,12 +217,12 @@ static PyObject *block(PyObject *self, PyObject *args)
     PyObject *objs[NIN + NOUT], *kobj, *zobj;
     Py_ssize_t m, k0, k1;
     int has_cap, grad;
-    double cfloor, S, neg_inv_S, near;
-    if (!PyArg_ParseTuple(args, "OOOOOOOOOOOOOOOOOOninndddd" "p", &objs[0], &objs[1],
+    double cfloor, S, neg_inv_S, near, bulge;
+    if (!PyArg_ParseTuple(args, "OOOOOOOOOOOOOOOOOOninnddddd" "p", &objs[0], &objs[1],
                           &objs[2], &objs[3], &objs[4], &objs[5], &objs[6], &objs[7],
                           &objs[8], &objs[9], &objs[10], &objs[11], &objs[12], &objs[13],
                           &objs[14], &objs[15], &kobj, &zobj, &m, &has_cap, &k0, &k1,
-                          &cfloor, &S, &neg_inv_S, &near, &grad))
+                          &cfloor, &S, &neg_inv_S, &near, &bulge, &grad))
         return NULL;
     static const char *const names[NIN + NOUT] = {
         "grid", "pcols", "tlo", "thi", "h", "J", "Tk", "sigma", "w", "alpha", "kinds",
@@ -257,7 +291,8 @@ static PyObject *block(PyObject *self, PyObject *args)
                     double dph = (b[2 * m + j] - a[2 * m + j]) / ds;
                     double c = np_max(fabs(ph), cfloor) * T * T;
                     double F = (pu * al + px * w * w - ph * T * T) / c;
-                    if (pass >= 2 && !(F > -near))
+                    if (pass >= 2 && !(F > -near && F > chord(&mo, grid, n1, pc, P, m, k,
+                                                               pass, j, cfloor) + bulge))
                         continue;
                     put(&o, k, F, c, th, mo.h[k], (dpu * al + dpx * w * w - dph * T * T) / c,
                         2 * px * w / c, pu / c, 0.0, -2 * ph * T / c);
@@ -563,7 +598,8 @@ done:
 static PyMethodDef methods[] = {
     {"block", block, METH_VARARGS,
      "block(grid, pcols, tlo, thi, h, J, Tk, sigma, w, alpha, kinds, lims, fric, F, norm, C, "
-     "k, sizes, m, has_cap, k0, k1, cfloor, S, neg_inv_S, near, grad) -> (second, cap, w, "
+     "k, sizes, m, has_cap, k0, k1, cfloor, S, neg_inv_S, near, bulge, grad) -> (second, "
+     "cap, w, "
      "third): "
      "the rows of the intervals k0 to k1 written into F, norm, C, k and sizes."},
     {"columns", columns, METH_VARARGS,

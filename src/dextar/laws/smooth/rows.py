@@ -35,7 +35,7 @@ except ImportError:  # pragma: no cover - installed without a C compiler: the nu
 
 #: The compiled rows' interface this module calls (``ROWS_VERSION`` in _rows.c): a build of
 #: another version (an old one left in place) is not used.
-ROWS_VERSION = 3
+ROWS_VERSION = 4
 if not usable(_compiled, ROWS_VERSION):
     _compiled = None  # type: ignore[assignment]  # an old build: the numpy rows instead
 
@@ -46,11 +46,16 @@ USE_COMPILED = _compiled is not None
 
 #: The second-order rows are at the inner knots and the intervals' middles, and at their
 #: first and third quarters where they are near their limits (above ``-QUARTER_NEAR``, in
-#: units of the limit): a limit's use between points a quarter of an interval apart exceeds
-#: theirs by a quarter of what points at the middles allow, about the check's tolerance at
-#: the knots' density of :func:`.start.fractions` (a pick-and-place move whose torque
-#: passed the envelope by 0.23 % between a middle and a knot, refined: now within it).
+#: units of the limit) and bulge above the chord of the rows on either side (the
+#: interval's start and middle, or middle and end) by more than ``QUARTER_BULGE``: a
+#: limit's use between points a quarter of an interval apart exceeds theirs by a quarter
+#: of what points at the middles allow, about the check's tolerance at the knots' density
+#: of :func:`.start.fractions` (a pick-and-place move whose torque passed the envelope by
+#: 0.23 % between a middle and a knot, refined: now within it); a row no more curved than
+#: that (an acceleration along a constant jerk) adds nothing, and the interior point's
+#: iterations grow with such rows (10 for 8 on that move).
 QUARTER_NEAR = 0.02
+QUARTER_BULGE = 1e-4
 #: Intervals whose rows are built at once (the temporaries of a block are a few hundred
 #: bytes a row).
 CHUNK = 2048
@@ -319,6 +324,17 @@ class RowModel:
                                np.arange(3 * n1) >= 2 * n1)
         return self._kept[key]
 
+    def _second_F(self, mo: Motion, cols: Array, m: int, phmax: float, k: Array, th: Array
+                  ) -> Array:
+        """The second-order rows' values (n, m) at offsets ``th`` into the intervals ``k``
+        (n,), by the same operations as :meth:`_block`'s."""
+        sig, w, al = mo.at(self.mesh, k, th)
+        vals = interp(self.table.s, cols, sig)[0]
+        pu, px, ph = vals[:, :m], vals[:, m:2 * m], vals[:, 2 * m:3 * m]
+        T = mo.Tk[k][:, None]
+        c = np.maximum(np.abs(ph), 1e-9 * phmax + 1e-300) * T * T
+        return np.asarray((pu * al[:, None] + px * w[:, None] * w[:, None] - ph * T * T) / c)
+
     def _block(self, mo: Motion, cols: Array, m: int, phmax: float, k0: int, k1: int
                ) -> Rows:
         """The rows of the intervals ``k0`` to ``k1`` (excluded), from the second-order
@@ -342,9 +358,17 @@ class RowModel:
         def flat(v: Array) -> Array:
             return np.asarray(v.reshape(-1))
 
-        # the finite rows, at a quarter only those near their limits
+        # the finite rows, at a quarter only those near their limits and above the chord of
+        # the rows on either side (the interval's start and middle, or middle and end)
+        kq = k[n2:]
+        hq = h[kq]
+        first = np.arange(len(kq)) < len(kq) // 2  # (the first quarters, then the third)
+        chord = (self._second_F(mo, cols, m, phmax, kq, np.where(first, 0.0, hq / 2))
+                 + self._second_F(mo, cols, m, phmax, kq, np.where(first, hq / 2, hq))) / 2
+        bulge = np.concatenate([np.ones((n2, m), bool),
+                                F[n2:] > chord + QUARTER_BULGE]).reshape(-1)
         keep = (vals[:, 3 * m:4 * m] > 1 - 1e-12).reshape(-1) & (
-            ~quarter | (flat(F) > -QUARTER_NEAR))
+            ~quarter | ((flat(F) > -QUARTER_NEAR) & bulge))
 
         Cs = [self._loc(h, kk, tt, flat((dpu * a_ + dpx * w_ * w_ - dph * T * T) / c),
                         flat(2 * px * w_ / c), flat(pu / c), zero, flat(-2 * ph * T / c),
@@ -407,7 +431,8 @@ class RowModel:
             f64(tab.s), f64(cols), f64(tab.lo), f64(tab.hi),
             f64(self.mesh.h), f64(mo.J), f64(mo.Tk), f64(mo.sigma), f64(mo.w), f64(mo.alpha),
             kinds, lims, fric, F, norm, C, k, sizes, m, int(cap), k0, k1,
-            1e-9 * phmax + 1e-300, self.length, -1.0 / self.length, QUARTER_NEAR, grad)
+            1e-9 * phmax + 1e-300, self.length, -1.0 / self.length, QUARTER_NEAR,
+            QUARTER_BULGE, grad)
         R = n_second + n_cap + n_w + n_third
         names = [("second-order", n_second), *([("cap", n_cap)] if cap else []),
                  ("w>=0", n_w), ("third", n_third)]
