@@ -119,6 +119,9 @@ class Programme:
         # their integrals from the nearer end (at any point of the interval)
         g = np.minimum(mesh.f[:-1], 1.0 - mesh.f[1:]) + h
         self.reach_sw = np.stack([g * g / 2, g], axis=1)
+        self._terms: tuple[Motion, tuple[Array, Array, Array, Array, Array, Array]] | None = None
+        self._x0: tuple[Motion, Array] | None = None
+        self._kp, self._kj = np.flatnonzero(self.into_pin), np.flatnonzero(~self.into_pin)
 
     def ahead(self, mo: Motion) -> float:
         """The mean of the inner knots' arc lengths over the path's length."""
@@ -140,7 +143,16 @@ class Programme:
     def _end_terms(self, mo: Motion) -> tuple[Array, Array, Array, Array, Array, Array]:
         """The linearised end states of every interval in its own normalisation:
         ``w_end = rw w_k+1 + tw``, ``alpha_end = ra alpha_k+1 + ta`` with ``tw, ta`` linear in
-        ``T_k / T0_k - T_k+1 / T0_k+1`` (coefficients ``cw, ca``); (M,) each."""
+        ``T_k / T0_k - T_k+1 / T0_k+1`` (coefficients ``cw, ca``); (M,) each (those of the
+        last motion asked kept: a programme's build and its model ask for the same)."""
+        if self._terms is not None and self._terms[0] is mo:
+            return self._terms[1]
+        terms = self._end_terms_of(mo)
+        self._terms = (mo, terms)
+        return terms
+
+    def _end_terms_of(self, mo: Motion) -> tuple[Array, Array, Array, Array, Array, Array]:
+        """:meth:`_end_terms`, computed."""
         Tn = knot_T(mo.Tk)
         rho = Tn[:-1] / Tn[1:]
         pin = self.into_pin
@@ -163,9 +175,15 @@ class Programme:
         return out
 
     def x0(self, mo: Motion) -> Array:
-        """The motion as the programme's variables."""
-        return np.concatenate([np.stack([mo.sigma, mo.w, mo.alpha, knot_T(mo.Tk)],
-                                        axis=1).reshape(-1), [0.0]])
+        """The motion as the programme's variables (those of the last motion asked kept;
+        not to be written)."""
+        if self._x0 is not None and self._x0[0] is mo:
+            return self._x0[1]
+        x0 = np.concatenate([np.stack([mo.sigma, mo.w, mo.alpha, knot_T(mo.Tk)],
+                                      axis=1).reshape(-1), [0.0]])
+        x0.flags.writeable = False
+        self._x0 = (mo, x0)
+        return x0
 
     def solve(self, rows: Rows, use: Array, mo: Motion, T_ref: float, delta: float,
               scale: float, jscale: float) -> LPResult:
@@ -181,7 +199,7 @@ class Programme:
         sel = np.flatnonzero(use)
         R = len(sel)
         pin = self.into_pin
-        kp, kj = np.flatnonzero(pin), np.flatnonzero(~pin)
+        kp, kj = self._kp, self._kj
         n = R + 2 * len(kp) + 2 * len(kj)
         k = np.empty(n, np.int64)
         ra = np.zeros((n, 6))
@@ -192,8 +210,10 @@ class Programme:
         x0 = self.x0(mo)
         rb[:R] = -rows.F[sel]
         del sel
+        at = 4 * k[:R]
         for j, off in enumerate((0, 1, 2, 3, 6, 7)):
-            rb[:R] += ra[:R, j] * x0[4 * k[:R] + off]
+            rb[:R] += ra[:R, j] * x0[at + off]
+        del at
         rg[:R] = -1.0
         # the stretches' durations relative to each other change less than the whole: the
         # jerk of the short interval into a pinned knot changes with the square of their
