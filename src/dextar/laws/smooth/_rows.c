@@ -550,8 +550,16 @@ static PyObject *monitor(PyObject *self, PyObject *args)
         const double *grid = b[0].buf, *lo = b[1].buf, *hi = b[2].buf, *s = b[3].buf;
         const double *v = b[4].buf, *a = b[5].buf, *kinds = b[6].buf, *lims = b[7].buf;
         double *c2 = b[8].buf, *G = p > 0 ? P + n * p : NULL;
+        Py_ssize_t k = 0;
         for (Py_ssize_t i = 0; i < n && p > 0; i++) {
-            Py_ssize_t k = segment(grid, n1, s[i], 0);
+            /* the samples' arc lengths increase (a motion's): the segment walked to from the
+             * last one, the same as the search's; else searched */
+            if (i > 0 && s[i] >= s[i - 1] && !isnan(s[i]) && s[i - 1] >= grid[k]) {
+                while (k < n1 - 2 && grid[k + 1] <= s[i])
+                    k++;
+            } else {
+                k = segment(grid, n1, s[i], 0);
+            }
             double ds = grid[k + 1] - grid[k];
             double u = (np_clip(s[i], grid[0], grid[n1 - 1]) - grid[k]) / ds;
             double vv = v[i], aa = a[i];

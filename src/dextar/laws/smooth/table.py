@@ -126,17 +126,16 @@ _SLOPES, _OF = _columns_of(Q3, DA, DB, DG), _columns_of(Q2, A, B, G)
 
 
 def _coefficients(dynamics: PathDynamics, s: Array, length: float
-                  ) -> tuple[PathCoefficients, PathCoefficients, PathCoefficients, Array,
-                             Array]:
-    """The coefficients at the arc lengths ``s`` and a short step
-    (:data:`DERIVATIVE_STEP`) before and after them (within the path), and those points,
-    from one evaluation of the dynamics (its cost is mostly per call)."""
+                  ) -> tuple[PathCoefficients, Array, Array, Array]:
+    """The coefficients at the arc lengths ``s``, and the columns with derivatives (``q''``,
+    ``a``, ``b``, ``g``; (3 n, 8)) there and a short step (:data:`DERIVATIVE_STEP`) before
+    and after them (within the path), and those points, from one evaluation of the dynamics
+    (its cost is mostly per call)."""
     step = DERIVATIVE_STEP * length
     left, right = np.maximum(s - step, 0.0), np.minimum(s + step, length)
     co = dynamics.coefficients(np.concatenate([s, left, right]))
-    n = len(s)
-    return (_rows_of(co, slice(0, n)), _rows_of(co, slice(n, 2 * n)),
-            _rows_of(co, slice(2 * n, 3 * n)), left, right)
+    base = np.concatenate([co.ddq_ds, co.a, co.b, co.g], axis=1)
+    return _rows_of(co, slice(0, len(s))), base, left, right
 
 
 def _rows_of(co: PathCoefficients, rows: slice) -> PathCoefficients:
@@ -146,16 +145,14 @@ def _rows_of(co: PathCoefficients, rows: slice) -> PathCoefficients:
                             None if co.d2q_ds2 is None else co.d2q_ds2[rows], co.coulomb_speed)
 
 
-def _columns(s: Array, co: PathCoefficients, cl: PathCoefficients, cr: PathCoefficients,
-             left: Array, right: Array) -> tuple[PathCoefficients, Array, Array, Array]:
-    """From the coefficients at ``s`` (N + 1,) and a step ``left`` and ``right`` of them
-    (:func:`_coefficients`), the table's columns (see :class:`Table`) at the starts and the
-    ends of the segments (two arrays (N, 18)) and the joints (indices)."""
-
-    def base(c: PathCoefficients) -> Array:  # the columns with derivatives
-        return np.concatenate([c.ddq_ds, c.a, c.b, c.g], axis=1)
-
-    f0, fl, fr = base(co), base(cl), base(cr)
+def _columns(s: Array, co: PathCoefficients, base: Array, left: Array, right: Array
+             ) -> tuple[PathCoefficients, Array, Array, Array]:
+    """From the coefficients at ``s`` (N + 1,) and the columns with derivatives there and a
+    step ``left`` and ``right`` of them (:func:`_coefficients`), the table's columns (see
+    :class:`Table`) at the starts and the ends of the segments (two arrays (N, 18)) and the
+    joints (indices)."""
+    n = len(s)
+    f0, fl, fr = base[:n], base[n:2 * n], base[2 * n:]
     with np.errstate(invalid="ignore", divide="ignore"):
         dl = np.where((s > left)[:, None], (f0 - fl) / (s - left)[:, None], np.nan)
         dr = np.where((right > s)[:, None], (fr - f0) / (right - s)[:, None], np.nan)
