@@ -96,18 +96,18 @@ class Programme:
         M, h = mesh.M, mesh.h
         self.mesh, self.M, self.length = mesh, M, length
         K = M + 1
-        z, one = np.zeros(M), np.ones(M)
         # w_k+1 - w_k = h (alpha_k + alpha_k+1) / 2, the arc length's over h, T_k = T_k+1,
         # on (sigma, w, alpha, T) of knots k and k + 1
-        E = np.stack([np.stack([z, -one, -h / 2, z, z, one, -h / 2, z], axis=1),
-                      np.stack([-1 / h, -one, -h / 3, z, 1 / h, z, -h / 6, z], axis=1),
-                      np.stack([z, z, z, one, z, z, z, -one], axis=1)], axis=1)
+        E = np.zeros((M, 3, 8))
+        E[:, 0, 1], E[:, 0, 2], E[:, 0, 5], E[:, 0, 6] = -1.0, -h / 2, 1.0, -h / 2
+        E[:, 1, 0], E[:, 1, 1], E[:, 1, 2], E[:, 1, 4], E[:, 1, 6] = (-1 / h, -1.0, -h / 3,
+                                                                    1 / h, -h / 6)
+        E[:, 2, 3], E[:, 2, 7] = 1.0, -1.0
         self.into_pin = mesh.pinned[1:]  # the intervals that end at a pinned knot
         E[self.into_pin, 2, :] = 0.0
         self.E = E
-        lo = np.stack([np.zeros(K), np.zeros(K), np.zeros(K), np.zeros(K)], axis=1)
-        hi = np.stack([np.full(K, length), np.full(K, np.inf), np.zeros(K), np.zeros(K)],
-                      axis=1)
+        lo, hi = np.zeros((K, 4)), np.zeros((K, 4))
+        hi[:, 0], hi[:, 1] = length, np.inf
         lo[-1, 0], hi[0, 0] = length, 0.0
         hi[0, 1] = hi[-1, 1] = 0.0
         lo[mesh.pins, 0] = hi[mesh.pins, 0] = mesh.pin_s
