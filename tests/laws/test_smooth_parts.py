@@ -661,3 +661,66 @@ def test_a_bad_grid_is_named(chain, bad, words):
     dyn, _ = chain
     with pytest.raises(ParameterError, match=words):
         solve_jerk_limited_law(dyn, motors=MOTORS, grid=bad)
+
+
+def _stop_and_go(idle):
+    """A jerk-limited law that moves, stops for ``idle`` s and moves again (each move four
+    intervals of 0.05 s at jerk +-100: rest to rest)."""
+    from dextar.laws.smooth.law import JerkLimitedLaw
+
+    move = [100.0, -100.0, -100.0, 100.0]
+    jerk = np.array(move + ([0.0] if idle else []) + move)
+    dt = np.array([0.05] * 4 + ([idle] if idle else []) + [0.05] * 4)
+    a, v, s = mesh.integrate(dt, jerk)
+    t = np.concatenate([[0.0], np.cumsum(dt)])
+    return JerkLimitedLaw(float(s[-1]), float(t[-1]), t, s, v, a, jerk)
+
+
+def test_an_idle_span_is_cut_out_and_a_law_without_one_left():
+    """A stop of 0.1 s in a 0.5 s law is cut out (the start it gives: 0.1 s shorter, and
+    the slow edges of the stop, 4.9 ms measured; the same arrays as from the law evaluated
+    whole); a law without one gives no start, or itself sampled when asked."""
+    law = _stop_and_go(0.1)
+    cut = start.without_idle(law)
+    whole = start.without_idle(law, always=True)  # (the law evaluated, arc length and all)
+    assert cut is not None and whole is not None
+    assert 0.1 <= law.duration - cut.T <= 0.11
+    for x, y in zip((cut.t, cut.s, cut.v, cut.a), (whole.t, whole.s, whole.v, whole.a),
+                    strict=True):
+        np.testing.assert_array_equal(x, y)
+    plain = _stop_and_go(0.0)
+    assert start.without_idle(plain) is None
+    sampled = start.without_idle(plain, always=True)
+    assert sampled is not None and sampled.T == plain.duration
+
+
+@pytest.mark.parametrize("t", [-4e-10, 0.4 * (1 + 1e-9), float("nan"), float("inf")])
+def test_a_time_outside_a_law_is_named(t):
+    """A time before its start, after its end (by 1e-9 of its duration: beyond rounding),
+    NaN or infinite: an error that names it and the interval; the ends themselves and a
+    rounding past them (1e-13) pass."""
+    from dextar.errors import ParameterError
+
+    law = _stop_and_go(0.0)  # 0.4 s
+    assert abs(law.duration - 0.4) < 1e-15
+    with pytest.raises(ParameterError, match=r"time t = .* outside the law's interval"):
+        law.evaluate(np.array([0.0, 0.1, t, 0.2]))
+    out = law.evaluate(np.array([0.0, law.duration * (1 + 1e-13), -1e-14]))
+    assert np.all(np.isfinite(out))
+
+
+@pytest.mark.parametrize("speed", [1.0, 0.5, 2.0])
+def test_the_time_scaling_factor_is_each_rows(setup, speed):
+    """The factor that brings the rows to their limits, from each block's largest row: the
+    largest over every row of ``max(1 + F, 0) ^ (1 / p)`` (p the block's power: the
+    second-order rows 2, the speed cap 1, w >= 0 none, the third-order 3), to the bit; and
+    the power of the largest row."""
+    model, me, J, Tk, _ = setup
+    r = model._rows(mesh.motion(me, J, Tk / speed, model.length), False)
+    p = np.concatenate([np.full(n, {"second-order": 2.0, "cap": 1.0, "w>=0": 0.0}.get(k, 3.0))
+                        for k, n in r.kinds])
+    on = p > 0
+    factor, p_worst = r.scaling()
+    assert factor == float(np.max(np.maximum(r.F + 1.0, 0.0)[on] ** (1.0 / p[on])))
+    assert p_worst == p[int(np.argmax(r.F))]
+    assert (factor > 1.0) == (speed > 1.0)  # (faster: beyond the limits)

@@ -88,12 +88,26 @@ class Rows:
             i -= n
         return "?"
 
-    def powers(self) -> Array:
-        """How each row's use scales with ``1 / T`` for a fixed normalised motion (about:
-        the speed cap 1, the torques and accelerations 2, the third-order limits 3; 0 for
-        the rows that do not scale)."""
-        p = {"second-order": 2.0, "cap": 1.0, "w>=0": 0.0}
-        return np.concatenate([np.full(n, p.get(name, 3.0)) for name, n in self.kinds])
+    def scaling(self) -> tuple[float, float]:
+        """The factor on the durations that brings every scaling row's use to its limit if
+        each scaled exactly as its power ``p`` (how its use scales with ``1 / T`` for a fixed
+        normalised motion, about: the speed cap 1, the torques and accelerations 2, the
+        third-order limits 3; 0 for the rows that do not scale): the largest
+        ``max(1 + F, 0) ^ (1 / p)``; and the power of the largest row."""
+        tops, exps = [], []
+        at, i, p_worst = 0, int(np.argmax(self.F)), 0.0
+        for name, n in self.kinds:
+            p = _power(name)
+            if at <= i < at + n:
+                p_worst = p
+            if p > 0 and n > 0:  # (x^(1/p) grows with x: each block's largest row)
+                tops.append(self.F[at:at + n].max())
+                exps.append(1.0 / p)
+            at += n
+        if not tops:
+            return 1.0, p_worst
+        use = np.maximum(np.array(tops) + 1.0, 0.0)
+        return float(np.max(use ** np.array(exps))), p_worst
 
     def linear(self, d_sigma: Array, d_w: Array, d_alpha: Array, d_alpha_end: Array,
                d_T: Array) -> Array:
@@ -140,6 +154,11 @@ def local(h: Array, k: Array, theta: Array, gs: Array, gw: Array, ga: Array, gj:
     for i, g in enumerate((gs, gw, ga, gj, gT)):
         sizes[:, i] = np.abs(g)
     return C, sizes
+
+
+def _power(kind: str) -> float:
+    """How a block of rows' use scales with ``1 / T`` (:meth:`Rows.scaling`)."""
+    return {"second-order": 2.0, "cap": 1.0, "w>=0": 0.0}.get(kind, 3.0)
 
 
 def columns(pr: PointRows, root_cap: Array | None) -> tuple[Array, int, float]:

@@ -287,7 +287,7 @@ class Programme:
 def time_scaled(model: RowModel, J: Array, Tk: Array, keep: bool = True) -> Array:
     """The durations that bring the normalised motion ``J`` just within its rows (a start
     that is slower than the limits allow is sped up, one beyond them slowed down), all
-    scaled alike: each row's use scales about as ``T^-p`` (:meth:`Rows.powers`); exact
+    scaled alike: each row's use scales about as ``T^-p`` (:meth:`Rows.scaling`); exact
     where it does, so a few rounds, then stretching while a row is still beyond its limit
     (gravity or friction rows that scale more slowly). With ``keep``, the last rows are
     kept (:meth:`.RowModel.rows`) for the SLP that starts from the motion."""
@@ -302,16 +302,12 @@ def time_scaled(model: RowModel, J: Array, Tk: Array, keep: bool = True) -> Arra
         near = keep and abs(last - 1.0) < 0.1
         rows = None  # (one set of gradients at a time)
         rows = model.rows(motion(model.mesh, J, Tk, model.length), gradients=near, keep=near)
-        i = int(np.argmax(rows.F))
-        worst = float(rows.F[i])
-        p = rows.powers()
-        use = np.maximum(rows.F + 1.0, 0.0)
-        on = p > 0
-        factor = float(np.max(use[on] ** (1.0 / p[on]))) if on.any() else 1.0
+        worst = float(rows.F.max())
+        factor, p_worst = rows.scaling()
         if worst <= 0.0 and abs(factor - 1.0) < 1e-3:
             break
         if worst > 0.0:
-            if p[i] == 0:
+            if p_worst == 0:
                 break  # a row the duration does not change
             if beyond:  # the powers' factor did not bring it within (gravity, friction)
                 factor = max(factor, 1.5)
