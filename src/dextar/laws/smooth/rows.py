@@ -455,7 +455,13 @@ class RowModel:
         R = n_second + n_cap + n_w + n_third
         names = [("second-order", n_second), *([("cap", n_cap)] if cap else []),
                  ("w>=0", n_w), ("third", n_third)]
-        return Rows(F[:R], k[:R], C[:R], norm[:R], sizes[:R], tuple(names))
+        # the room for rows left out (a limit not finite, a quarter not near its limit)
+        # given back: the arrays cut to their rows in place (no copy)
+        for x in (F, norm, k):
+            x.resize(R, refcheck=False)
+        for g in (C, sizes):
+            g.resize((R if grad else 0, 5), refcheck=False)
+        return Rows(F, k, C, norm, sizes, tuple(names))
 
     def _third_at(self, mo: Motion, k: Array, theta: Array, v: Array, d: Array, w: Array,
                   al: Array) -> tuple[Array, list[list[Array]], Array, Array]:
