@@ -181,6 +181,23 @@ def test_the_tables_miss_at_the_middles_comes_from_both_ends(chain):
     assert np.all(np.abs(est - miss) <= 2e-5 * scale)
 
 
+@pytest.mark.parametrize("eps", [1e-12, 1e-13, 1e-15])
+def test_a_very_short_segment_of_a_given_grid_is_left_as_it_is(chain, eps):
+    """A grid given with a point ``eps`` of the path from another: the table as the grid
+    without it, with that point (the miss's slope form over so short a segment is the
+    rounding of its ends' values: it had been split into up to 6508 points, some equal),
+    no warning."""
+    import warnings
+
+    dyn, path = chain
+    clean = table.make_table(dyn, grid(path))
+    g = grid(path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        tab = table.make_table(dyn, np.unique(np.concatenate([g, [g[57] + eps * dyn.length]])))
+    assert len(tab.s) == len(clean.s) + 1 and np.all(np.diff(tab.s) > 0)
+
+
 def test_an_equal_grid_gets_the_paths_joints(chain):
     """A grid given as a number of segments gets the blend's two joints (an equal grid misses
     one or both: the table then smooths that jump of the joints' third derivatives
@@ -756,6 +773,8 @@ def test_the_region_use_is_the_programmes_largest_box(setup):
     lp = slp.Programme(me, model.length)
     delta, scale, jscale = 0.3, float(np.abs(mo.alpha).max()), float(np.abs(mo.J).max())
     x = lp.x0(mo).copy()
+    rows_ = model._rows(mo, True)
+    prog = lp.build(rows_, np.ones(len(rows_.F), bool), mo, mo.T, delta, scale, jscale)[0]
 
     def use(y):
         return lp.region_use(y, mo, delta, scale, jscale)
@@ -764,7 +783,7 @@ def test_the_region_use_is_the_programmes_largest_box(setup):
     k = int(lp._kj[len(lp._kj) // 2]) + 1  # (a knot between two intervals in a stretch)
     assert not me.pinned[k] and not me.pinned[k + 1] and not me.pinned[k - 1]
     y = x.copy()
-    y[4 * k + 1] += delta * (abs(mo.w[k]) + slp.W_FLOOR * np.abs(mo.w).max())
+    y[4 * k + 1] = prog.hi[4 * k + 1]  # (the programme's own box)
     assert abs(use(y) - 1.0) < 1e-9
     d = 0.1 * delta * scale
     y = x.copy()
@@ -777,7 +796,7 @@ def test_the_region_use_is_the_programmes_largest_box(setup):
     y[4 * (kp + 1) + 3] *= 1 + 1e-4
     assert abs(use(y) - 1e-4 / (slp.RHO_SHARE * delta)) < 1e-6
     y = x.copy()
-    y[3:4 * (me.M + 1):4] *= 1 + slp.T_SHARE * delta  # (every duration, alike)
+    y[3:4 * (me.M + 1):4] = prog.hi[3:4 * (me.M + 1):4]  # (every duration, its box's edge)
     assert abs(use(y) - 1.0) < 1e-9
 
 

@@ -51,7 +51,7 @@ def both(monkeypatch, model, mo, gradients=True):
 def assert_same(a, b):
     """The same rows in the same order: intervals and kinds exactly, values to rounding
     (1e-12 of each array's scale: the C library's pow and cosh may differ from numpy's in
-    the last bit on another machine; on this one they are the same bits)."""
+    the last bit; the third-order rows here by up to 3e-13, the rest the same bits)."""
     assert a.kinds == b.kinds
     np.testing.assert_array_equal(a.k, b.k)
     assert a.k.dtype == b.k.dtype and a.sizes.dtype == b.sizes.dtype
@@ -88,6 +88,15 @@ def test_the_compiled_rows_are_the_numpy_rows_with_a_jerk_limit(setup, monkeypat
     a, b = both(monkeypatch, model, motions(model, J, Tk)[1])
     assert len(a.kinds) > 4 * 3  # several blocks
     assert_same(a, b)
+    # every quarter's row kept (near any use, above any chord), blocks of 7 and of all
+    monkeypatch.setattr(rows, "QUARTER_NEAR", 10.0)
+    monkeypatch.setattr(rows, "QUARTER_BULGE", -10.0)
+    M = model.mesh.M
+    for chunk in (7, 2048):
+        monkeypatch.setattr(rows, "CHUNK", chunk)
+        a, b = both(monkeypatch, model, motions(model, J, Tk)[1])
+        assert sum(n for k, n in a.kinds if k == "second-order") == 4 * (4 * M - 1)
+        assert_same(a, b)
 
 
 def test_the_compiled_rows_are_the_numpy_rows_with_a_torque_rate_limit(setup, monkeypatch):  # noqa: F811

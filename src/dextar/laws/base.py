@@ -75,14 +75,21 @@ class Law(ABC):
 
     def evaluate(self, t: object) -> Array:
         """``s, sdot, sddot, sdddot`` at times ``t``, stacked in an array of shape (4, ...)."""
+        return self._evaluate(self._within(t))
+
+    def _within(self, t: object) -> Array:
+        """The times ``t`` as floats clipped to the law's interval (a rounding past an end),
+        a :class:`ParameterError` naming a time outside it."""
         t = np.asarray(t, dtype=float)
         T = self.duration
         # (the least and the largest first: a NaN or a time outside is rare)
         if t.size and not (float(t.min()) >= -1e-12 * T and float(t.max()) <= T * (1 + 1e-12)):
-            bad = ~np.isfinite(t) | (t < -1e-12 * T) | (t > T * (1 + 1e-12))
-            v = t.reshape(-1)[np.flatnonzero(bad.reshape(-1))[0]]
-            raise ParameterError(f"time t = {v:.6g} outside the law's interval [0, {T:.6g}]")
-        return self._evaluate(np.clip(t, 0.0, T))
+            bad = (~np.isfinite(t) | (t < -1e-12 * T) | (t > T * (1 + 1e-12))).reshape(-1)
+            if bad.any():  # (none: a duration that is not a number, as before)
+                v = t.reshape(-1)[np.flatnonzero(bad)[0]]
+                raise ParameterError(f"time t = {v:.6g} outside the law's interval "
+                                     f"[0, {T:.6g}]")
+        return np.asarray(np.clip(t, 0.0, T))
 
     def cost_parts(self, path: Path, mass: float, eta: float) -> tuple[float, float]:
         """The functional's kinetic and inertial parts for this law along ``path``."""

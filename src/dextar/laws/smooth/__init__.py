@@ -22,8 +22,9 @@ modules, in the order of the solve:
   recurrence), so the ends (``sigma = S``, ``w = alpha = 0``) do not involve ``T`` and the
   motion between the knots is exact.
 * :mod:`.rows`: every limit as a row ``r <= 0`` at the inner knots and in the middle of
-  every interval, and at its quarters where a row is near its limit (the third-order
-  limits at both ends and the middle of every interval, where the jerk is constant): the second-order constraint objects' rows
+  every interval, a second-order one also at its quarters where it is near its limit and
+  bends above the chord of its neighbours (the third-order limits at both ends and the
+  middle of every interval, where the jerk is constant): the second-order constraint objects' rows
   ``pu u + px x <= ph`` (:mod:`dextar.laws.constraints`) become ``pu alpha + px w^2 - ph
   T^2 <= 0``, the speed cap ``w <= sqrt(cap) T``, the joint jerk ``q' J + 3 q'' w alpha +
   q''' w^3 <= j_max T^3``, the torque rate ``a J + (a' + 2 b) w alpha + b' w^3 + g' w T^2 +

@@ -72,17 +72,23 @@
 #define CDB 14
 #define CDG 16
 
-/* numpy's maximum and clip where a NaN propagates (a tie of signed zeros, which numpy gives
- * as +0, is not met by the callers: a floor above zero, a magnitude against a maximum) */
 /* The offset into an interval of length h of a second-order point's pass (see POINTS). */
 static double offset(int pass, double h)
 {
     return pass == 0 ? 0.0 : (pass == 1 ? h / 2 : (pass == 2 ? h / 4 : 3 * h / 4));
 }
 
+/* numpy's maximum, minimum and clip where a NaN propagates (a tie of signed zeros, which
+ * numpy gives as +0, is not met by the callers: a floor above zero, a magnitude against a
+ * maximum) */
 static double np_max(double a, double b)
 {
     return (a >= b || isnan(a)) ? a : b;
+}
+
+static double np_min(double a, double b)
+{
+    return (a <= b || isnan(a)) ? a : b;
 }
 
 static double np_clip(double x, double lo, double hi)
@@ -126,22 +132,50 @@ static void state_at(const Motion *mo, Py_ssize_t k, double th, double *sig, dou
 
 /* A second-order row's value (row j of the m, its columns in pc: P per table point) at the
  * offset th into interval k, by the same operations as its row */
+/* A second-order point: its state, table segment (s, ds, u, the columns a and b at its
+ * ends) and its interval's duration */
+typedef struct {
+    double w, al, ds, u, T;
+    const double *a, *b;
+} Point;
+
+static Point point_at(const Motion *mo, const double *grid, Py_ssize_t n1, const double *pc,
+                      Py_ssize_t P, Py_ssize_t k, double th)
+{
+    Point pt;
+    double sig;
+    state_at(mo, k, th, &sig, &pt.w, &pt.al);
+    Py_ssize_t s = segment(grid, n1, sig, 0);
+    pt.ds = grid[s + 1] - grid[s];
+    pt.u = (np_clip(sig, grid[0], grid[n1 - 1]) - grid[s]) / pt.ds;
+    pt.a = pc + s * P;
+    pt.b = pc + (s + 1) * P;
+    pt.T = mo->Tk[k];
+    return pt;
+}
+
+/* Row j's value at the point (of the m; the columns pu | px | ph), and its pu, px, ph and
+ * normalisation c */
+static double second_row(const Point *pt, Py_ssize_t m, Py_ssize_t j, double cfloor,
+                         double *pu, double *px, double *ph, double *c)
+{
+    const double *a = pt->a, *b = pt->b;
+    double u = pt->u, T = pt->T;
+    *pu = a[j] + (b[j] - a[j]) * u;
+    *px = a[m + j] + (b[m + j] - a[m + j]) * u;
+    *ph = a[2 * m + j] + (b[2 * m + j] - a[2 * m + j]) * u;
+    *c = np_max(fabs(*ph), cfloor) * T * T;
+    return (*pu * pt->al + *px * pt->w * pt->w - *ph * T * T) / *c;
+}
+
+/* Row j's value at the offset th into interval k */
 static double row_at(const Motion *mo, const double *grid, Py_ssize_t n1, const double *pc,
                      Py_ssize_t P, Py_ssize_t m, Py_ssize_t k, double th, Py_ssize_t j,
                      double cfloor)
 {
-    double sig, w, al;
-    state_at(mo, k, th, &sig, &w, &al);
-    Py_ssize_t s = segment(grid, n1, sig, 0);
-    double ds = grid[s + 1] - grid[s];
-    double u = (np_clip(sig, grid[0], grid[n1 - 1]) - grid[s]) / ds;
-    const double *a = pc + s * P, *b = pc + (s + 1) * P;
-    double T = mo->Tk[k];
-    double pu = a[j] + (b[j] - a[j]) * u;
-    double px = a[m + j] + (b[m + j] - a[m + j]) * u;
-    double ph = a[2 * m + j] + (b[2 * m + j] - a[2 * m + j]) * u;
-    double c = np_max(fabs(ph), cfloor) * T * T;
-    return (pu * al + px * w * w - ph * T * T) / c;
+    Point pt = point_at(mo, grid, n1, pc, P, k, th);
+    double pu, px, ph, c;
+    return second_row(&pt, m, j, cfloor, &pu, &px, &ph, &c);
 }
 
 /* The middle of the chord a quarter's row is measured against: the row at the interval's
@@ -273,24 +307,17 @@ static PyObject *block(PyObject *self, PyObject *args)
         for (int pass = 0; pass < POINTS; pass++) {
             Py_ssize_t ka = pass == 0 ? (k0 > 1 ? k0 : 1) : k0;
             for (Py_ssize_t k = ka; k < k1; k++) {
-                double th = offset(pass, mo.h[k]), sig, w, al;
-                state_at(&mo, k, th, &sig, &w, &al);
-                Py_ssize_t s = segment(grid, n1, sig, 0);
-                double ds = grid[s + 1] - grid[s];
-                double u = (np_clip(sig, lo_s, hi_s) - grid[s]) / ds;
-                const double *a = pc + s * P, *b = pc + (s + 1) * P;
-                double T = mo.Tk[k];
+                double th = offset(pass, mo.h[k]);
+                Point pt = point_at(&mo, grid, n1, pc, P, k, th);
+                const double *a = pt.a, *b = pt.b, ds = pt.ds, w = pt.w, al = pt.al, T = pt.T;
                 for (Py_ssize_t j = 0; j < m; j++) {
-                    double fin = a[3 * m + j] + (b[3 * m + j] - a[3 * m + j]) * u;
+                    double fin = a[3 * m + j] + (b[3 * m + j] - a[3 * m + j]) * pt.u;
                     if (!(fin > 1 - 1e-12))
                         continue;
-                    double pu = a[j] + (b[j] - a[j]) * u;
-                    double px = a[m + j] + (b[m + j] - a[m + j]) * u;
-                    double ph = a[2 * m + j] + (b[2 * m + j] - a[2 * m + j]) * u;
+                    double pu, px, ph, c;
+                    double F = second_row(&pt, m, j, cfloor, &pu, &px, &ph, &c);
                     double dpu = (b[j] - a[j]) / ds, dpx = (b[m + j] - a[m + j]) / ds;
                     double dph = (b[2 * m + j] - a[2 * m + j]) / ds;
-                    double c = np_max(fabs(ph), cfloor) * T * T;
-                    double F = (pu * al + px * w * w - ph * T * T) / c;
                     if (pass >= 2 && !(F > -near && F > chord(&mo, grid, n1, pc, P, m, k,
                                                                pass, j, cfloor) + bulge))
                         continue;
@@ -398,11 +425,6 @@ done:
 /* The second-order rows' columns at the table's points (RowModel._columns: point_rows of
  * the built-in constraints with the tangent of the friction and of the envelope at x0, the
  * same operations in the same order) */
-static double np_min(double a, double b)
-{
-    return (a <= b || isnan(a)) ? a : b;
-}
-
 static PyObject *columns(PyObject *self, PyObject *args)
 {
     (void)self;
@@ -417,8 +439,14 @@ static PyObject *columns(PyObject *self, PyObject *args)
     if (get_buffers(objs, b, 6, 5, names) < 0)
         return NULL;
     PyObject *result = NULL;
-    Py_ssize_t n = b[1].len / 8, nc = b[2].len / 8, P = 4 * m + (has_cap ? 1 : 0);
-    if (n < 1 || m != 4 * nc || b[0].len / 8 != n * PTS || b[3].len / 8 != 6 * nc
+    /* (m checked against the constraints' count before any product of it) */
+    Py_ssize_t n = b[1].len / 8, nc = b[2].len / 8;
+    if (m != 4 * nc || (double)n * (double)(4 * nc + 2) > 1e15) {
+        PyErr_SetString(PyExc_ValueError, "columns: inconsistent array sizes");
+        goto done;
+    }
+    Py_ssize_t P = 4 * m + (has_cap ? 1 : 0);
+    if (n < 1 || b[0].len / 8 != n * PTS || b[3].len / 8 != 6 * nc
         || b[4].len / 8 != (has_cap ? n : 0) || (double)n * (double)(P + 1) > 1e15
         || b[5].len / 8 != n * P) {
         PyErr_SetString(PyExc_ValueError, "columns: inconsistent array sizes");

@@ -29,7 +29,8 @@ class JerkLimitedLaw(Law):
         ``acceleration``, ``jerk``, ``torque_rate``).
     second_order_duration : float
         The duration of the second-order (unlimited jerk) law on the same limits (on the
-        coarse grid of the start).
+        coarse grid of the start: its reachability analysis, not checked between the grid's
+        points).
     status : int
         0 when the limits hold within their tolerances on the check samples, 1 otherwise.
     message : str
@@ -65,9 +66,24 @@ class JerkLimitedLaw(Law):
                 "max_ratios_check_samples": dict(self.ratios),
                 "second_order_duration": self.second_order_duration}
 
-    def _evaluate(self, t: Array) -> Array:
+    def speed_and_acceleration(self, t: object) -> tuple[Array, Array]:
+        """``sdot, sddot`` at times ``t`` (:meth:`evaluate`'s, without the arc length and
+        the jerk)."""
+        k, tau = self._interval(self._within(t))
+        return self._rates(k, tau)
+
+    def _interval(self, t: Array) -> tuple[Array, Array]:
+        """Each time's interval and its time into it."""
         k = np.clip(np.searchsorted(self.knots_t, t, side="right") - 1, 0, self.jerk.size - 1)
-        tau = t - self.knots_t[k]
+        return k, t - self.knots_t[k]
+
+    def _rates(self, k: Array, tau: Array) -> tuple[Array, Array]:
+        """The speed and the acceleration at ``tau`` into the intervals ``k``."""
+        j, a = self.jerk[k], self.knots_a[k]
+        return self.knots_v[k] + tau * (a + tau * j / 2), a + tau * j
+
+    def _evaluate(self, t: Array) -> Array:
+        k, tau = self._interval(t)
         j, a, v = self.jerk[k], self.knots_a[k], self.knots_v[k]
         s = self.knots_s[k] + tau * (v + tau * (a / 2 + tau * j / 6))
-        return np.stack([s, v + tau * (a + tau * j / 2), a + tau * j, j])
+        return np.stack([s, *self._rates(k, tau), j])

@@ -156,6 +156,17 @@ def local(h: Array, k: Array, theta: Array, gs: Array, gw: Array, ga: Array, gj:
     return C, sizes
 
 
+def _second_values(vals: Array, m: int, al: Array, w: Array, T: Array, phmax: float
+                   ) -> tuple[Array, Array]:
+    """The second-order rows' values (n, m) and their normalisations from their columns
+    ``vals`` (n, 4 m + ...) at points of the states ``al, w`` and durations ``T`` (n,):
+    ``(pu alpha + px w^2 - ph T^2) / c``, ``c = max(|ph|, floor) T^2``."""
+    pu, px, ph = vals[:, :m], vals[:, m:2 * m], vals[:, 2 * m:3 * m]
+    a_, w_, T_ = al[:, None], w[:, None], T[:, None]
+    c = np.maximum(np.abs(ph), 1e-9 * phmax + 1e-300) * T_ * T_
+    return np.asarray((pu * a_ + px * w_ * w_ - ph * T_ * T_) / c), np.asarray(c)
+
+
 def _power(kind: str) -> float:
     """How a block of rows' use scales with ``1 / T`` (:meth:`Rows.scaling`)."""
     return {"second-order": 2.0, "cap": 1.0, "w>=0": 0.0}.get(kind, 3.0)
@@ -180,28 +191,28 @@ def _compiled_columns(second: Sequence[Constraint], table: Table
     each constraint's kind (0 a torque limit, 1 the torque-speed envelope, 2 an
     acceleration limit) and limits; None where a constraint is of another class (its own
     ``rows``: a plugin's, or a subclass's)."""
+    def pair(v: object) -> Array:
+        return np.broadcast_to(np.asarray(v, float), (2,))
+
+    co = table.moving
     kinds: list[float] = []
     pars: list[Array] = []
     for c in second:
         if type(c) is TorqueLimit:
             kinds.append(0.0)
-            pars.append(np.concatenate([np.asarray(c.peak, float), np.zeros(4)]))
+            pars.append(np.concatenate([pair(c.peak), np.zeros(4)]))
         elif type(c) is TorqueSpeedEnvelope:
             kinds.append(1.0)
-            pars.append(np.concatenate([np.asarray(x, float) for x in (c.peak, c.max_speed,
-                                                                      c.knee)]))
+            pars.append(np.concatenate([pair(x) for x in (c.peak, c.max_speed, c.knee)]))
         elif type(c) is AccelerationLimit:
             kinds.append(2.0)
-            pars.append(np.concatenate([np.broadcast_to(np.asarray(c.max_acceleration, float),
-                                                        (2,)), np.zeros(4)]))
-        elif type(c) is SpeedLimit or (type(c) is DegeneracyCondition
-                                       and not table.co.conditions):
+            pars.append(np.concatenate([pair(c.max_acceleration), np.zeros(4)]))
+        elif type(c) is SpeedLimit or (type(c) is DegeneracyCondition and not co.conditions):
             continue  # (no rows at the points)
         else:
             return None
     if not kinds:
         return None
-    co = table.moving
     up, down = co.friction_sides
     inner = slice(1, -1)
     pts = np.concatenate([x[inner] for x in (
@@ -346,13 +357,10 @@ class RowModel:
     def _second_F(self, mo: Motion, cols: Array, m: int, phmax: float, k: Array, th: Array
                   ) -> Array:
         """The second-order rows' values (n, m) at offsets ``th`` into the intervals ``k``
-        (n,), by the same operations as :meth:`_block`'s."""
+        (n,), as :meth:`_block` makes them."""
         sig, w, al = mo.at(self.mesh, k, th)
-        vals = interp(self.table.s, cols, sig)[0]
-        pu, px, ph = vals[:, :m], vals[:, m:2 * m], vals[:, 2 * m:3 * m]
-        T = mo.Tk[k][:, None]
-        c = np.maximum(np.abs(ph), 1e-9 * phmax + 1e-300) * T * T
-        return np.asarray((pu * al[:, None] + px * w[:, None] * w[:, None] - ph * T * T) / c)
+        return _second_values(interp(self.table.s, cols, sig)[0], m, al, w, mo.Tk[k],
+                              phmax)[0]
 
     def _block(self, mo: Motion, cols: Array, m: int, phmax: float, k0: int, k1: int
                ) -> Rows:
@@ -370,8 +378,7 @@ class RowModel:
         pu, px, ph = vals[:, :m], vals[:, m:2 * m], vals[:, 2 * m:3 * m]
         dpu, dpx, dph = slopes[:, :m], slopes[:, m:2 * m], slopes[:, 2 * m:3 * m]
         a_, w_, T = al[:, None], w[:, None], mo.Tk[k][:, None]
-        c = np.maximum(np.abs(ph), 1e-9 * phmax + 1e-300) * T * T
-        F = (pu * a_ + px * w_ * w_ - ph * T * T) / c
+        F, c = _second_values(vals, m, al, w, mo.Tk[k], phmax)
         zero = np.zeros(len(kk))
 
         def flat(v: Array) -> Array:

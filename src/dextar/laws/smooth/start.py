@@ -270,15 +270,6 @@ IDLE_ACCEL = 0.05
 IDLE_SPAN = 0.03
 
 
-def _speed_and_acceleration(law: JerkLimitedLaw, t: Array) -> tuple[Array, Array]:
-    """The law's speed and acceleration at the times ``t`` (within its duration): the same
-    operations as its ``evaluate``'s, without the arc length and the jerk."""
-    k = np.clip(np.searchsorted(law.knots_t, t, side="right") - 1, 0, law.jerk.size - 1)
-    tau = t - law.knots_t[k]
-    j, a = law.jerk[k], law.knots_a[k]
-    return law.knots_v[k] + tau * (a + tau * j / 2), a + tau * j
-
-
 def without_idle(law: Law, n: int = 4001, always: bool = False) -> Start | None:
     """The law sampled on ``n`` times with its idle spans cut out (the motion before and
     after each span joined: the states there differ by the little it moves while idle), as
@@ -289,7 +280,7 @@ def without_idle(law: Law, n: int = 4001, always: bool = False) -> Start | None:
     if always or not isinstance(law, JerkLimitedLaw):
         s, v, a = law.evaluate(t)[:3]
     else:  # (the arc length only for a start: its speed and acceleration, as evaluate's)
-        v, a = _speed_and_acceleration(law, t)
+        v, a = law.speed_and_acceleration(t)
     still = (np.abs(v) <= IDLE_SPEED * np.abs(v).max()) & \
         (np.abs(a) <= IDLE_ACCEL * np.abs(a).max())
     # runs of still samples, long enough

@@ -63,6 +63,12 @@ class Table:
 #: much), in at most :data:`TABLE_ROUNDS` rounds.
 TABLE_TOL = 2e-4
 TABLE_ROUNDS = 4
+#: A segment shorter than this fraction of the path's length is not refined: its
+#: interpolation's miss (the square of its length times the columns' curvature) is below
+#: rounding, and :func:`middle_miss`'s slope form divides the rounding of its ends' values
+#: by its length (a grid given with two points 1e-13 of the path apart had been split into
+#: thousands of points, some of them equal).
+SHORT = 1e-9
 #: The step of the derivatives along the path (a fraction of the path's length): a central
 #: difference of the dynamics' own coefficients, or one-sided at a joint (truncation about
 #: the step times the next derivative, far below the interpolation's).
@@ -86,8 +92,11 @@ def make_table(dynamics: PathDynamics, s: Array) -> Table:
     for _ in range(TABLE_ROUNDS):
         co, lo, hi, joint = _columns(s, *_coefficients(dynamics, s, length))
         scale = np.abs(np.concatenate([lo, hi])).max(axis=0) + 1e-300
-        err = (np.abs(middle_miss(np.diff(s), lo, hi)) / scale).max(axis=1)
-        bad = err > TABLE_TOL
+        h = np.diff(s)
+        err = (np.abs(middle_miss(h, lo, hi)) / scale).max(axis=1)
+        # (a segment shorter than SHORT of the path misses by the square of its length: its
+        # estimate is the rounding of its ends' values over its length)
+        bad = (err > TABLE_TOL) & (h > SHORT * length)
         if not bad.any():
             break
         pieces = np.where(bad, np.clip(np.ceil(np.sqrt(err / TABLE_TOL)), 2, 8), 1)
@@ -104,9 +113,11 @@ def middle_miss(h: Array, lo: Array, hi: Array) -> Array:
     ``d`` the miss is the cubic's through both ends' values and slopes, ``h (d0 - d1) / 8``,
     and for a slope ``d`` of ``f`` the quartic's (with the middle's value, which drops out),
     ``3 ((f1 - f0) - h (d0 + d1) / 2) / (2 h)``: both to order ``h^4``. Measured on 80
-    blended corners against the dynamics at the quarter points: the table's largest miss
-    2.01e-4 of a column's largest (2.00e-4 from the middles' own values, which cost twice
-    the model's evaluations), the same number of points."""
+    blended corners against the dynamics at the segments' quarters and middles: the
+    table's largest miss 2.01e-4 of a column's largest (2.00e-4 from the middles' own
+    values, which cost twice the model's evaluations), the same number of points. Over a
+    very short segment (below :data:`SHORT` of the path) the slope form is rounding: not
+    used (:func:`make_table`)."""
     hh = h[:, None]
     out = np.empty_like(lo)
     out[:, _VALUES] = hh * (lo[:, _THEIR_SLOPES] - hi[:, _THEIR_SLOPES]) / 8
