@@ -3,9 +3,10 @@
  * intervals' middles and quarters, the speed cap, w >= 0, and the joint jerk and
  * torque-rate rows at every interval's start, middle and end, with their gradients in the
  * programme's variables) and the second-order rows' columns at the table's points (the
- * built-in constraints' point_rows) each in one call, each value by the same operations in the same order as the numpy
- * code (the same bits where the C library's pow and cosh are numpy's), without its few
- * hundred array operations per call: on a short move those cost more than the arithmetic.
+ * built-in constraints' point_rows), each in one call, each value by the same operations
+ * in the same order as the numpy code (the same bits where the C library's pow and cosh
+ * are numpy's), without its few hundred array operations per call: on a short move those
+ * cost more than the arithmetic.
  *
  * Built by `pip install` when a C compiler is there (an optional extension: without one,
  * dextar builds the rows with numpy).
@@ -130,8 +131,6 @@ static void state_at(const Motion *mo, Py_ssize_t k, double th, double *sig, dou
     *al = a + th * J;
 }
 
-/* A second-order row's value (row j of the m, its columns in pc: P per table point) at the
- * offset th into interval k, by the same operations as its row */
 /* A second-order point: its state, table segment (s, ds, u, the columns a and b at its
  * ends) and its interval's duration */
 typedef struct {
@@ -332,19 +331,16 @@ static PyObject *block(PyObject *self, PyObject *args)
             for (int pass = 0; pass < 2; pass++) {
                 Py_ssize_t ka = pass == 0 ? (k0 > 1 ? k0 : 1) : k0;
                 for (Py_ssize_t k = ka; k < k1; k++) {
-                    double th = offset(pass, mo.h[k]), sig, w, al;
-                    state_at(&mo, k, th, &sig, &w, &al);
+                    double th = offset(pass, mo.h[k]);
+                    Point pt = point_at(&mo, grid, n1, pc, P, k, th);
                     if (kind == 1) {
-                        put(&o, k, -w / S, S, th, mo.h[k], 0.0, neg_inv_S, 0.0, 0.0, 0.0);
+                        put(&o, k, -pt.w / S, S, th, mo.h[k], 0.0, neg_inv_S, 0.0, 0.0, 0.0);
                         continue;
                     }
-                    Py_ssize_t s = segment(grid, n1, sig, 0);
-                    double ds = grid[s + 1] - grid[s];
-                    double u = (np_clip(sig, lo_s, hi_s) - grid[s]) / ds;
-                    double a = pc[s * P + 4 * m], b = pc[(s + 1) * P + 4 * m];
-                    double rv = a + (b - a) * u, rs = (b - a) / ds, T = mo.Tk[k];
+                    double a = pt.a[4 * m], b = pt.b[4 * m], T = pt.T;
+                    double rv = a + (b - a) * pt.u, rs = (b - a) / pt.ds;
                     double c2 = np_max(rv, 1e-300) * T;
-                    put(&o, k, (w - rv * T) / c2, c2, th, mo.h[k], -rs * T / c2, 1.0 / c2,
+                    put(&o, k, (pt.w - rv * T) / c2, c2, th, mo.h[k], -rs * T / c2, 1.0 / c2,
                         0.0, 0.0, -rv / c2);
                 }
             }

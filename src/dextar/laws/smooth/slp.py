@@ -202,19 +202,14 @@ class Programme:
         last motion asked kept: a programme's build and its model ask for the same)."""
         if self._terms is not None and self._terms[0] is mo:
             return self._terms[1]
-        terms = self._end_terms_of(mo)
-        self._terms = (mo, terms)
-        return terms
-
-    def _end_terms_of(self, mo: Motion) -> tuple[Array, Array, Array, Array, Array, Array]:
-        """:meth:`_end_terms`, computed."""
         Tn = knot_T(mo.Tk)
         rho = Tn[:-1] / Tn[1:]
         pin = self.into_pin
         rho = np.where(pin, rho, 1.0)
         cw = np.where(pin, rho * mo.w[1:], 0.0)
         ca = np.where(pin, 2 * rho * rho * mo.alpha[1:], 0.0)
-        return rho, rho * rho, cw, ca, Tn[:-1], Tn[1:]
+        self._terms = (mo, (rho, rho * rho, cw, ca, Tn[:-1], Tn[1:]))
+        return self._terms[1]
 
     def _local(self, C: Array, k: Array, mo: Motion, out: Array | None = None) -> Array:
         """The rows' coefficients (n, 6) on ``sigma_k, w_k, alpha_k, T_k, alpha_k+1,

@@ -277,10 +277,12 @@ def without_idle(law: Law, n: int = 4001, always: bool = False) -> Start | None:
     sampled)."""
     T = float(law.duration)
     t = np.linspace(0.0, T, n)
-    if always or not isinstance(law, JerkLimitedLaw):
+    # (a jerk-limited law's arc length only for a start: its speed and acceleration alone)
+    lazy = law if not always and isinstance(law, JerkLimitedLaw) else None
+    if lazy is not None:
+        v, a = lazy.speed_and_acceleration(t)
+    else:
         s, v, a = law.evaluate(t)[:3]
-    else:  # (the arc length only for a start: its speed and acceleration, as evaluate's)
-        v, a = law.speed_and_acceleration(t)
     still = (np.abs(v) <= IDLE_SPEED * np.abs(v).max()) & \
         (np.abs(a) <= IDLE_ACCEL * np.abs(a).max())
     # runs of still samples, long enough
@@ -289,8 +291,8 @@ def without_idle(law: Law, n: int = 4001, always: bool = False) -> Start | None:
     long = (t[last] - t[first]) >= IDLE_SPAN * T
     if not long.any():
         return Start(t, s, v, a) if always else None
-    if not always and isinstance(law, JerkLimitedLaw):
-        s = law.evaluate(t)[0]
+    if lazy is not None:
+        s = lazy.evaluate(t)[0]
     cut = np.zeros(n - 1, bool)  # the sample pairs whose time is removed
     for i0, i1 in zip(first[long], last[long], strict=True):
         cut[i0:i1] = True
