@@ -208,6 +208,32 @@ def test_a_blended_chain_names_the_move_at_fault(tmp_path, capsys):
     assert "move 2 (line), in the motion blended from move 0" in err, err
 
 
+
+def test_a_blend_longer_than_its_move_is_quoted_in_mm(tmp_path, capsys):
+    """The blends are given in mm: the error quotes them and the move's length in mm and
+    names the move that is too short (the second, 20 mm long, with blends of 12 and 9 mm)."""
+    cfg = tmp_path / "task.toml"
+    cfg.write_text('[motors]\npeak_torque = 3.4\n[program]\nstart = [-40.0, 110.0]\n'
+                   '[[move]]\ntype = "line"\nto = [-40.0, 140.0]\nblend = 12.0\n'
+                   '[[move]]\ntype = "line"\nto = [-20.0, 140.0]\nblend = 9.0\n'
+                   '[[move]]\ntype = "line"\nto = [-20.0, 110.0]\n')
+    assert main(["program", str(cfg), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1, err
+    assert ("move 1 (line), in the motion blended from move 0: its blends of 12 mm at its "
+            "start and 9 mm at its end do not fit its length of 20 mm") in err, err
+    # the first move too short: the chain's name, the one blend cut from its end
+    cfg.write_text(cfg.read_text().replace("blend = 12.0", "blend = 31.0")
+                   .replace("blend = 9.0", "blend = 1.0"))
+    assert main(["program", str(cfg), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert ("move 0 (line), blended with moves 1-2: its blend of 31 mm at its end does not "
+            "fit its length of 30 mm") in err, err
+    # blends that fit plan
+    cfg.write_text(cfg.read_text().replace("blend = 31.0", "blend = 10.0")
+                   .replace("blend = 1.0", "blend = 9.0"))
+    assert main(["program", str(cfg), "--out", str(tmp_path / "o"), "--no-figures"]) == 0
+
 def test_ik_words_units_near_singularities_and_subcommand_help(capsys):
     assert main(["ik", "0", "500"]) == 2
     err = capsys.readouterr().err

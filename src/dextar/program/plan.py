@@ -676,7 +676,7 @@ def _chain_name(group: list[tuple[int, Move]], exc: DextarError) -> str:
     if len(group) == 1:
         return move_name(i, mv)
     member = getattr(exc, "member", None)
-    if isinstance(member, int) and 0 <= member < len(group):
+    if isinstance(member, int) and 0 < member < len(group):  # (the first: the chain's name)
         j, mj = group[member]
         return f"{move_name(j, mj)}, in the motion blended from move {i}"
     last = group[-1][0]
@@ -702,8 +702,10 @@ def _plan_chain(ctx: PlanContext, group: list[tuple[int, Move]], state: PlanStat
         assert kind.path is not None  # a chain holds path moves only (_chains)
         pieces.append(kind.path(mv, P))
         P = _end(mv, pieces[-1])
+    blends = tuple(float(mv.blend) for _, mv in group[:-1])
+    _check_blends_fit(pieces, blends)
     try:
-        path, owner = _blended(tuple(pieces), tuple(float(mv.blend) for _, mv in group[:-1]))
+        path, owner = _blended(tuple(pieces), blends)
     except ParameterError as exc:
         raise ParameterError(f"blend: {exc}") from None
     # the assembly modes the members ask for where they end (the next member's start)
@@ -930,6 +932,25 @@ def _across(ctx: PlanContext, mv: Move, path: Path, mode: str,
         return planned(np.clip(t, 0.0, law.duration))
 
     return law, margins, torques
+
+
+def _check_blends_fit(pieces: list[Path], blends: tuple[float, ...]) -> None:
+    """Each piece of a chain longer than the blends cut from it (the one at its start and
+    the one at its end), or a :class:`ParameterError` marked with the piece (``member``)
+    that quotes them in mm, as the program gives them."""
+    for k, piece in enumerate(pieces):
+        start = blends[k - 1] if k > 0 else 0.0
+        end = blends[k] if k < len(blends) else 0.0
+        if start + end >= piece.length:
+            parts = ([f"{1e3 * start:.6g} mm at its start"] if start > 0 else []) + (
+                [f"{1e3 * end:.6g} mm at its end"] if end > 0 else [])
+            exc = ParameterError(
+                f"its blend{'s' if len(parts) > 1 else ''} of {' and '.join(parts)} "
+                f"{'do' if len(parts) > 1 else 'does'} not fit its length of "
+                f"{1e3 * piece.length:.6g} mm (a blend is cut from the moves on both sides "
+                "of its corner): make the blends shorter")
+            exc.member = k  # type: ignore[attr-defined]  # read back by _chain_name
+            raise exc
 
 
 @functools.lru_cache(maxsize=32)
