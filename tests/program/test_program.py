@@ -352,3 +352,28 @@ def test_shortest_duration_within_the_limits_is_bracketed(T0):
                   lambda T: np.inf if T < 0.9 * T0 else (T0 / T) ** 3):
         T = shortest_within(ratio)
         assert ratio(T) <= 1.0 and T0 <= T <= T0 * (1 + 2e-6), (T0, T)
+
+
+def test_no_speed_ratio_without_a_speed_limit(tmp_path, capsys):
+    """A ratio to a limit the program does not set is left out of the summary and shown as
+    "-" in the report (it was written as 0); with the limit set it is the peak speed over it.
+    The words name every file written: the report and the figures too, unless --no-figures."""
+    cfg = tmp_path / "task.toml"
+    text = ('[motors]\npeak_torque = 3.4\n[program]\nstart = [-40.0, 110.0]\n'
+            '[[move]]\ntype = "line"\nto = [40.0, 110.0]\n')
+    cfg.write_text(text)
+    assert main(["program", str(cfg), "--out", str(tmp_path / "a")]) == 0
+    for m in json.loads((tmp_path / "a" / "summary.json").read_text())["motors"]:
+        assert "peak_speed_ratio" not in m, m
+        assert m["peak_speed_rad_s"] > 1.0
+    assert ("peak speed / maximum speed</td><td>-</td><td>-</td>"
+            in (tmp_path / "a" / "report.html").read_text())
+    wrote = capsys.readouterr().out.splitlines()[-1]
+    assert "report.html" in wrote and "operating_points" in wrote, wrote
+    assert (tmp_path / "a" / "operating_points.svg").is_file()
+    cfg.write_text(text.replace("peak_torque = 3.4\n", "peak_torque = 3.4\nmax_speed_rpm = 300\n"))
+    assert main(["program", str(cfg), "--out", str(tmp_path / "b"), "--no-figures"]) == 0
+    wrote = capsys.readouterr().out.splitlines()[-1]
+    assert "report.html" not in wrote and wrote.endswith("summary.json"), wrote
+    for m in json.loads((tmp_path / "b" / "summary.json").read_text())["motors"]:
+        assert m["peak_speed_ratio"] == pytest.approx(m["peak_speed_rad_s"] / (300 * np.pi / 30))

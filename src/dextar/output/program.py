@@ -106,8 +106,9 @@ class ProgramSummary:
             out["drive"] = self.drive
         return out
 
-    def lines(self, out: str, samples: int) -> list[str]:
-        """The summary in words."""
+    def lines(self, out: str, samples: int, figures: bool = False) -> list[str]:
+        """The summary in words (``figures``: the figures and ``report.html`` were written
+        too)."""
         return [
             f"program: cycle time {self.cycle_time_s:.6g} s, "
             f"{sum(not m.mode_change for m in self.moves)} moves; {self.verdict}",
@@ -132,7 +133,9 @@ class ProgramSummary:
             f"wrote {Path(out) / 'setpoints.csv'} ({samples} setpoints at "
             f"{self.servo_rate_hz:g} Hz{self._angles_note()})"
             + (f", {Path(out) / 'csp.csv'}, {Path(out) / 'pvt.csv'}" if self.drive else "")
-            + f" and {Path(out) / 'summary.json'}"]
+            + (f", {Path(out) / 'summary.json'}, {Path(out) / 'report.html'} and the figures "
+               "(motion, moves, operating_points: .png and .svg)" if figures
+               else f" and {Path(out) / 'summary.json'}")]
 
     def mode_lines(self) -> list[str]:
         """The working modes the planner chose, in words (none without auto)."""

@@ -146,7 +146,8 @@ def sizing(res: ProgramResult) -> Sizing:
             avail = m.available_torque(dq)[:, i]
             ratio = np.abs(tau[:, i]) / np.maximum(avail, 1e-300)
             ratios["peak_torque_ratio"] = float(ratio.max())
-            ratios["peak_speed_ratio"] = float(np.abs(dq[:, i]).max() / m.max_speed[i])
+            if math.isfinite(m.max_speed[i]):  # (no ratio to a limit not set)
+                ratios["peak_speed_ratio"] = float(np.abs(dq[:, i]).max() / m.max_speed[i])
             k = int(np.argmax(ratio))
             if ratio[k] > 1.0 + SIZING_TOL:
                 peak = float(np.asarray(m.peak_torque, float)[i])
