@@ -270,3 +270,13 @@ def test_plan_and_torques_take_units(tmp_path, capsys):
     assert "t_s," in head and "tau1_Nm" in head
     assert main(["plan", "--out", str(tmp_path / "p.csv"), "--units", "paper"]) == 0
     assert (tmp_path / "p.csv").read_text().startswith("t_T,")
+
+
+@pytest.mark.parametrize("name", ["plan", "torques", "simulate", "export", "program", "run",
+                                  "ik"])
+def test_the_commands_that_read_a_task_list_its_tables_in_their_help(name, capsys):
+    """docs/reference/config.rst: the help of the commands that read a task ends with the
+    registered tables, laws and move types (a program's writer needs the move types)."""
+    assert main([name, "--help"]) == 0
+    out = capsys.readouterr().out
+    assert ("[[move]] type:" in out and "time-optimal" in out) == (name != "ik"), out[-300:]

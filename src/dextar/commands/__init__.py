@@ -80,7 +80,7 @@ _BUILTIN = (
      "leaves [control].tolerance_mm, the files written)", True),
     ("export", "export the robot model (mjcf: MuJoCo XML)", True),
     ("program", "plan a robot program under the motors: setpoints and sizing (exit 1 when a "
-     "motor limit is exceeded)", False),
+     "motor limit is exceeded)", True),
     ("excite", "an exciting trajectory for identification (a Fourier series per motor, "
      "regressor condition number minimised, coverage floors checked: a warning below "
      "them) to CSV", False),
