@@ -377,3 +377,37 @@ def test_no_speed_ratio_without_a_speed_limit(tmp_path, capsys):
     assert "report.html" not in wrote and wrote.endswith("summary.json"), wrote
     for m in json.loads((tmp_path / "b" / "summary.json").read_text())["motors"]:
         assert m["peak_speed_ratio"] == pytest.approx(m["peak_speed_rad_s"] / (300 * np.pi / 30))
+
+
+def test_each_move_of_a_blended_chain_has_its_own_singularity_distances():
+    """A chain's moves each report their smallest distances along their own stretch of the
+    path (they all reported the chain's): here the second line reaches out towards the
+    boundary of the workspace, the first stays inside it. Each move's figure lies between
+    the smallest over its own setpoints' poses and the smallest with a setpoint either side
+    (the setpoints, 1 ms apart, straddle where the moves meet), to 2e-3 (the checked poses'
+    spacing; measured: the first move's type-1 figure 0.9324 between 0.9299 and 0.9408)."""
+    from dextar.dynamics import paper_inertia
+    from dextar.geometry import DEXTAR_MM
+    from dextar.kinematics.checker import pose_distances
+    from dextar.motors import MotorLimits
+    from dextar.program import Move, plan_program
+
+    robot = DEXTAR_MM.scaled(1e-3)
+    res = plan_program(robot, paper_inertia(robot).scaled_masses(0.1),
+                       [Move("line", {"to": (0.0, 0.12)}, blend=0.008),
+                        Move("line", {"to": (0.0, 0.15)})], start=(-0.04, 0.11),
+                       working_mode="+-", motors=MotorLimits((2.0, 2.0)))
+    timing = res.timeline()
+    assert [m.blended_with_next for m in timing] == [True, False]
+    own = []
+    for m in timing:
+        at = np.flatnonzero(res.move_index == m.index)
+        d = pose_distances(robot, res.q[at], res.P[at])
+        wide = np.arange(max(at[0] - 1, 0), min(at[-1] + 2, len(res.t)))
+        w = pose_distances(robot, res.q[wide], res.P[wide])
+        own.append((float(d.type1.min()), float(d.type2.min())))
+        for got, lo, hi in ((m.min_type1_distance, w.type1.min(), own[-1][0]),
+                            (m.min_type2_distance, w.type2.min(), own[-1][1])):
+            assert lo - 2e-3 <= got <= hi + 2e-3, (m.index, got, lo, hi)
+    # the two moves' figures differ by far more than that: the check can tell them apart
+    assert own[0][0] - own[1][0] > 0.05 or own[0][1] - own[1][1] > 0.05, own

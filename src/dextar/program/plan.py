@@ -187,6 +187,10 @@ class PlannedMove:
     mode_change : bool
         A joint move the mode planner put before move ``index`` (a path move) to change the
         working mode there (``working_mode = "auto"``, :func:`plan_program`).
+    member_distances : tuple of (float, float)
+        For a blended chain: each move's smallest normalised distances to the singularities
+        (type 1, type 2) along its own stretch of the path (a blend counts with the move it
+        leaves).
     """
 
     index: int
@@ -207,6 +211,7 @@ class PlannedMove:
     torques: Callable[[Array], Array] | None = None
     crossings: tuple[CrossingMargin, ...] = ()
     mode_change: bool = False
+    member_distances: tuple[tuple[float, float], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -224,7 +229,8 @@ class MoveTiming:
     start_s, duration_s : float
     blended_with_next : bool
     min_type1_distance, min_type2_distance : float
-        Of the whole motion the move belongs to.
+        Along the move (a move of a blended chain: along its own stretch of the chain's
+        path).
     working_mode, assembly_mode : str
         The modes the move ends in.
     crossings : tuple of dict
@@ -306,16 +312,17 @@ class ProgramResult:
             law = pm.law
             members = pm.members or ((pm.index, pm.start_s, pm.duration_s),)
             peak = None if self.motors is None else self.motors.peak_torque
-            for idx, start, dur in members:
+            for k, (idx, start, dur) in enumerate(members):
                 mine = tuple(crossing_dict(c, pm.start_s, peak) for c in pm.crossings
                              if start <= pm.start_s + c.t <= start + dur)
+                d1, d2 = (pm.member_distances[k] if pm.member_distances else
+                          (pm.min_type1_distance, pm.min_type2_distance))
                 out.append(MoveTiming(
                     idx, pm.move.type if pm.mode_change or not self.move_types
                     else self.move_types[idx],
                     law.name if law else None, int(law.status) if law else 0,
                     law.message if law else "holding still", start, dur,
-                    bool(pm.members) and idx != pm.members[-1][0], pm.min_type1_distance,
-                    pm.min_type2_distance, pm.mode,
+                    bool(pm.members) and idx != pm.members[-1][0], d1, d2, pm.mode,
                     pm.end_assembly if idx == members[-1][0] else _assembly_at(pm, start + dur),
                     mine, pm.mode_change))
         return out
@@ -736,8 +743,27 @@ def _plan_chain(ctx: PlanContext, group: list[tuple[int, Move]], state: PlanStat
     pm = PlannedMove(group[0][0], first, law, start_s, law.duration, state.q, q1, sample,
                      float(poses.distances.type1.min()), float(poses.distances.type2.min()),
                      owner_of, members, assembly=state.assembly, end_assembly=pp.end_assembly,
-                     mode=state.mode, torques=pp.torques, crossings=pp.crossings)
+                     mode=state.mode, torques=pp.torques, crossings=pp.crossings,
+                     member_distances=_member_distances(poses, owner, len(group)))
     return pm, PlanState(P, q1, state.mode, pp.end_assembly)
+
+
+def _member_distances(poses: CheckedPath, owner: Sequence[int], n: int
+                      ) -> tuple[tuple[float, float], ...]:
+    """Each of a chain's ``n`` moves' smallest distances to the singularities (type 1, type
+    2) over the checked poses on its pieces (``owner``: the move of each of the composite
+    path's pieces, whose parameter runs from ``j`` to ``j + 1`` on piece ``j``), the poses
+    where it meets its neighbours included; a stretch between two poses takes the nearer."""
+    bounds = [owner.index(k) for k in range(n)] + [len(owner)]
+    d1, d2, p = poses.distances.type1, poses.distances.type2, poses.p
+    out = []
+    for k in range(n):
+        on = (p >= bounds[k]) & (p <= bounds[k + 1])
+        if not on.any():  # (a stretch shorter than the poses' spacing)
+            on = np.abs(p - 0.5 * (bounds[k] + bounds[k + 1])) == np.abs(
+                p - 0.5 * (bounds[k] + bounds[k + 1])).min()
+        out.append((float(d1[on].min()), float(d2[on].min())))
+    return tuple(out)
 
 
 def _end(mv: Move, path: Path) -> Array:
