@@ -411,3 +411,32 @@ def test_each_move_of_a_blended_chain_has_its_own_singularity_distances():
             assert lo - 2e-3 <= got <= hi + 2e-3, (m.index, got, lo, hi)
     # the two moves' figures differ by far more than that: the check can tell them apart
     assert own[0][0] - own[1][0] > 0.05 or own[0][1] - own[1][1] > 0.05, own
+
+
+def test_a_key_a_move_type_does_not_know_is_refused_by_name():
+    """Move's values hold its type's keys only: a key there that the type does not read
+    (a blend passed among them, a misspelling) was ignored, the move planned without it."""
+    from dextar.dynamics import paper_inertia
+    from dextar.errors import ParameterError
+    from dextar.geometry import DEXTAR_MM
+    from dextar.motors import MotorLimits
+    from dextar.program import Move, plan_program
+
+    robot = DEXTAR_MM.scaled(1e-3)
+
+    def plan(*moves):
+        return plan_program(robot, paper_inertia(robot).scaled_masses(0.1), list(moves),
+                            start=(-0.04, 0.11), working_mode="+-",
+                            motors=MotorLimits((2.0, 2.0)))
+
+    first = Move("line", {"to": (-0.03, 0.11)})
+    with pytest.raises(ParameterError, match=r"move 1 \(line\): 'blend' is not a key of a "
+                       r"line move; its keys: assembly_mode, to, working_mode \(blend is an "
+                       r"argument of Move itself"):
+        plan(first, Move("line", {"to": (0.0, 0.12), "blend": 0.008}))
+    with pytest.raises(ParameterError, match=r"move 0 \(dwell\): 'to' is not a key"):
+        plan(Move("dwell", {"time": 0.1, "to": (0.0, 0.1)}), first)
+    # the same moves with the keys in their places plan
+    res = plan(Move("line", {"to": (-0.03, 0.11)}, blend=0.004), Move("line", {"to": (0.0, 0.12)}),
+               Move("dwell", {"time": 0.1}))
+    assert [m.blended_with_next for m in res.timeline()] == [True, False, False]

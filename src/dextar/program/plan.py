@@ -509,6 +509,25 @@ def fit_rms(req: ProgramRequest, *, rtol: float = 1e-3) -> ProgramResult:
 
 
 
+#: A move's own arguments, which a caller might put among its type's values.
+_MOVE_ARGUMENTS = ("law", "duration", "law_params", "blend")
+
+
+def _check_keys(moves: Sequence[Move]) -> None:
+    """Every move of a registered type, with none but its type's keys among its values (a
+    key it does not know would be ignored), or a :class:`ParameterError` naming the move and
+    the key."""
+    for i, mv in enumerate(moves):
+        kind = move_type(mv.type, f"move {i}'s type")
+        known = sorted({kind.si_keys.get(k, k) for k in kind.params})
+        unknown = sorted(set(mv.values) - set(known))
+        if unknown:
+            hint = (f" ({unknown[0]} is an argument of Move itself: Move({mv.type!r}, ..., "
+                    f"{unknown[0]}=...))" if unknown[0] in _MOVE_ARGUMENTS else "")
+            raise ParameterError(f"{move_name(i, mv)}: {unknown[0]!r} is not a key of a "
+                                 f"{mv.type} move; its keys: {', '.join(known)}{hint}")
+
+
 def move_name(index: int, mv: Move) -> str:
     """``move 2 (arc)``."""
     return f"move {index} ({mv.type})"
@@ -592,6 +611,7 @@ def plan_program(robot: FiveBar, inertia: Inertia, moves: Sequence[Move], *,
     """
     if not moves:
         raise ParameterError("the program has no move")
+    _check_keys(moves)
     if not (math.isfinite(servo_rate_hz) and servo_rate_hz > 0):
         raise ParameterError(f"servo rate {servo_rate_hz!r} must be positive")
     ctx = PlanContext(robot, inertia, assembly, motors, grid, tolerances)
