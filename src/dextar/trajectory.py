@@ -235,12 +235,12 @@ def check_path(robot: FiveBar, path: Path, *, mode: str = "+-", samples: int = 2
     p = np.linspace(path.p0, path.p1, samples)
     P = path.position(p)
     words = _Words(units)
-    check_reach(robot, P, lambda i: f"the path leaves the workspace at p = {p[i]:.6g}",
-                words.point, words.length)
+    check_reach(robot, P, lambda i: "the path leaves the workspace "
+                + words.along(path, p[i]), words.point, words.length)
     q = inverse_kinematics(robot, P, mode, unwrap=True)
     excused = (crossing_excused(tuple(crossings), path.arc_length(p), tolerances)
                if crossings else None)
-    d = check_poses(robot, q, P, tolerances=tolerances, where=lambda i: f"at p = {p[i]:.6g}",
+    d = check_poses(robot, q, P, tolerances=tolerances, where=lambda i: words.along(path, p[i]),
                     point=words.point, mode=mode, excused=excused)
     return CheckedPath(p, P, q, d)
 
@@ -305,8 +305,8 @@ def find_crossings(robot: FiveBar, path: Path, *, mode: str = "+-", samples: int
     words = _Words(units)
     p = np.linspace(path.p0, path.p1, samples)
     P = path.position(p)
-    check_reach(robot, P, lambda i: f"the path leaves the workspace at p = {p[i]:.6g}",
-                words.point, words.length)
+    check_reach(robot, P, lambda i: "the path leaves the workspace "
+                + words.along(path, p[i]), words.point, words.length)
 
     def indicator(pp: Array) -> Array:
         PP = path.position(pp)
@@ -341,8 +341,8 @@ def find_crossings(robot: FiveBar, path: Path, *, mode: str = "+-", samples: int
         qk = inverse_kinematics(robot, Pk, mode)
         if not abs(slope) * reach >= MIN_CROSSING_SLOPE:
             raise SingularityError(
-                f"at p = {pk:.6g}: the path meets the parallel (type 2) singularity curve at "
-                f"P = {words.point(Pk)} in working mode {mode} without crossing it "
+                f"{words.along(path, pk)}: the path meets the parallel (type 2) singularity "
+                f"curve at P = {words.point(Pk)} in working mode {mode} without crossing it "
                 f"transversally (the normalised distance changes by {abs(slope) * reach:.3g} "
                 f"per reach, below {MIN_CROSSING_SLOPE:g}): no motion passes it with bounded "
                 "torques")
@@ -385,6 +385,14 @@ class _Words:
 
     def length(self, x: float) -> str:
         return f"{x:.6g}" if self.units is None else f"{self.units.mm(x):.6g} mm"
+
+    def along(self, path: Path, p: float) -> str:
+        """Where the parameter ``p`` is on ``path``: at its arc length from the start in mm
+        (at the parameter itself in run units)."""
+        if self.units is None:
+            return f"at p = {p:.6g}"
+        s = float(path.arc_length(np.array([p]))[0])
+        return f"at {self.units.mm(s):.6g} mm along the path"
 
 
 @dataclass(frozen=True)

@@ -206,6 +206,11 @@ def test_a_blended_chain_names_the_move_at_fault(tmp_path, capsys):
     assert main(["program", str(cfg), "--out", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err
     assert "move 2 (line), in the motion blended from move 0" in err, err
+    # where, in the program's units: the arc length along the motion's path (out of reach
+    # at y = 156.4 mm: 10 + 41.2 + 26.4 mm along the lines, the blends' shortcuts a little
+    # less: 75.95 mm)
+    at = re.search(r"leaves the workspace at ([\d.]+) mm along the path: point \(0, ", err)
+    assert at and 74.0 < float(at.group(1)) < 77.6, err
 
 
 
