@@ -40,5 +40,5 @@ def run(args: argparse.Namespace) -> Result:
     warnings = note_lines("program", sc)
     warnings += [f"dextar program: {v.text()}" for v in summary.sizing.violations]
     warnings += [f"dextar program: warning: {n}" for n in job.warnings]
-    return Result(summary.as_json(), "\n".join(summary.lines(args.out, res.t.size, args.figures)), warnings,
-                  code=0 if job.fits else 1)
+    words = summary.lines(args.out, res.t.size, args.figures)
+    return Result(summary.as_json(), "\n".join(words), warnings, code=0 if job.fits else 1)

@@ -508,7 +508,6 @@ def fit_rms(req: ProgramRequest, *, rtol: float = 1e-3) -> ProgramResult:
                                           r, plans))
 
 
-
 #: A move's own arguments, which a caller might put among its type's values.
 _MOVE_ARGUMENTS = ("law", "duration", "law_params", "blend")
 
