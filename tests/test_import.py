@@ -107,9 +107,9 @@ def test_the_command_line_and_its_parser_load_no_scipy_matplotlib_or_stages():
     # (dextar._lazy; start-up time: benchmarks/bench_start.py)
     assert _loaded("import dextar.cli") == []
     # each probe below in a fresh interpreter after `import dextar.cli` (forked: _loaded_after)
-    light = ("ik", "fk", "calibrate", "poses", "identify", "design")
-    registries = ("plan", "torques", "simulate", "export", "run", "program", "excite",
-                  "workspace")
+    light = ("ik", "fk", "calibrate", "poses", "identify")
+    registries = ("plan", "torques", "simulate", "export", "run", "program", "design",
+                  "excite", "workspace")
     codes = ["dextar.cli.build_parser('')", "dextar.cli.main(['--help'])",
              *(f"dextar.cli.main([{name!r}, '--help'])" for name in (*light, *registries))]
     found = dict(zip(["parser", "--help", *light, *registries],
@@ -117,7 +117,7 @@ def test_the_command_line_and_its_parser_load_no_scipy_matplotlib_or_stages():
     assert found["parser"] == [] and found["--help"] == []
     for name in light:
         assert found[name] == [], name
-    # plan, torques, export, program and run list the registered laws and paths: the
+    # plan, torques, export, program, design and run list the registered laws and paths: the
     # registries load, not the solvers or the plotting behind them
     for name in registries:
         loaded = set(found[name])

@@ -387,12 +387,13 @@ class _Words:
         return f"{x:.6g}" if self.units is None else f"{self.units.mm(x):.6g} mm"
 
     def along(self, path: Path, p: float) -> str:
-        """Where the parameter ``p`` is on ``path``: at its arc length from the start in mm
-        (at the parameter itself in run units)."""
+        """Where the parameter ``p`` is on ``path``: at its arc length from the path's start
+        in mm (a blended chain's from the start of its first move; at the parameter itself in
+        run units)."""
         if self.units is None:
             return f"at p = {p:.6g}"
         s = float(path.arc_length(np.array([p]))[0])
-        return f"at {self.units.mm(s):.6g} mm along the path"
+        return f"at {self.units.mm(s):.6g} mm along the path (from the start of the motion)"
 
 
 @dataclass(frozen=True)

@@ -105,7 +105,8 @@ def test_export_loads_in_mujoco(tmp_path):
     ('[inertia]\nproximal_mass = [0.1, 0.2, 0.3]\n', "[inertia].proximal_mass"),
     ('[output]\nunits = "imperial"\n', "[output].units"),
     ('[output]\nfigures = ["fig99"]\n', "fig99"),
-    ('[path]\nradius = 200.0\n', "leaves the workspace at 0 mm along the path: point (200, 0) mm"),
+    ('[path]\nradius = 200.0\n',
+     "leaves the workspace at 0 mm along the path (from the start of the motion): point (200, 0) mm"),
     ('[gravity]\nvector = 9.81\n', "[gravity].vector"),
     ('[control]\nnatural_frequency_hz = 0\n', "natural_frequency_hz"),
 ])

@@ -206,10 +206,11 @@ def test_a_blended_chain_names_the_move_at_fault(tmp_path, capsys):
     assert main(["program", str(cfg), "--out", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err
     assert "move 2 (line), in the motion blended from move 0" in err, err
-    # where, in the program's units: the arc length along the motion's path (out of reach
-    # at y = 156.4 mm: 10 + 41.2 + 26.4 mm along the lines, the blends' shortcuts a little
-    # less: 75.95 mm)
-    at = re.search(r"leaves the workspace at ([\d.]+) mm along the path: point \(0, ", err)
+    # where, in the program's units: the arc length along the motion's path, from the start
+    # of the chain's first move, as the message says (out of reach at y = 156.4 mm: 10 +
+    # 41.2 + 26.4 mm along the lines, the blends' shortcuts a little less: 75.95 mm)
+    at = re.search(r"leaves the workspace at ([\d.]+) mm along the path \(from the start of "
+                   r"the motion\): point \(0, ", err)
     assert at and 74.0 < float(at.group(1)) < 77.6, err
 
 
@@ -234,6 +235,18 @@ def test_a_blend_longer_than_its_move_is_quoted_in_mm(tmp_path, capsys):
     err = capsys.readouterr().err
     assert ("move 0 (line), blended with moves 1-2: its blend of 31 mm at its end does not "
             "fit its length of 30 mm") in err, err
+    # blends that add up to the move's length exactly (20 mm: 15 + 5) do not fit either
+    # (here the metres' rounding had let them pass the check, and the path's trimming then
+    # failed with "line start and end must differ", naming the chain's first move)
+    exact = tmp_path / "exact.toml"
+    exact.write_text('[motors]\npeak_torque = 3.4\n[program]\nstart = [38.0, 76.0]\n'
+                     '[[move]]\ntype = "line"\nto = [38.0, 106.0]\nblend = 15.0\n'
+                     '[[move]]\ntype = "line"\nto = [58.0, 106.0]\nblend = 5.0\n'
+                     '[[move]]\ntype = "line"\nto = [58.0, 136.0]\n')
+    assert main(["program", str(exact), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert ("move 1 (line), in the motion blended from move 0: its blends of 15 mm at its "
+            "start and 5 mm at its end do not fit its length of 20 mm") in err, err
     # blends that fit plan
     cfg.write_text(cfg.read_text().replace("blend = 31.0", "blend = 10.0")
                    .replace("blend = 1.0", "blend = 9.0"))
@@ -277,8 +290,8 @@ def test_plan_and_torques_take_units(tmp_path, capsys):
     assert (tmp_path / "p.csv").read_text().startswith("t_T,")
 
 
-@pytest.mark.parametrize("name", ["plan", "torques", "simulate", "export", "program", "run",
-                                  "ik"])
+@pytest.mark.parametrize("name", ["plan", "torques", "simulate", "export", "program",
+                                  "design", "run", "ik"])
 def test_the_commands_that_read_a_task_list_its_tables_in_their_help(name, capsys):
     """docs/reference/config.rst: the help of the commands that read a task ends with the
     registered tables, laws and move types (a program's writer needs the move types)."""

@@ -436,6 +436,10 @@ def test_a_key_a_move_type_does_not_know_is_refused_by_name():
         plan(first, Move("line", {"to": (0.0, 0.12), "blend": 0.008}))
     with pytest.raises(ParameterError, match=r"move 0 \(dwell\): 'to' is not a key"):
         plan(Move("dwell", {"time": 0.1, "to": (0.0, 0.1)}), first)
+    # the config's name of a key whose SI value a Move holds under another
+    with pytest.raises(ParameterError, match=r"'to_deg' is not a key of a joint move; its "
+                       r"keys: .*to_q.* \(to_deg is the config's key; a Move takes to_q, in SI\)"):
+        plan(Move("joint", {"to_deg": (60.0, 120.0)}))
     # the same moves with the keys in their places plan
     res = plan(Move("line", {"to": (-0.03, 0.11)}, blend=0.004), Move("line", {"to": (0.0, 0.12)}),
                Move("dwell", {"time": 0.1}))

@@ -92,7 +92,7 @@ _BUILTIN = (
      "identified lengths, encoder offsets and instrument frame (exit 1 when the fit does not "
      "fit)", False),
     ("design", "sweep five-bar geometries for a task on Dask: designs, Pareto front, the "
-     "chosen robot", False),
+     "chosen robot", True),
     ("run", "reproduce the paper end to end and write a report (exit 1 when a physics check "
      "fails, the files written)", True),
 )

@@ -30,10 +30,11 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 
+#: A program's figures (each as PNG and SVG).
+FIGURES = ("moves", "motion", "operating_points")
 #: Every file a program may write (``csp.csv`` and ``pvt.csv`` with a ``[drive]`` table).
 PROGRAM_FILES = ("setpoints.csv", "summary.json", "report.html", "csp.csv", "pvt.csv",
-                 *(f"{n}.{e}" for n in ("moves", "motion", "operating_points")
-                   for e in ("png", "svg")))
+                 *(f"{n}.{e}" for n in FIGURES for e in ("png", "svg")))
 #: What the units of a program's outputs are.
 UNITS = "SI: s, rad, N m, W, J; positions in mm in setpoints.csv"
 #: What the joint angles of ``setpoints.csv`` are.
@@ -134,7 +135,7 @@ class ProgramSummary:
             f"{self.servo_rate_hz:g} Hz{self._angles_note()})"
             + (f", {Path(out) / 'csp.csv'}, {Path(out) / 'pvt.csv'}" if self.drive else "")
             + (f", {Path(out) / 'summary.json'}, {Path(out) / 'report.html'} and the figures "
-               "(motion, moves, operating_points: .png and .svg)" if figures
+               f"({', '.join(FIGURES)}: .png and .svg)" if figures
                else f" and {Path(out) / 'summary.json'}")]
 
     def mode_lines(self) -> list[str]:
@@ -230,9 +231,9 @@ def _figures(res: ProgramResult, summary: ProgramSummary, robot_mm: FiveBar, mod
              ) -> dict[str, tuple[bytes, bytes]]:
     """Each figure's PNG and SVG, drawn on two cores where there are two
     (:mod:`dextar.output.parallel`)."""
-    makers: dict[str, Callable[[], Figure]] = {
-        "moves": lambda: moves_figure(res, robot_mm, mode), "motion": lambda: motion_figure(res),
-        "operating_points": lambda: operating_points_figure(res, summary.sizing)}
+    makers: dict[str, Callable[[], Figure]] = dict(zip(FIGURES, (
+        lambda: moves_figure(res, robot_mm, mode), lambda: motion_figure(res),
+        lambda: operating_points_figure(res, summary.sizing)), strict=True))
 
     def files(name: str) -> tuple[bytes, bytes]:
         fig = makers[name]()

@@ -521,10 +521,13 @@ def _check_keys(moves: Sequence[Move]) -> None:
         known = sorted({kind.si_keys.get(k, k) for k in kind.params})
         unknown = sorted(set(mv.values) - set(known))
         if unknown:
-            hint = (f" ({unknown[0]} is an argument of Move itself: Move({mv.type!r}, ..., "
-                    f"{unknown[0]}=...))" if unknown[0] in _MOVE_ARGUMENTS else "")
-            raise ParameterError(f"{move_name(i, mv)}: {unknown[0]!r} is not a key of a "
-                                 f"{mv.type} move; its keys: {', '.join(known)}{hint}")
+            key = unknown[0]
+            hint = (f" ({key} is an argument of Move itself: Move({mv.type!r}, ..., {key}=...))"
+                    if key in _MOVE_ARGUMENTS else
+                    f" ({key} is the config's key; a Move takes {kind.si_keys[key]}, in SI)"
+                    if key in kind.si_keys else "")
+            raise ParameterError(f"{move_name(i, mv)}: {key!r} is not a key of a {mv.type} "
+                                 f"move; its keys: {', '.join(known)}{hint}")
 
 
 def move_name(index: int, mv: Move) -> str:
@@ -986,7 +989,7 @@ def _check_blends_fit(pieces: list[Path], blends: tuple[float, ...]) -> None:
     for k, piece in enumerate(pieces):
         start = blends[k - 1] if k > 0 else 0.0
         end = blends[k] if k < len(blends) else 0.0
-        if start + end >= piece.length:
+        if start + end >= piece.length * (1.0 - 1e-9):  # (blended trims in rounding)
             parts = ([f"{1e3 * start:.6g} mm at its start"] if start > 0 else []) + (
                 [f"{1e3 * end:.6g} mm at its end"] if end > 0 else [])
             exc = ParameterError(
