@@ -229,3 +229,85 @@ def test_the_moves_figure_draws_each_working_mode_it_runs_in(setup):
     titles = [ax.get_title() for ax in fig.axes]
     assert [t for t in titles if t.startswith("the moves in")] == [
         f"the moves in working mode {m}" for m in visited]
+
+
+#: A new user's program (a trial's): down a line, a dwell, back up it, across, down, a dwell
+#: and an arc over the top; its map's legend at the lower right hid move 5's number and the
+#: numbers of moves 0 and 2 touched.
+TRIAL = """[robot]
+l1 = 150.0
+l2 = 150.0
+L1 = 200.0
+L2 = 200.0
+d = 120.0
+working_mode = "+-"
+[inertia]
+effector_mass = 0.2
+payload = 0.5
+[gravity]
+vector = [0.0, -9810.0]
+[motors]
+peak_torque = 4.0
+max_jerk = 2000.0
+[program]
+start = [-70.0, 230.0]
+[[move]]
+type = "line"
+to = [-70.0, 180.0]
+[[move]]
+type = "dwell"
+time = 0.15
+[[move]]
+type = "line"
+to = [-70.0, 230.0]
+blend = 10.0
+[[move]]
+type = "line"
+to = [70.0, 230.0]
+blend = 10.0
+[[move]]
+type = "line"
+to = [70.0, 180.0]
+[[move]]
+type = "dwell"
+time = 0.15
+[[move]]
+type = "arc"
+via = [0.0, 280.0]
+to = [-70.0, 230.0]
+"""
+
+
+@pytest.mark.slow
+def test_the_moves_figure_legend_covers_no_map_and_numbers_do_not_touch(setup, tmp_path):
+    """One legend for the figure, below the maps (each map's own legend, at its lower right,
+    had hidden a move's number, and in a grid of maps it ran into the next row's title), and
+    no two moves' numbers touch (a move back up a line it came down had its number 4 pixels
+    from the first's): drawn, and measured in the figure's pixels."""
+    from matplotlib.text import Annotation
+
+    from dextar.config import load_scenario
+    from dextar.output.program import moves_figure
+
+    grid = plan(setup, ACROSS, PLACE, AUTO)
+    (tmp_path / "trial.toml").write_text(TRIAL)
+    sc = load_scenario(tmp_path / "trial.toml")
+    one = sc.program_request().plan()
+    for res, robot, mode in ((grid, setup["robot"].scaled(1e3), grid.mode_choice.start_mode),
+                             (one, sc.robot_mm, sc.program_mode)):
+        fig = moves_figure(res, robot, mode)
+        fig.canvas.draw()
+        renderer = fig.canvas.get_renderer()
+        assert len(fig.legends) == 1 and all(ax.get_legend() is None for ax in fig.axes)
+        box = fig.legends[0].get_window_extent(renderer)
+        for ax in fig.axes:
+            assert not box.overlaps(ax.get_tightbbox(renderer)), ax.get_title()
+        for ax in fig.axes:
+            # each number's circle with 3 pixels around it (numbers 4 pixels apart, as moves
+            # 0 and 2 here were with the old gap, read as touching; now 12.6 pixels at least)
+            marks = [a.get_bbox_patch().get_window_extent(renderer).padded(3) for a in ax.texts
+                     if isinstance(a, Annotation)]
+            assert marks or not ax.get_title().startswith(("Program", "the moves"))
+            for i, a in enumerate(marks):
+                for b in marks[i + 1:]:
+                    assert not a.overlaps(b), (ax.get_title(), a, b)

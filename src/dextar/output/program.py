@@ -309,7 +309,6 @@ def moves_figure(res: ProgramResult, robot_mm: FiveBar, mode: str) -> Figure:
         if len(changes):
             ax.plot(changes[:, 0], changes[:, 1], "D", color="black", mec="white", ms=8,
                     label="working-mode change")
-            ax.legend(loc="lower right", fontsize=8)
         ax.set_xlim(lo[0], hi[0])
         ax.set_ylim(lo[1], hi[1])
         _number_moves(ax, res, inside if n > 1 else np.ones(len(res.t), bool), span)
@@ -319,7 +318,24 @@ def moves_figure(res: ProgramResult, robot_mm: FiveBar, mode: str) -> Figure:
             ax.set_title(f"the moves in working mode {m}", fontsize=10)
     if n > 1:
         fig.suptitle(f"{title}, in {n} working modes (start: {mode})", fontsize=11)
+    # one legend below the maps, where it covers no move (a move's number at a map's lower
+    # right had been hidden under the map's own legend)
+    entries: dict[str, Any] = {}
+    for ax in axes[:n]:
+        for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
+            entries.setdefault(label, handle)
+        if ax.get_legend() is not None:
+            ax.get_legend().remove()
+    fig.subplots_adjust(bottom=1.05 / fig.get_figheight())
+    fig.legend(list(entries.values()), list(entries), loc="lower center", ncol=3, fontsize=8,
+               frameon=False)
     return fig
+
+
+#: Two moves' numbers closer than this fraction of the moves' extent would touch (the
+#: map spans 1.7 times it; a number's circle is about a twentieth of the map): the second
+#: is moved aside.
+LABEL_GAP = 0.1
 
 
 def _number_moves(ax: Any, res: ProgramResult, inside: Array, span: float) -> None:
@@ -330,7 +346,7 @@ def _number_moves(ax: Any, res: ProgramResult, inside: Array, span: float) -> No
         at = P[len(P) // 2]
         # a label that would sit on another's (a move back over the same segment, a dwell
         # at a move's end) is moved aside, with a leader line to its move
-        near = sum(bool(np.hypot(*(at - p)) < 0.06 * span) for p in placed)
+        near = sum(bool(np.hypot(*(at - p)) < LABEL_GAP * span) for p in placed)
         placed.append(at)
         ax.annotate(str(int(index)), at, xytext=(14 * near, 12 * near),
                     textcoords="offset points", fontsize=8, color="white",
