@@ -88,3 +88,23 @@ def test_a_path_across_the_parallel_singularity_curve_passes_only_where_planned(
     moved = replace(crossings[0], s=crossings[0].s * 0.5)
     with pytest.raises(SingularityError, match="parallel"):
         check_path(case.robot, case.path, mode="+-", crossings=(moved,))
+
+
+def test_a_paths_dynamics_names_the_place_by_its_arc_length():
+    """The path's dynamics sample it with a unit-speed law, whose times are arc lengths: an
+    error there said "at t = 0.0972 (sample 216)" for a place 97.2 mm along the path (a new
+    user's trial); it names the arc length (in mm with SI words)."""
+    from dextar.dynamics import RobotAlongPath, paper_inertia
+    from dextar.dynamics.exact import Model
+    from dextar.geometry import DEXTAR_MM
+    from dextar.units import SI
+
+    robot = DEXTAR_MM.scaled(1e-3)
+    line = Line((0.0, 0.12), (0.0, 0.20))  # out of the DexTAR's reach at y = 0.1563 m
+    model = Model(robot, paper_inertia(robot))
+    for units, words in ((SI, r"at (3[\d.]+) mm along the path \(from the start of the "
+                               r"motion\): point \(0, 156\.\d+\) mm"),
+                         (None, r"at s = (0\.03[\d]+) along the path: point \(0, 0\.156")):
+        with pytest.raises(dx.ReachError, match=words) as err:
+            RobotAlongPath(model, line, "+-", units).coefficients(np.linspace(0, 0.08, 801))
+        assert "t =" not in str(err.value)

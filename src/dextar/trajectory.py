@@ -125,7 +125,8 @@ def sample_trajectory(robot: FiveBar, path: Path, law: Law, *, mode: str = "+-",
                       samples: int = 1001, times: Array | None = None,
                       tolerances: Tolerances = DEFAULT_TOLERANCES,
                       units: Units | None = None, checked: bool = True,
-                      crossings: Sequence[Crossing] = ()) -> Trajectory:
+                      crossings: Sequence[Crossing] = (), at_arc_length: bool = False
+                      ) -> Trajectory:
     """Sample ``law`` along ``path`` and map it to joint space in working mode ``mode``.
 
     Parameters
@@ -150,6 +151,9 @@ def sample_trajectory(robot: FiveBar, path: Path, law: Law, *, mode: str = "+-",
     crossings : sequence of Crossing
         The path's crossings of the parallel singularity curve that the motion may make
         (:func:`find_crossings`); the checker refuses any other.
+    at_arc_length : bool
+        The law is at unit speed (its times are arc lengths, as a path's dynamics samples
+        it): an error names the place by its arc length, not by a time.
 
     Returns
     -------
@@ -171,7 +175,7 @@ def sample_trajectory(robot: FiveBar, path: Path, law: Law, *, mode: str = "+-",
     words = _Words(units)
 
     def where(i: int) -> str:
-        return f"at {words.time(t[i])} (sample {i})"
+        return words.arc(t[i]) if at_arc_length else f"at {words.time(t[i])} (sample {i})"
 
     if checked:
         check_reach(robot, P, lambda i: f"the path leaves the workspace {where(i)}",
@@ -392,7 +396,12 @@ class _Words:
         run units)."""
         if self.units is None:
             return f"at p = {p:.6g}"
-        s = float(path.arc_length(np.array([p]))[0])
+        return self.arc(float(path.arc_length(np.array([p]))[0]))
+
+    def arc(self, s: float) -> str:
+        """Where the arc length ``s`` is along a path, from its start."""
+        if self.units is None:
+            return f"at s = {s:.6g} along the path"
         return f"at {self.units.mm(s):.6g} mm along the path (from the start of the motion)"
 
 

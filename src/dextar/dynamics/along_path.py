@@ -52,7 +52,7 @@ class RobotAlongPath:
         # a unit-speed law makes t = s, qdot = q', qddot = q''
         jp = sample_trajectory(self.model.robot, self.path, UniformLaw(S, S), mode=self.mode,
                                times=np.asarray(s, float), units=self.units,
-                               checked=self.checked)
+                               checked=self.checked, at_arc_length=True)
         ine = self.model.inertia
         a, b, g = path_dynamics(self._model(jp.assembly), jp.q, jp.dq, jp.ddq)
         return PathCoefficients(jp.t, jp.P, a, b, g, jp.dq, np.array(ine.coulomb, float),
