@@ -103,3 +103,29 @@ def test_nearly_coincident_spline_waypoints_refused():
     optimal law taking minutes on it): refused by name."""
     with pytest.raises(ParameterError, match="waypoints 1 and 2 coincide"):
         Spline(((0.0, 1.0), (0.5, 1.2), (0.5 + 1e-12, 1.2), (1.0, 1.0)))
+
+
+def test_pieces_that_do_not_meet_are_refused():
+    """A composite path (or a chain to blend) whose piece starts away from where the previous
+    ends was accepted, the gap crossed in no time (a new user's trial: a 10 mm jump, a law
+    "within the limits"): refused, naming the pieces, the points and the gap. Pieces that
+    meet to rounding (an arc's end computed from its angle) are accepted."""
+    from dextar.paths import Composite, blended
+
+    a, b = Line((-0.04, 0.20), (0.0, 0.24)), Line((0.01, 0.24), (0.04, 0.20))
+    with pytest.raises(ParameterError, match=r"pieces 0 and 1 do not meet: piece 0 ends at "
+                       r"\(0, 0\.24\), piece 1 starts at \(0\.01, 0\.24\), 0\.01 apart"):
+        Composite((a, b))
+    with pytest.raises(ParameterError, match="pieces 0 and 1 do not meet"):
+        blended((a, b), (0.005,))
+    # 1e-8 of their lengths apart: refused too (the tolerance is 1e-9 of them)
+    with pytest.raises(ParameterError, match="do not meet"):
+        Composite((a, Line((1e-9, 0.24), (0.04, 0.20))))
+    arc = Arc(0.05, 0.0, np.pi / 3, center=(0.0, 0.2))
+    end = tuple(float(v) for v in arc.position(np.array([arc.p1]))[0])
+    assert np.hypot(end[0] - 0.025, end[1] - (0.2 + 0.05 * np.sin(np.pi / 3))) < 1e-15
+    path = Composite((arc, Line((0.025, 0.2 + 0.05 * np.sin(np.pi / 3)), (0.0, 0.3))))
+    assert path.length == pytest.approx(arc.length + np.hypot(0.025, 0.3 - end[1]))
+    chain, owner = blended((Line((-0.04, 0.20), (0.0, 0.24)), Line((0.0, 0.24), (0.04, 0.20))),
+                           (0.005,))
+    assert list(owner) == [0, 0, 1]

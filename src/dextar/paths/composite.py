@@ -132,6 +132,27 @@ def blend_corner(incoming: Path, outgoing: Path, radius: float) -> tuple[Path, P
     return inc, out, q
 
 
+#: Two pieces meet when the end of one and the start of the next are within this fraction
+#: of their lengths (rounding: the pieces of a program's chain meet exactly or to 1e-16).
+JOIN_TOL = 1e-9
+
+
+def check_joined(pieces: Sequence[Path]) -> None:
+    """Each piece starting where the previous ends (within :data:`JOIN_TOL` of their
+    lengths), or a :class:`ParameterError` naming the two pieces, the points and the gap (a
+    gap would be crossed in no time: a jump of the end-effector)."""
+    for k in range(len(pieces) - 1):
+        a, b = pieces[k], pieces[k + 1]
+        end = np.asarray(a.position(np.array([a.p1])), float).reshape(-1)
+        start = np.asarray(b.position(np.array([b.p0])), float).reshape(-1)
+        gap = float(np.hypot(*(start - end)))
+        if not gap <= JOIN_TOL * (a.length + b.length):
+            raise ParameterError(
+                f"pieces {k} and {k + 1} do not meet: piece {k} ends at ({end[0]:.6g}, "
+                f"{end[1]:.6g}), piece {k + 1} starts at ({start[0]:.6g}, {start[1]:.6g}), "
+                f"{gap:.6g} apart")
+
+
 @dataclass(frozen=True)
 class Composite(Path):
     """Pieces joined end to end; parameter ``k + f`` is the fraction ``f`` of piece ``k``."""
@@ -142,6 +163,7 @@ class Composite(Path):
     def __post_init__(self) -> None:
         if not self.pieces:
             raise ParameterError("a composite path needs pieces")
+        check_joined(self.pieces)
 
     @property
     def p1(self) -> float:  # type: ignore[override]  # derived from the pieces
@@ -250,6 +272,7 @@ def blended(pieces: Sequence[Path], blends: Sequence[float]) -> tuple[Composite,
     """
     if len(blends) != len(pieces) - 1:
         raise ParameterError("one blend per corner")
+    check_joined(pieces)
     cur = list(pieces)
     out: list[Path] = []
     owner: list[int] = []
