@@ -129,3 +129,15 @@ def test_pieces_that_do_not_meet_are_refused():
     chain, owner = blended((Line((-0.04, 0.20), (0.0, 0.24)), Line((0.0, 0.24), (0.04, 0.20))),
                            (0.005,))
     assert list(owner) == [0, 0, 1]
+
+
+def test_a_short_line_is_a_line():
+    """np.allclose's relative tolerance refused a 1 um line 0.22 m from the origin ("start
+    and end must differ": they do); a line is refused only when its ends are equal to
+    rounding, and the message names them."""
+    short = Line((0.0, 0.22), (0.0, 0.220001))
+    assert short.length == pytest.approx(1e-6, rel=1e-9)
+    for end in ((0.0, 0.22), (0.0, 0.22 + 1e-17)):
+        with pytest.raises(ParameterError, match=r"line start \(0, 0\.22\) and end \(0, "
+                           r"0\.22\) must differ"):
+            Line((0.0, 0.22), end)

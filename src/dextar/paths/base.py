@@ -238,8 +238,9 @@ class Line(Path):
         a, b = np.asarray(self.start, float), np.asarray(self.end, float)
         if a.shape != (2,) or b.shape != (2,) or not (np.isfinite(a).all() and np.isfinite(b).all()):
             raise ParameterError("line start and end must be two finite points (x, y)")
-        if np.allclose(a, b):
-            raise ParameterError("line start and end must differ")
+        if not float(np.hypot(*(b - a))) > 1e-12 * float(np.abs(a).sum() + np.abs(b).sum()):
+            raise ParameterError(f"line start ({a[0]:.9g}, {a[1]:.9g}) and end ({b[0]:.9g}, "
+                                 f"{b[1]:.9g}) must differ (by more than their rounding)")
 
     def derivatives(self, p: object) -> tuple[Array, Array, Array, Array]:
         """``r, r', r'', r'''`` at ``p`` (shape (...,)), each of shape (..., 2)."""
