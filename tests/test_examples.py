@@ -21,6 +21,14 @@ def test_quickstart_script_runs(capsys):
     assert "checks passed" in capsys.readouterr().out
 
 
+def test_jerk_limited_script_runs_and_checks_itself(capsys):
+    """The script's own asserts are the checks (jerk within 1 %, torques within 0.1 %, at
+    rest at both ends, power against the kinetic energy's rate); they run here."""
+    runpy.run_path(str(EXAMPLES / "jerk_limited.py"), run_name="__main__")
+    out = capsys.readouterr().out
+    assert "checks passed" in out and "peak jerk / limit" in out
+
+
 @pytest.mark.parametrize("name", [n for n, doc in CONFIGS.items() if "move" not in doc])
 def test_example_configs_plan(name):
     sc = load_scenario(str(EXAMPLES / name))

@@ -28,25 +28,26 @@ from .errors import ParameterError
 
 @dataclass(frozen=True)
 class MotorLimits:
-    """The two motors' limits at the joints (run units): peak torque, maximum speed and,
-    optionally, a torque-speed envelope: full torque up to ``knee_speed``, then linearly
-    down to zero at ``max_speed``.
+    """The two motors' limits at the joints, in the units of the model they limit (with a
+    model in SI, as the Python API's: N m, rad/s, rad/s^2, rad/s^3, N m/s): peak torque,
+    maximum speed and, optionally, a torque-speed envelope: full torque up to
+    ``knee_speed``, then linearly down to zero at ``max_speed``.
 
     Attributes
     ----------
     peak_torque : (float, float)
-        Motor at A, motor at D.
+        Motor at A, motor at D (N m in SI).
     max_speed : (float, float)
-        ``inf`` for none.
+        ``inf`` for none (rad/s in SI).
     knee_speed : (float, float), optional
         Below ``max_speed``; None for no envelope.
     max_acceleration : (float, float), optional
-        Joint accelerations (rad per run time unit squared); None for none.
+        Joint accelerations (rad/s^2 in SI; rad per run time unit squared); None for none.
     max_jerk : (float, float), optional
-        Joint jerks (rad per run time unit cubed); None for none.
+        Joint jerks (rad/s^3 in SI; rad per run time unit cubed); None for none.
     max_torque_rate : (float, float), optional
-        Rates of change of the motor torques (run torque unit per run time unit); None for
-        none.
+        Rates of change of the motor torques (N m/s in SI; run torque unit per run time
+        unit); None for none.
     """
 
     peak_torque: tuple[float, float]
