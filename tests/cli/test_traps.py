@@ -197,12 +197,20 @@ def test_program_figures_and_report_count_and_name_the_moves(pick_place_program)
     assert fig.axes[0].get_title().startswith("Program: 8 moves")
 
 
+def lines_config(start, *moves):
+    """A program of lines (each ``(x, y)`` in mm, or ``(x, y, blend)``) under a 3.4 N m peak
+    torque, from ``start``."""
+    text = f"[motors]\npeak_torque = 3.4\n[program]\nstart = [{start[0]}, {start[1]}]\n"
+    for mv in moves:
+        text += f'[[move]]\ntype = "line"\nto = [{mv[0]}, {mv[1]}]\n'
+        text += f"blend = {mv[2]}\n" if len(mv) > 2 else ""
+    return text
+
+
 def test_a_blended_chain_names_the_move_at_fault(tmp_path, capsys):
     cfg = tmp_path / "task.toml"
-    cfg.write_text('[motors]\npeak_torque = 3.4\n[program]\nstart = [-40.0, 110.0]\n'
-                   '[[move]]\ntype = "line"\nto = [-40.0, 120.0]\nblend = 3.0\n'
-                   '[[move]]\ntype = "line"\nto = [0.0, 130.0]\nblend = 3.0\n'
-                   '[[move]]\ntype = "line"\nto = [0.0, 400.0]\n')
+    cfg.write_text(lines_config((-40.0, 110.0), (-40.0, 120.0, 3.0), (0.0, 130.0, 3.0),
+                                (0.0, 400.0)))
     assert main(["program", str(cfg), "--out", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err
     assert "move 2 (line), in the motion blended from move 0" in err, err
@@ -214,15 +222,12 @@ def test_a_blended_chain_names_the_move_at_fault(tmp_path, capsys):
     assert at and 74.0 < float(at.group(1)) < 77.6, err
 
 
-
 def test_a_blend_longer_than_its_move_is_quoted_in_mm(tmp_path, capsys):
     """The blends are given in mm: the error quotes them and the move's length in mm and
     names the move that is too short (the second, 20 mm long, with blends of 12 and 9 mm)."""
     cfg = tmp_path / "task.toml"
-    cfg.write_text('[motors]\npeak_torque = 3.4\n[program]\nstart = [-40.0, 110.0]\n'
-                   '[[move]]\ntype = "line"\nto = [-40.0, 140.0]\nblend = 12.0\n'
-                   '[[move]]\ntype = "line"\nto = [-20.0, 140.0]\nblend = 9.0\n'
-                   '[[move]]\ntype = "line"\nto = [-20.0, 110.0]\n')
+    cfg.write_text(lines_config((-40.0, 110.0), (-40.0, 140.0, 12.0), (-20.0, 140.0, 9.0),
+                                (-20.0, 110.0)))
     assert main(["program", str(cfg), "--out", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1, err
@@ -239,10 +244,8 @@ def test_a_blend_longer_than_its_move_is_quoted_in_mm(tmp_path, capsys):
     # (here the metres' rounding had let them pass the check, and the path's trimming then
     # failed with "line start and end must differ", naming the chain's first move)
     exact = tmp_path / "exact.toml"
-    exact.write_text('[motors]\npeak_torque = 3.4\n[program]\nstart = [38.0, 76.0]\n'
-                     '[[move]]\ntype = "line"\nto = [38.0, 106.0]\nblend = 15.0\n'
-                     '[[move]]\ntype = "line"\nto = [58.0, 106.0]\nblend = 5.0\n'
-                     '[[move]]\ntype = "line"\nto = [58.0, 136.0]\n')
+    exact.write_text(lines_config((38.0, 76.0), (38.0, 106.0, 15.0), (58.0, 106.0, 5.0),
+                                  (58.0, 136.0)))
     assert main(["program", str(exact), "--out", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err
     assert ("move 1 (line), in the motion blended from move 0: its blends of 15 mm at its "
