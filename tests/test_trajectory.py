@@ -1,3 +1,5 @@
+import re
+
 import numpy as np
 import pytest
 
@@ -108,3 +110,7 @@ def test_a_paths_dynamics_names_the_place_by_its_arc_length():
         with pytest.raises(dx.ReachError, match=words) as err:
             RobotAlongPath(model, line, "+-", units).coefficients(np.linspace(0, 0.08, 801))
         assert "t =" not in str(err.value)
+        # the first sample out of reach: 36.3 mm along (y = 0.1563 m), the samples 0.1 mm
+        # apart
+        at = float(re.search(words, str(err.value)).group(1))
+        assert at * (1e-3 if units is SI else 1.0) == pytest.approx(0.0363, abs=2e-4)

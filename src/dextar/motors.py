@@ -28,8 +28,8 @@ from .errors import ParameterError
 
 @dataclass(frozen=True)
 class MotorLimits:
-    """The two motors' limits at the joints, in the units of the model they limit (with a
-    model in SI, as the Python API's: N m, rad/s, rad/s^2, rad/s^3, N m/s): peak torque,
+    """The two motors' limits at the joints, in the units of the model they limit (N m,
+    rad/s, rad/s^2, rad/s^3 and N m/s with a model in SI): peak torque,
     maximum speed and, optionally, a torque-speed envelope: full torque up to
     ``knee_speed``, then linearly down to zero at ``max_speed``.
 

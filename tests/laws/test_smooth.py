@@ -105,3 +105,22 @@ def test_a_jerk_limit_far_above_the_motions_does_not_slow_it(model):
             k, law.duration / fine.duration - 1, law.message)
         ratios.append(law.ratios["jerk"])
     assert ratios[1] < 1e-3 and ratios[2] < 1e-6 * ratios[1], ratios
+
+
+def test_a_torque_rate_limit_far_above_the_motions_does_not_slow_it_and_a_binding_one_rules(
+        model):
+    """The same with a torque-rate limit far above what the motion needs (1.74 % slower at
+    1e9 N m/s before; measured now 0.19 %); with a jerk limit far above the motion's but a
+    torque-rate limit that binds, no second search (it had doubled the programmes for a law
+    1e-12 shorter)."""
+    path = Line((-0.04, 0.09), (0.04, 0.12))
+    along = RobotAlongPath(model, path, "+-", checked=True)
+    fine = solve_time_optimal_law(along, torque_limit=(0.3, 0.3), grid=4000)
+    loose = solve_jerk_limited_law(along, motors=MotorLimits((0.3, 0.3),
+                                                             max_torque_rate=(1e9, 1e9)))
+    assert loose.success and "second search" in loose.message
+    assert (1 - 1e-3) * fine.duration < loose.duration < 1.003 * fine.duration
+    ruled = solve_jerk_limited_law(along, motors=MotorLimits(
+        (0.3, 0.3), max_jerk=(1e12, 1e12), max_torque_rate=(300.0, 300.0)))
+    assert ruled.success and ruled.ratios["torque_rate"] > 0.99
+    assert "second search" not in ruled.message and ruled.duration > 1.01 * fine.duration

@@ -118,9 +118,18 @@ def test_pieces_that_do_not_meet_are_refused():
         Composite((a, b))
     with pytest.raises(ParameterError, match="pieces 0 and 1 do not meet"):
         blended((a, b), (0.005,))
-    # 1e-8 of their lengths apart: refused too (the tolerance is 1e-9 of them)
-    with pytest.raises(ParameterError, match="do not meet"):
-        Composite((a, Line((1e-9, 0.24), (0.04, 0.20))))
+    # 1.8e-5 of the longer piece's length apart: refused too (the tolerance is 2e-6 of it);
+    # 1.8e-7 of it: they meet
+    with pytest.raises(ParameterError, match=r"do not meet: .* 1e-06 apart \(1\.77e-05 of"):
+        Composite((a, Line((1e-6, 0.24), (0.04, 0.20))))
+    assert Composite((a, Line((1e-8, 0.24), (0.04, 0.20)))).length > 0.1
+    # an arc about a centre ends on its circle, its target 1.6e-7 off it: the next piece,
+    # starting at the target, meets it (a program's blended chain with it had been refused)
+    from dextar.paths.circles import arc_about
+
+    to = (0.0212132, 0.1412132)
+    arc = arc_about(np.array([0.03, 0.12]), np.array([0.0, 0.12]), np.array(to))
+    assert Composite((arc, Line(to, (0.0, 0.15)))).length > arc.length
     arc = Arc(0.05, 0.0, np.pi / 3, center=(0.0, 0.2))
     end = tuple(float(v) for v in arc.position(np.array([arc.p1]))[0])
     assert np.hypot(end[0] - 0.025, end[1] - (0.2 + 0.05 * np.sin(np.pi / 3))) < 1e-15
@@ -131,13 +140,14 @@ def test_pieces_that_do_not_meet_are_refused():
     assert list(owner) == [0, 0, 1]
 
 
-def test_a_short_line_is_a_line():
-    """np.allclose's relative tolerance refused a 1 um line 0.22 m from the origin ("start
-    and end must differ": they do); a line is refused only when its ends are equal to
-    rounding, and the message names them."""
-    short = Line((0.0, 0.22), (0.0, 0.220001))
-    assert short.length == pytest.approx(1e-6, rel=1e-9)
-    for end in ((0.0, 0.22), (0.0, 0.22 + 1e-17)):
-        with pytest.raises(ParameterError, match=r"line start \(0, 0\.22\) and end \(0, "
-                           r"0\.22\) must differ"):
-            Line((0.0, 0.22), end)
+def test_a_line_too_short_to_plan_is_refused_by_its_length():
+    """NumPy's allclose refused a line under about 1e-5 of its coordinates with "start and
+    end must differ" (a new user's trial: they do); the same lines are refused with their
+    length and why (a law along a shorter one took tens of seconds), a longer one is a
+    line."""
+    assert Line((0.0, 0.22), (0.0, 0.22001)).length == pytest.approx(1e-5, rel=1e-9)
+    with pytest.raises(ParameterError, match=r"the line is 1e-06 long, under 1e-05 of the "
+                       r"size of its coordinates \(0\.22\): too short to plan a motion"):
+        Line((0.0, 0.22), (0.0, 0.220001))
+    with pytest.raises(ParameterError, match="line start and end must differ"):
+        Line((0.0, 0.22), (0.0, 0.22))

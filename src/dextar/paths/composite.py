@@ -133,24 +133,27 @@ def blend_corner(incoming: Path, outgoing: Path, radius: float) -> tuple[Path, P
 
 
 #: Two pieces meet when the end of one and the start of the next are within this fraction
-#: of their lengths (rounding: the pieces of a program's chain meet exactly or to 1e-16).
-JOIN_TOL = 1e-9
+#: of their size (the longer piece's length or an arc's radius): an arc about a centre
+#: takes its end point to 1e-6 of its radius off the circle, and ends on the circle, where
+#: the next move starts at the point (the pieces of lines and blends meet to 1e-16).
+JOIN_TOL = 2e-6
 
 
 def check_joined(pieces: Sequence[Path]) -> None:
-    """Each piece starting where the previous ends (within :data:`JOIN_TOL` of their
-    lengths), or a :class:`ParameterError` naming the two pieces, the points and the gap (a
-    gap would be crossed in no time: a jump of the end-effector)."""
+    """Each piece starting where the previous ends (within :data:`JOIN_TOL` of their size),
+    or a :class:`ParameterError` naming the two pieces, the points and the gap (a gap would
+    be crossed in no time: a jump of the end-effector)."""
     for k in range(len(pieces) - 1):
         a, b = pieces[k], pieces[k + 1]
         end = np.asarray(a.position(np.array([a.p1])), float).reshape(-1)
         start = np.asarray(b.position(np.array([b.p0])), float).reshape(-1)
         gap = float(np.hypot(*(start - end)))
-        if not gap <= JOIN_TOL * (a.length + b.length):
+        size = max(a.length, b.length, getattr(a, "radius", 0.0), getattr(b, "radius", 0.0))
+        if not gap <= JOIN_TOL * size:
             raise ParameterError(
-                f"pieces {k} and {k + 1} do not meet: piece {k} ends at ({end[0]:.6g}, "
-                f"{end[1]:.6g}), piece {k + 1} starts at ({start[0]:.6g}, {start[1]:.6g}), "
-                f"{gap:.6g} apart")
+                f"pieces {k} and {k + 1} do not meet: piece {k} ends at ({end[0]:.9g}, "
+                f"{end[1]:.9g}), piece {k + 1} starts at ({start[0]:.9g}, {start[1]:.9g}), "
+                f"{gap:.3g} apart ({gap / size:.3g} of the pieces' size)")
 
 
 @dataclass(frozen=True)

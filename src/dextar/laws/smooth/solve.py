@@ -19,9 +19,7 @@ from ..base import Law
 from ..constraints import (
     AccelerationLimit,
     Constraint,
-    JerkLimit,
     PathDynamics,
-    _pair,
     motor_constraints,
 )
 from ..time_optimal import (
@@ -189,38 +187,43 @@ def solve_jerk_limited_law(dynamics: PathDynamics, *, motors: MotorLimits | None
 def _within_a_tighter_jerk(dynamics: PathDynamics, table: Table, cons: Sequence[Constraint],
                            first: _Search, segments: int, tol: float, rate_tol: float,
                            units: Units | None) -> JerkLimitedLaw:
-    """``first``'s law, or where its jerk stays far below the limit (below
-    :data:`LOOSE_JERK` of it), the faster of it and a second search's within
-    :data:`JERK_MARGIN` times the jerks it used (a law within them is within the limit)."""
+    """``first``'s law, or where its third-order limits (jerk, torque rate) all stay far
+    above what it uses (it uses less than :data:`LOOSE_JERK` of each), the faster of it and
+    a second search's within :data:`JERK_MARGIN` times what it used of each (a law within
+    them is within the limits)."""
     law = first.law
-    jerks = [c for c in cons if isinstance(c, JerkLimit)]
-    used = law.ratios.get("jerk", 1.0)
-    if not jerks or not 0.0 < used < LOOSE_JERK:
+    third = [c for c in cons if c.order == 3]
+    used = {c.kind: law.ratios.get(c.kind, 1.0) for c in third}
+    if not third or not all(0.0 < r < LOOSE_JERK for r in used.values()):
         return law
-    cap = tuple(JerkLimit(_pair(np.asarray(c.max_jerk, float) * JERK_MARGIN * used))
-                for c in jerks)
+    cap = tuple(c.scaled({c.kind: JERK_MARGIN * used[c.kind]}) for c in third)
     try:
         other = _solve(dynamics, table, (*cons, *cap), segments, tol, rate_tol, units)
     except InfeasibleError:  # pragma: no cover - the first search found a motion within it
         return law
-    if other.law.status == 0 and other.law.duration < law.duration:
+    both = first.programmes + other.programmes
+    words = ", ".join(f"{r:.3g} of the {k.replace('_', ' ')} limit" for k, r in used.items())
+    if other.law.status == 0 and other.law.duration < law.duration * (1.0 - GAIN):
         ratio, excess = check(dynamics, cons, other.law, tol, rate_tol)  # the user's alone
         if not np.any(excess > 0):
-            note = (f"; from a second search within {JERK_MARGIN:g} times the jerks of the "
-                    f"first motion ({law.duration:.6g} s, {used:.3g} of the jerk limit)")
-            return _verdict(replace(other.last, ratio=ratio, bad=excess > 0), first.scales,
-                            first.programmes + other.programmes, first.T2, note)
-    return law
+            note = (f"; from a second search within {JERK_MARGIN:g} times what the first "
+                    f"motion used ({law.duration:.6g} s, {words})")
+            return _verdict(replace(other.last, ratio=ratio, bad=excess > 0), other.scales,
+                            both, first.T2, note)
+    return _verdict(first.last, first.scales, both, first.T2,
+                    f"; a second search within {JERK_MARGIN:g} times what it used ({words}) "
+                    f"found no faster motion")
 
 
-#: Where a law's jerk stays below this fraction of the limit, a second search within
-#: :data:`JERK_MARGIN` times its jerks (the faster returned): with a limit far above the
-#: jerks a motion needs, the knots are placed for sharper changes of acceleration than the
-#: motion makes, and the law came out slower the higher the limit (a line with a jerk limit
-#: of 1e7 rad/s^3, 0.71 of it used: 0.017 % above the second-order law; with 1e8, 1e10 and
-#: 1e15: 0.10 %, 1.4 % and 1.6 % above it).
+#: Where a law uses less than this fraction of each of its third-order limits, a second
+#: search within :data:`JERK_MARGIN` times what it used (the faster returned, by more than
+#: :data:`GAIN`): with limits far above what a motion needs, the knots are placed for
+#: sharper changes of acceleration than the motion makes, and the law came out slower the
+#: higher the limit (a line with a jerk limit of 1e7 rad/s^3, 0.71 of it used: 0.017 % above
+#: the second-order law; with 1e8, 1e10 and 1e15: 0.10 %, 1.4 % and 1.6 % above it).
 LOOSE_JERK = 0.1
 JERK_MARGIN = 2.0
+GAIN = 1e-6
 
 
 #: A second search (see :func:`solve_jerk_limited_law`) where the first motion's duration is
