@@ -5,6 +5,7 @@ keeps its mode where that is best."""
 
 import itertools
 import json
+import re
 from dataclasses import replace
 from pathlib import Path
 
@@ -311,3 +312,18 @@ def test_the_moves_figure_legend_covers_no_map_and_numbers_do_not_touch(setup, t
             for i, a in enumerate(marks):
                 for b in marks[i + 1:]:
                     assert not a.overlaps(b), (ax.get_title(), a, b)
+
+
+def test_modes_that_fail_for_one_reason_are_named_together(tmp_path, capsys):
+    """A blend that does not fit its move fails in every working mode the planner tries: the
+    reason is given once, after the modes it holds in (it was repeated for each mode)."""
+    cfg = tmp_path / "task.toml"
+    cfg.write_text('[motors]\npeak_torque = 3.4\n[program]\nworking_mode = "auto"\n'
+                   'start = [-40.0, 110.0]\n'
+                   '[[move]]\ntype = "line"\nto = [-40.0, 120.0]\nblend = 30.0\n'
+                   '[[move]]\ntype = "line"\nto = [0.0, 130.0]\nblend = 30.0\n'
+                   '[[move]]\ntype = "line"\nto = [0.0, 400.0]\n')
+    assert main(["program", str(cfg), "--out", str(tmp_path / "o"), "--no-figures"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("its blend of 30 mm at its end does not fit its length of 10 mm") == 1, err
+    assert re.search(r"in [+-]{2}, [+-]{2}(, [+-]{2})*: move 0 \(line\)", err), err

@@ -1275,7 +1275,11 @@ def _no_mode(group: list[tuple[int, Move]],
         seen.setdefault(mode, exc)
     if len(seen) == 1:  # one mode tried: its own error (it names the move)
         return fails[0][2]
-    why = "; ".join(f"in {mode or 'its own mode'}: {exc}" for mode, exc in seen.items())
+    # the modes that failed for the same reason, together
+    modes_of: dict[str, list[str]] = {}
+    for mode, exc in seen.items():
+        modes_of.setdefault(str(exc), []).append(mode or "its own mode")
+    why = "; ".join(f"in {', '.join(modes)}: {text}" for text, modes in modes_of.items())
     first = fails[0][2]
     return type(first)(f"{move_name(i, mv)}: working_mode = \"auto\": no working mode plans "
                        f"it{what} from where the moves before it can leave the robot ({why})")
