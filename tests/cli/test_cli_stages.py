@@ -54,6 +54,27 @@ def test_plan_configs(tmp_path, capsys, table, law):
     assert np.isfinite(data).all() and head[:16] == PLAN_COLUMNS
 
 
+
+def test_the_laws_speed_limit_holds_with_the_motors_limits(tmp_path, capsys):
+    """[law].speed_limit_deg_s was left out unless [law].torque_limit was given (a new user's
+    trial: 600 deg/s, the motors' 100 rpm, under a 360 deg/s limit, the law "within the
+    limits"): with the motors' limits the lower of the two speed limits holds."""
+    table = ('[output]\nunits = "si"\n[path]\ntype = "line"\nstart = [-50.0, 100.0]\n'
+             'end = [50.0, 120.0]\n[motors]\npeak_torque = 3.0\nmax_speed_rpm = 100.0\n'
+             '[law]\ntype = "time-optimal"\n')
+    peaks = {}
+    for name, extra in (("motors", ""), ("law", "speed_limit_deg_s = 240.0\n")):
+        cfg = tmp_path / f"{name}.toml"
+        cfg.write_text(table + extra)
+        out = tmp_path / f"{name}.csv"
+        assert main(["plan", str(cfg), "--out", str(out)]) == 0
+        capsys.readouterr()
+        names, data = read_csv(out)
+        dq = data[:, [names.index("dphi_rad_s"), names.index("dpsi_rad_s")]]
+        peaks[name] = np.degrees(np.abs(dq).max())
+    assert 600.0 * 0.99 < peaks["motors"] <= 600.0 * 1.001, peaks  # 100 rpm
+    assert 240.0 * 0.99 < peaks["law"] <= 240.0 * 1.001, peaks
+
 def test_torques_columns(tmp_path, capsys):
     out = tmp_path / "t.csv"
     assert main(["torques", "--out", str(out)]) == 0

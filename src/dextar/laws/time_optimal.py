@@ -740,7 +740,8 @@ def _register() -> None:
         "time-optimal",
         {"torque_limit": Param("pair", "N m", None, "motor torque limits [A, D] (default: "
                                "[motors])", positive=True),
-         "speed_limit_deg_s": Param("pair", "deg/s", None, "motor speed limits [A, D]",
+         "speed_limit_deg_s": Param("pair", "deg/s", None, "motor speed limits [A, D] "
+                                    "(with [motors]: the lower of the two holds)",
                                     positive=True),
          "grid": Param("integer", "", 400, "segments in arc length", minimum=10,
                        maximum=100_000)},

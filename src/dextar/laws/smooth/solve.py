@@ -20,6 +20,7 @@ from ..constraints import (
     AccelerationLimit,
     Constraint,
     PathDynamics,
+    SpeedLimit,
     motor_constraints,
 )
 from ..time_optimal import (
@@ -496,9 +497,16 @@ def _build(r: Any) -> Law:
     elif motors is None:
         raise ConfigError("config key [law].torque_limit is required for a time-optimal law "
                           "(or a [motors] table with peak_torque)")
+    cons = motor_constraints(motors)
+    if p.get("torque_limit") is None and p.get("speed_limit_deg_s") is not None:
+        # the law's speed limit with the motors' limits: the lower of the two holds (it was
+        # left out unless [law].torque_limit was given)
+        w = np.broadcast_to(np.asarray(p["speed_limit_deg_s"], float), (2,))
+        cons = (*cons, SpeedLimit((float(w[0]), float(w[1]))))
     if motors.third_order:
-        return solve_jerk_limited_law(r.dynamics, motors=motors, grid=p["grid"], units=r.units)
-    return solve_time_optimal_law(r.dynamics, motors=motors, grid=p["grid"], units=r.units)
+        return solve_jerk_limited_law(r.dynamics, constraints=cons, grid=p["grid"],
+                                      units=r.units)
+    return solve_time_optimal_law(r.dynamics, constraints=cons, grid=p["grid"], units=r.units)
 
 
 def _register() -> None:
