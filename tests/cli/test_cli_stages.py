@@ -1,5 +1,6 @@
 import csv
 import json
+import re
 import subprocess
 import sys
 
@@ -68,7 +69,8 @@ def test_the_laws_speed_limit_holds_with_the_motors_limits(tmp_path, capsys):
         cfg.write_text(table + extra)
         out = tmp_path / f"{name}.csv"
         assert main(["plan", str(cfg), "--out", str(out)]) == 0
-        capsys.readouterr()
+        # the grid's segments in mm (they were in metres without a unit)
+        assert re.search(r"\(400 segments of 0\.2\d+ mm", capsys.readouterr().out)
         names, data = read_csv(out)
         dq = data[:, [names.index("dphi_rad_s"), names.index("dpsi_rad_s")]]
         peaks[name] = np.degrees(np.abs(dq).max())
@@ -86,7 +88,12 @@ def test_torques_columns(tmp_path, capsys):
     assert head[:16] == PLAN_COLUMNS  # the same names as plan for the same quantities
     cols = dict(zip(head, data.T, strict=True))
     np.testing.assert_allclose(cols["power1_mL2_T3"], cols["tau1_mL2_T2"] * cols["dphi_rad_T"])
-    assert "paper model (42) error" in capsys.readouterr().out
+    words = capsys.readouterr().out
+    assert "paper model (42) error" in words
+    # each motor's peak with its unit (it read "peak |tau| = 39.46, 39.46 [m L^2/T^2]")
+    peak = np.abs(data[:, [head.index("tau1_mL2_T2"), head.index("tau2_mL2_T2")]]).max(axis=0)
+    assert (f"peak |tau|: motor A {peak[0]:.6g} m L^2/T^2, motor D {peak[1]:.6g} m L^2/T^2"
+            in words), words
 
 
 @pytest.mark.slow

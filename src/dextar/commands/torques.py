@@ -44,8 +44,9 @@ def run(args: argparse.Namespace) -> Result:
                                **law_payload(sc, an.law),
                                "peak_torque": [float(v) for v in peak],
                                "units": sc.units.describe()}
+    unit = sc.units.names["torque"]
     text = (f"{law_line(sc, an.law)}\nwrote {where}: {an.trajectory.t.size} samples; peak "
-            f"|tau| = {peak[0]:.6g}, {peak[1]:.6g} [{sc.units.names['torque']}] "
+            f"|tau|: motor A {peak[0]:.6g} {unit}, motor D {peak[1]:.6g} {unit} "
             f"({units_note(sc)})")
     if an.paper is not None:
         payload["paper_model_error"] = an.paper.error

@@ -292,7 +292,7 @@ def solve_time_optimal_law(dynamics: PathDynamics, *,
             for kind, r in ratio.items():
                 scales[kind] *= min(1.0, (1 + 0.25 * tol) / max(r, 1e-300))
     assert law is not None
-    return _verdict(law, ratio, scales, ds, tol)
+    return _verdict(law, ratio, scales, ds, tol, units)
 
 
 def _constraints(torque_limit: tuple[float, float] | None,
@@ -345,12 +345,17 @@ def _speed_limit(cons: Sequence[Constraint]) -> tuple[float, float]:
 
 
 def _verdict(law: TimeOptimalLaw, ratio: dict[str, float], scales: dict[str, float],
-             ds: Array, tol: float) -> TimeOptimalLaw:
-    """The settled law with its status and the message in words."""
+             ds: Array, tol: float, units: Units | None = None) -> TimeOptimalLaw:
+    """The settled law with its status and the message in words (the segments' lengths in
+    mm with ``units``)."""
     n, length = len(ds), law.distance
+
+    def mm(x: float) -> str:
+        return f"{x:.4g}" if units is None else f"{units.mm(x):.4g} mm"
+
     ok = all(r <= 1 + tol for r in ratio.values())
-    where = (f"{n} segments of {ds[0]:.4g}" if np.ptp(ds) <= 1e-9 * length else
-             f"{n} segments of {ds.min():.4g} to {ds.max():.4g}")
+    where = (f"{n} segments of {mm(ds[0])}" if np.ptp(ds) <= 1e-9 * length else
+             f"{n} segments of {mm(ds.min())} to {mm(ds.max())}")
     margin = "" if all(v == 1.0 for v in scales.values()) else (
         "; limits tightened by " + " and ".join(f"{1 - v:.2%} ({k})" for k, v in scales.items())
         + " so that they hold between the grid points")
