@@ -248,7 +248,7 @@ class Line(Path):
         if length == 0.0:
             raise ParameterError("line start and end must differ")
         size = max(float(np.abs(a).max()), float(np.abs(b).max()))
-        if not length > SHORT_LINE * size + 1e-300:
+        if not length > SHORT_LINE * size:
             raise ParameterError(
                 f"the line is {length:.3g} long, under {SHORT_LINE:g} of the size of its "
                 f"coordinates ({size:.3g}): too short to plan a motion along it (leave it out "

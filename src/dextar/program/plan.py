@@ -781,9 +781,9 @@ def _member_distances(poses: CheckedPath, owner: Sequence[int], n: int
     out = []
     for k in range(n):
         on = (p >= bounds[k]) & (p <= bounds[k + 1])
-        if not on.any():  # (a stretch shorter than the poses' spacing)
-            on = np.abs(p - 0.5 * (bounds[k] + bounds[k + 1])) == np.abs(
-                p - 0.5 * (bounds[k] + bounds[k + 1])).min()
+        if not on.any():  # (a stretch shorter than the poses' spacing: the nearest)
+            gap = np.abs(p - 0.5 * (bounds[k] + bounds[k + 1]))
+            on = gap == gap.min()
         out.append((float(d1[on].min()), float(d2[on].min())))
     return tuple(out)
 
