@@ -2,6 +2,7 @@
 solver it replaces where it was built (the same programmes, the same answers to their
 tolerances, the same laws), and the start's jerks whatever the number of knots."""
 
+import dataclasses
 import signal
 from types import SimpleNamespace
 
@@ -52,7 +53,7 @@ def test_an_old_build_of_the_compiled_interior_point_is_not_used():
 
 def test_the_compiled_interior_point_solves_as_the_numpy_one(setup, monkeypatch):  # noqa: F811
     """On the blended chain's programmes (two pinned joints): the same status, the same
-    objective to 1e-9 (relative; both stop at a duality gap of 1e-8), the same solution to
+    objective to 1e-9 (relative; both stop at a duality gap of 1e-6), the same solution to
     1e-6 of its scale, within a couple of iterations of each other; stopped after three
     iterations, both say they have not converged."""
     if banded._compiled is None:
@@ -206,3 +207,43 @@ def test_the_start_jerks_do_not_grow_with_the_knots(line_start):
         jmax.append(np.abs(start.start_jerks(st, me, along.length)).max())
     assert jmax[1] <= 1.01 * jmax[0]
 
+
+
+def test_a_long_programme_has_a_proximal_term_on_its_jerks(setup, monkeypatch):  # noqa: F811
+    """From ``slp.LONG_PROGRAMME`` intervals the programme carries proximal weights on its
+    jerks' rows (the box's upper rows, ``PROX h / jb^2``), a shorter one none. Both solvers
+    then give the convex quadratic programme's solution ``x``: by HiGHS, no feasible point
+    is better along the objective's gradient at ``x`` (first-order optimality, checked
+    independently); it is nearer the start than the linear programme's solution (``q``, the
+    quadratic term, under a tenth: the weight made 100 times PROX so that ``q`` is far
+    above the tolerances), its linear objective ``c x`` no lower; with zero weights the
+    linear programme's solution to the bit."""
+    from scipy.optimize import linprog
+
+    assert programmes(setup)[0][0].rq is None  # (the chain's mesh: tens of intervals)
+    monkeypatch.setattr(slp, "LONG_PROGRAMME", 16)
+    monkeypatch.setattr(slp, "PROX", 100 * slp.PROX)
+    for lp, x0 in programmes(setup):
+        assert lp.rq is not None
+        assert np.count_nonzero(lp.rq) == len(lp.E) - 2  # (all but the two into the pins)
+        general = as_linprog(lp)
+        g = general["A_ub"]
+        linear = banded.solve_staged(dataclasses.replace(lp, rq=None), x0)
+        again = banded.solve_staged(dataclasses.replace(lp, rq=np.zeros(len(lp.rk))), x0)
+        assert np.array_equal(linear.x, again.x)
+        tol = 1e-6 * (1 + abs(linear.fun))
+        for use in (False, True):
+            if use and banded._compiled is None:
+                continue
+            monkeypatch.setattr(banded, "USE_COMPILED", use)
+            res = banded.solve_staged(lp, x0)
+            assert res.status == 0
+            d, d_lin = g @ (res.x - x0), g @ (linear.x - x0)
+            q, q_lin = 0.5 * float(lp.rq @ (d * d)), 0.5 * float(lp.rq @ (d_lin * d_lin))
+            slope = lp.c + g.T @ (lp.rq * d)
+            best = linprog(**dict(general, c=slope), method="highs")
+            print(use, q_lin, q, float(slope @ res.x) - best.fun, res.fun - linear.fun)
+            assert best.status == 0
+            assert float(slope @ res.x) - best.fun <= tol
+            assert q_lin > 100 * tol and q <= 0.1 * q_lin
+            assert res.fun >= linear.fun - tol

@@ -101,16 +101,17 @@ def programmes(setup, deltas=(0.3, 0.05)):
 
 
 def test_the_banded_interior_point_matches_highs(setup):
-    """Same objective as HiGHS's simplex to 1e-7 (relative) on the chain's programmes, and
-    the solution within the rows, equalities and bounds; stopped after three iterations it
-    says it has not converged."""
+    """Same objective as HiGHS's simplex to 1e-6 (relative: the duality gap it stops at,
+    which bounds the objective's error; measured 9.7e-8 and 6.0e-9) on the chain's
+    programmes, and the solution within the rows, equalities and bounds; stopped after
+    three iterations it says it has not converged."""
     _, me, *_ = setup
     assert len(me.pins) == 2
     for lp, x0 in programmes(setup):
         res = banded.solve_staged(lp, x0)
         ref = linprog(**as_linprog(lp), method="highs-ds")
         assert res.status == 0 and ref.status == 0
-        assert abs(res.fun - ref.fun) <= 1e-7 * (1 + abs(ref.fun))
+        assert abs(res.fun - ref.fun) <= 1e-6 * (1 + abs(ref.fun))
         g = as_linprog(lp)
         scale = 1 + np.abs(lp.rb).max()
         assert (g["A_ub"] @ res.x - lp.rb).max() <= 1e-7 * scale

@@ -10,14 +10,15 @@
  * dextar runs the Python solver, which gives the same solutions to the programmes'
  * tolerances).
  *
- * solve(c, rk, ra, rg, rb, E, e, lo, hi, x0, x, tol, dual_tol, gap_tol, maxiter)
+ * solve(c, rk, ra, rg, rb, E, e, lo, hi, rq, x0, x, tol, dual_tol, gap_tol, maxiter)
  *     -> (status, iterations)
  *   The programme of banded.StagedLP with one border variable: c, lo, hi, x0 and the
  *   writable x hold nx = 4 (M + 1) + 1 float64 values (the knots' states sigma, w, alpha,
  *   T, knot by knot, then the border); rk (int64) the R rows' intervals, ra their 6
  *   coefficients on sigma_k, w_k, alpha_k, T_k, alpha_k+1, T_k+1 (R x 6), rg (R) on the
- *   border, rb (R) their right-hand sides; E (M x 3 x 8) and e (M x 3) the equalities of
- *   each interval on the states of its two knots. The solution is written into x; status
+ *   border, rb (R) their right-hand sides, rq (R) their proximal weights (the objective's
+ *   quadratic term sum rq (g . (x - x0))^2 / 2, 0 for none); E (M x 3 x 8) and e (M x 3)
+ *   the equalities of each interval on the states of its two knots. The solution is written into x; status
  *   0 (converged, or the best iterate within a hundred times the tolerances), 1 (the
  *   iteration limit) or 2 (a singular Newton matrix). A signal's Python handler runs
  *   between iterations (an exception it raises ends the solve).
@@ -35,7 +36,7 @@
 #endif
 
 /* The interface version: banded.py uses a build of this version only. */
-#define IPM_VERSION 2
+#define IPM_VERSION 3
 
 /* States per knot, equalities per interval, band positions per knot, the band's
  * half-widths and its storage's width with the fill-in of the pivoting (banded.py's D, Q,
@@ -46,7 +47,7 @@
 #define KL 8
 #define KU 8
 #define W (2 * KL + KU + 1)
-#define REG 1e-11
+#define REG 1e-14
 #define ETA 0.99
 #define MU0 1e-3
 /* the start's slacks at least this much: of 1 + |rb| for a row, of the width for a bound
@@ -67,7 +68,8 @@ static const int EQ_POS[8] = {2, 3, 0, 1, BLOCK + 2, BLOCK + 3, BLOCK + 0, BLOCK
 
 typedef struct {
     Py_ssize_t M, nk, nx, nb, R, nu, nl, m;
-    const double *c, *ra, *rg, *rb, *E, *e, *lo, *hi;
+    const double *c, *ra, *rg, *rb, *E, *e, *lo, *hi, *rq;
+    double *rc;  /* the rows' values at the start: the proximal term's centres */
     const long long *rk;
     const unsigned char *fixed;
     const Py_ssize_t *iu, *il;
@@ -108,7 +110,8 @@ static double nan_max(double a, double b)
 }
 
 /* The residuals at the iterate in one pass over the rows and the bounds: rp = G x + s - h
- * and rd = G^T z (the fixed variables' entries zero; c and E^T y are added after); returns
+ * and rd = G^T z plus the proximal term's gradient (the fixed variables' entries zero; c
+ * and E^T y are added after); returns
  * the gap s . z and the largest |rp| in *maxrp. In the same pass, the predictor's part of
  * the step's right-hand side: the barrier terms Dz = z / s, the targets cc = s z,
  * t = rp - cc / z into ds, Dz t into dz and G^T dz into rhs (work of no use when the
@@ -137,16 +140,16 @@ static double residuals(const Prog *p, const double *x, const double *sl, const 
         const Py_ssize_t o = D * p->rk[r];
         const double *xs = x + o;
         double *os = rd + o, *ts = rhs + o;
-        const double zr = z[r];
         double g = p->rg[r] * xb;
-        for (int j = 0; j < 6; j++) {
+        for (int j = 0; j < 6; j++)
             g += a[j] * xs[ROW_X[j]];
+        const double zr = p->rq[r] != 0.0 ? z[r] + p->rq[r] * (g - p->rc[r]) : z[r];
+        for (int j = 0; j < 6; j++)
             os[ROW_X[j]] += a[j] * zr;
-        }
         b += p->rg[r] * zr;
         const double res = g + (sl[r] - p->rb[r]);
         rp[r] = res;
-        gap += sl[r] * zr;
+        gap += sl[r] * z[r];
         mx = nan_max(mx, fabs(res));
         PREDICTOR(r, res)
         for (int j = 0; j < 6; j++)
@@ -495,7 +498,7 @@ static int newton_matrix(const Prog *p, Newton *nw, const double *Dz, double *di
         double Hc[6][6] = {{0.0}}, uc[6] = {0.0};
         for (; r < R && p->rk[r] == k; r++) {
             const double *a = p->ra + 6 * r;
-            const double d = Dz[r];
+            const double d = Dz[r] + p->rq[r];
             for (int i = 0; i < 6; i++) {
                 if (a[i] == 0.0)
                     continue;
@@ -589,9 +592,9 @@ static int ipm(Prog *p, const double *x0, double *x, double tol, double dual_tol
     int status = 1;
     long it = 0;
     /* m-sized: sl, z, Dz, rp, cc, dz, ds; nx-sized: rd, diag, best, rhs, dx; nE: y, re, dy;
-     * nb: U, BU, full; the band */
-    double *work = malloc(((size_t)7 * m + 5 * nx + 3 * nE + 3 * nb + (size_t)nb * W)
-                          * sizeof(double));
+     * nb: U, BU, full; the band; R: the rows at the start (the proximal term's centres) */
+    double *work = malloc(((size_t)7 * m + 5 * nx + 3 * nE + 3 * nb + (size_t)nb * W
+                           + (size_t)R) * sizeof(double));
     Py_ssize_t *piv = malloc((size_t)2 * nb * sizeof(Py_ssize_t));
     if (work == NULL || piv == NULL) {
         free(work);
@@ -611,6 +614,7 @@ static int ipm(Prog *p, const double *x0, double *x, double tol, double dual_tol
     nw.BU = nw.U + nb;
     nw.full = nw.BU + nb;
     nw.L = nw.full + nb;
+    p->rc = nw.L + (size_t)nb * W;
     nw.piv = piv;
     nw.ext = piv + nb;
 
@@ -619,6 +623,7 @@ static int ipm(Prog *p, const double *x0, double *x, double tol, double dual_tol
     for (Py_ssize_t v = 0; v < nx; v++)
         x[v] = p->fixed[v] ? p->lo[v] : x0[v];
     G(p, x, sl);
+    memcpy(p->rc, sl, (size_t)R * sizeof(double));
     for (Py_ssize_t i = 0; i < m; i++) {
         double floor;
         if (i < R)
@@ -734,21 +739,22 @@ static int get_int64(PyObject *obj, Py_buffer *view, const char *name)
 
 static PyObject *solve(PyObject *self, PyObject *args)
 {
-    /* float64 buffers: c, ra, rg, rb, E, e, lo, hi, x0, then x (writable) */
-    PyObject *objs[10], *rk_obj;
-    static const char *names[10] = {"c", "ra", "rg", "rb", "E", "e", "lo", "hi", "x0", "x"};
-    Py_buffer views[10], rk_view;
+    /* float64 buffers: c, ra, rg, rb, E, e, lo, hi, rq, x0, then x (writable) */
+    PyObject *objs[11], *rk_obj;
+    static const char *names[11] = {"c", "ra", "rg", "rb", "E", "e", "lo", "hi", "rq", "x0",
+                                    "x"};
+    Py_buffer views[11], rk_view;
     double tol, dual_tol, gap_tol;
     long maxiter;
     PyObject *result = NULL;
     (void)self;
-    if (!PyArg_ParseTuple(args, "OOOOOOOOOOOdddl", &objs[0], &rk_obj, &objs[1], &objs[2],
+    if (!PyArg_ParseTuple(args, "OOOOOOOOOOOOdddl", &objs[0], &rk_obj, &objs[1], &objs[2],
                           &objs[3], &objs[4], &objs[5], &objs[6], &objs[7], &objs[8],
-                          &objs[9], &tol, &dual_tol, &gap_tol, &maxiter))
+                          &objs[9], &objs[10], &tol, &dual_tol, &gap_tol, &maxiter))
         return NULL;
     if (get_int64(rk_obj, &rk_view, "rk") < 0)
         return NULL;
-    if (get_buffers(objs, views, 10, 9, names) < 0) {
+    if (get_buffers(objs, views, 11, 10, names) < 0) {
         PyBuffer_Release(&rk_view);
         return NULL;
     }
@@ -762,10 +768,11 @@ static PyObject *solve(PyObject *self, PyObject *args)
                 || views[2].len != R * 8 || views[3].len != R * 8
                 || views[4].len != M * Q * 2 * D * 8 || views[5].len != M * Q * 8
                 || views[6].len != nx * 8 || views[7].len != nx * 8
-                || views[8].len != nx * 8 || views[9].len != nx * 8 || maxiter < 0) {
+                || views[8].len != R * 8 || views[9].len != nx * 8
+                || views[10].len != nx * 8 || maxiter < 0) {
             PyErr_SetString(PyExc_ValueError,
-                            "c, lo, hi, x0, x must hold 4 (M + 1) + 1 values, ra 6 R, rg and "
-                            "rb R (rk's length), E 24 M and e 3 M");
+                            "c, lo, hi, x0, x must hold 4 (M + 1) + 1 values, ra 6 R, rg, "
+                            "rb and rq R (rk's length), E 24 M and e 3 M");
             goto done;
         }
         const long long *rk = rk_view.buf;
@@ -793,16 +800,17 @@ static PyObject *solve(PyObject *self, PyObject *args)
         /* the rows sorted by interval (a counting sort, stable): the solve's passes over
          * them then read the knots' states and write the band in order (on a long path,
          * rows in the order of their kinds swept the band once per kind, out of cache) */
-        sorted_rows = malloc((size_t)R * 9 * sizeof(double) + (size_t)R * sizeof(long long)
+        sorted_rows = malloc((size_t)R * 10 * sizeof(double) + (size_t)R * sizeof(long long)
                              + (size_t)(M + 1) * sizeof(Py_ssize_t));
         if (sorted_rows == NULL) {
             PyErr_NoMemory();
             goto done;
         }
-        double *ra_s = sorted_rows, *rg_s = ra_s + 6 * R, *rb_s = rg_s + R;
-        long long *rk_s = (long long *)(rb_s + R);
+        double *ra_s = sorted_rows, *rg_s = ra_s + 6 * R, *rb_s = rg_s + R, *rq_s = rb_s + R;
+        long long *rk_s = (long long *)(rq_s + R);
         Py_ssize_t *start = (Py_ssize_t *)(rk_s + R);
-        const double *ra = views[1].buf, *rg = views[2].buf, *rb = views[3].buf;
+        const double *ra = views[1].buf, *rg = views[2].buf, *rb = views[3].buf,
+                     *rq = views[8].buf;
         memset(start, 0, (size_t)(M + 1) * sizeof(Py_ssize_t));
         for (Py_ssize_t r = 0; r < R; r++)
             start[rk[r] + 1]++;
@@ -813,13 +821,14 @@ static PyObject *solve(PyObject *self, PyObject *args)
             memcpy(ra_s + 6 * i, ra + 6 * r, 6 * sizeof(double));
             rg_s[i] = rg[r];
             rb_s[i] = rb[r];
+            rq_s[i] = rq[r];
             rk_s[i] = rk[r];
         }
         Prog p = {M, D * K, nx, BLOCK * M + D, R, nu, nl, R + nu + nl,
                   views[0].buf, ra_s, rg_s, rb_s, views[4].buf,
-                  views[5].buf, lo, hi, rk_s, fixed, bnd, bnd + nu};
+                  views[5].buf, lo, hi, rq_s, NULL, rk_s, fixed, bnd, bnd + nu};
         long nit = 0;
-        int status = ipm(&p, views[8].buf, views[9].buf, tol, dual_tol, gap_tol, maxiter,
+        int status = ipm(&p, views[9].buf, views[10].buf, tol, dual_tol, gap_tol, maxiter,
                          &nit);
         if (status >= 0)
             result = Py_BuildValue("il", status, nit);
@@ -829,13 +838,13 @@ done:
     free(bnd);
     free(sorted_rows);
     PyBuffer_Release(&rk_view);
-    release_buffers(views, 10);
+    release_buffers(views, 11);
     return result;
 }
 
 static PyMethodDef methods[] = {
     {"solve", solve, METH_VARARGS,
-     "solve(c, rk, ra, rg, rb, E, e, lo, hi, x0, x, tol, dual_tol, gap_tol, maxiter) -> "
+     "solve(c, rk, ra, rg, rb, E, e, lo, hi, rq, x0, x, tol, dual_tol, gap_tol, maxiter) -> "
      "(status, iterations): the programme's solution into x."},
     {NULL, NULL, 0, NULL}
 };

@@ -75,6 +75,22 @@ REGION_FREE = 0.5
 #: does not bound them), and makes the rows again where a step is turned down or a
 #: programme fails: one set of gradients alive at a time.
 LEAN_ROWS = 8192
+#: A programme of at least ``LONG_PROGRAMME`` intervals adds to its objective a proximal
+#: term on the jerks' changes, ``PROX / 2 * sum_k h_k ((J_k - J0_k) / jb)^2`` (``h_k`` the
+#: intervals' fractions, ``jb`` the trust region's half-width for the jerks: at most
+#: ``PROX / 2`` where the objective's scale is 1, a fiftieth of :data:`STEP_TOL`), so that
+#: its solution is unique where the rows leave the jerks nearly free. Without it, the
+#: interior point walks the edge of a stretch of jerks on their box one to three knots per
+#: iteration (at 16k knots on the 20 mm lines of ``bench_smooth.py scaling``: 76 and 69
+#: iterations, 45 and 37 at 4k, the planning time M^1.28 and M^1.32); with it 38 and 35
+#: (36 and 30 at 4k), the durations of the four lines of the scaling the same to 1e-6. Not
+#: on shorter programmes: on 80 random blended corners (47 to 80 intervals,
+#: ``bench_smooth.py blends``' paths, three seeds) the local search came out 0.5 to 1.5 %
+#: slower on average with it (0 to 0.3 % without; each corner moves by a few per cent
+#: either way, another path of the search); at 2000 intervals 12 of them moved by +1.4 % and
+#: -0.3 % on average (two seeds) against +0.7 % and -0.6 % without it.
+LONG_PROGRAMME = 2000
+PROX = 1e-4
 FEAS_TOL = 1e-4
 
 
@@ -281,6 +297,10 @@ class Programme:
         ra[i + len(kj)] = -ra[i]
         jb = delta * jscale
         rb[i], rb[i + len(kj)] = mo.J[kj] + jb, jb - mo.J[kj]
+        rq = None
+        if M >= LONG_PROGRAMME:  # (a proximal term on the jerks: see LONG_PROGRAMME)
+            rq = np.zeros(n)
+            rq[i] = PROX * mesh.h[kj] / (jb * jb)
         # the integration into a pinned knot, linearised in the durations
         E = self.E.copy()
         h = mesh.h[pin]
@@ -304,7 +324,7 @@ class Programme:
         c[3:4 * M:4] = mesh.h / T_ref
         return StagedLP(c, k, ra, rg, rb, E, np.zeros((M, 3)),
                         np.concatenate([lo.reshape(-1), [0.0]]),
-                        np.concatenate([hi.reshape(-1), [np.inf]])), x0
+                        np.concatenate([hi.reshape(-1), [np.inf]]), rq), x0
 
     def model(self, rows: Rows, x: Array, mo: Motion) -> Array:
         """Every row's linear model at the programme's variables ``x``."""
