@@ -10,17 +10,17 @@
  * dextar runs the Python solver, which gives the same solutions to the programmes'
  * tolerances).
  *
- * solve(c, rk, ra, rg, rb, E, e, lo, hi, rq, x0, x, tol, dual_tol, gap_tol, maxiter)
- *     -> (status, iterations)
+ * solve(c, rk, ra, rg, rb, E, e, lo, hi, rq, x0, x, tol, dual_tol, gap_tol,
+ *       maxiter) -> (status, iterations)
  *   The programme of banded.StagedLP with one border variable: c, lo, hi, x0 and the
  *   writable x hold nx = 4 (M + 1) + 1 float64 values (the knots' states sigma, w, alpha,
  *   T, knot by knot, then the border); rk (int64) the R rows' intervals, ra their 6
  *   coefficients on sigma_k, w_k, alpha_k, T_k, alpha_k+1, T_k+1 (R x 6), rg (R) on the
  *   border, rb (R) their right-hand sides, rq (R) their proximal weights (the objective's
  *   quadratic term sum rq (g . (x - x0))^2 / 2, 0 for none); E (M x 3 x 8) and e (M x 3)
- *   the equalities of each interval on the states of its two knots. The solution is written into x; status
- *   0 (converged, or the best iterate within a hundred times the tolerances), 1 (the
- *   iteration limit) or 2 (a singular Newton matrix). A signal's Python handler runs
+ *   the equalities of each interval on the states of its two knots. The solution is
+ *   written into x; status 0 (converged, or the best iterate within a hundred times the
+ *   tolerances), 1 (the iteration limit) or 2 (a singular Newton matrix). A signal's Python handler runs
  *   between iterations (an exception it raises ends the solve).
  *
  * Compiled without contraction into fused multiply-adds (-ffp-contract=off).

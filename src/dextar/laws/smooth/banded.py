@@ -306,6 +306,8 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
     del floor, width
     # the proximal term's weights and centres (the rows at the start)
     rq = np.zeros(R) if lp.rq is None else np.asarray(lp.rq, float)
+    if rq.shape != (R,):
+        raise ValueError(f"rq must hold the {R} rows' weights, not {rq.shape}")
     near = np.flatnonzero(rq)
     rc = gx[near]
     del gx
@@ -317,8 +319,10 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
     best: tuple[float, Array] = (np.inf, x)
     for it in range(maxiter + 1):
         gx = G(x)
-        zq = z.copy()
-        zq[near] += rq[near] * (gx[near] - rc)
+        zq = z
+        if near.size:  # (the proximal term's gradient with the rows' multipliers)
+            zq = z.copy()
+            zq[near] += rq[near] * (gx[near] - rc)
         rd = c + GT(zq) + ETy(y)
         del zq
         rd[fixed] = 0.0
