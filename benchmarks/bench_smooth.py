@@ -20,7 +20,8 @@ Floors (issue 29):
   in a new process, five times, the best CPU time read: on this shared machine one run of
   16k knots in three took 1.1 to 1.6 s with the same iterations; its peak resident memory
   above the process's after a warm-up), and at 4k and 16k on three other lines, three
-  times each (the floor read on each);
+  times each (the floor read on each), and at 2k and 8k knots on a long blended chain (a
+  new user's trial, once each; its floor read too);
   one programme of about 1000 knots solved by the banded
   interior point (compiled where built) and by HiGHS (scipy's linprog, dual simplex and
   IPX) on the same rows, which is why the programmes have their own solver.
@@ -51,7 +52,7 @@ from dextar.config import load_scenario
 from dextar.dynamics import Model, RobotAlongJointLine, RobotAlongPath, exact
 from dextar.laws import solve_jerk_limited_law, solve_time_optimal_law, time_optimal
 from dextar.motors import MotorLimits
-from dextar.paths import Line
+from dextar.paths import Line, blended
 from dextar.trajectory import JointLine
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -69,6 +70,16 @@ MOVE = ((-0.04, 0.11), (0.04, 0.09))
 #: differ from line to line: the floor is read on every one.
 OTHER_LINES = (((-0.04, 0.11), (-0.04, 0.09)), ((0.04, 0.09), (0.04, 0.11)),
                ((-0.06, 0.12), (0.05, 0.10)))
+#: A long blended chain (a new user's trial): five lines of 41-78 mm through these points
+#: (m), 8 mm blends, 280 mm; its knots as ``one_size``'s line ``len(OTHER_LINES)``.
+CHAIN = ((-0.08, 0.18), (-0.02, 0.23), (0.04, 0.19), (0.08, 0.22), (0.06, 0.17), (0.02, 0.16))
+CHAIN_SIZES = (2000, 8000)
+
+
+def chain_path():
+    """The blended chain :data:`CHAIN`."""
+    pieces = [Line(a, b) for a, b in zip(CHAIN, CHAIN[1:], strict=False)]
+    return blended(pieces, (0.008,) * (len(pieces) - 1))[0]
 
 
 def load() -> str:
@@ -315,18 +326,22 @@ def section_blends(n: int = 40) -> None:
 
 
 def one_size(segments: int, line: int = -1) -> dict[str, Any]:
-    """Plan the pick-and-place line (or ``OTHER_LINES[line]``) with at least ``segments``
-    intervals, in this process: CPU and wall time, peak resident memory above the
+    """Plan the pick-and-place line (or ``OTHER_LINES[line]``, or the blended chain
+    :data:`CHAIN` with the jerk example's robot and motors for ``line = len(OTHER_LINES)``)
+    with at least ``segments`` intervals, in this process: CPU and wall time, peak
+    resident memory above the
     process's after a warm-up (Linux: the high-water mark reset through
     /proc/self/clear_refs), programmes and their interior-point iterations, intervals."""
     from dextar.laws.smooth import slp
 
-    sc = load_scenario(EXAMPLE)
+    chain = line == len(OTHER_LINES)
+    sc = load_scenario(JERK_EXAMPLE if chain else EXAMPLE)
     limits = sc.si_motors
     assert limits is not None
-    mv = RobotAlongPath(sc.si_model, Line(*(MOVE if line < 0 else OTHER_LINES[line])),
-                        sc.mode)
-    solve_jerk_limited_law(mv, motors=jerky(limits), grid=400)  # (warm)
+    motors = limits if chain else jerky(limits)
+    path = chain_path() if chain else Line(*(MOVE if line < 0 else OTHER_LINES[line]))
+    mv = RobotAlongPath(sc.si_model, path, sc.mode)
+    solve_jerk_limited_law(mv, motors=motors, grid=400)  # (warm)
     captured = []
     iterations = []
     real = slp.solve_staged
@@ -348,7 +363,7 @@ def one_size(segments: int, line: int = -1) -> dict[str, Any]:
     Path("/proc/self/clear_refs").write_text("5")
     base = status("VmRSS")
     t0, c0 = time.perf_counter(), time.process_time()
-    law = solve_jerk_limited_law(mv, motors=jerky(limits), grid=400, segments=segments)
+    law = solve_jerk_limited_law(mv, motors=motors, grid=400, segments=segments)
     cpu, wall = time.process_time() - c0, time.perf_counter() - t0
     peak = status("VmHWM") - base
     slp.solve_staged = real
@@ -459,6 +474,20 @@ def section_scaling(repeats: int = 5) -> None:
               f"{'met' if met[-1] else 'NOT met'}), peak {b['peak_MB']:.0f} MB")
     print(f"  the growth floor from 4000 to 16000 knots on every line: "
           f"{'met' if all(met) else 'NOT met'} ({sum(met)} of {len(met)} lines)")
+    print(f"  a blended chain of five lines (280 mm, 8 mm blends) at {CHAIN_SIZES[0]} and "
+          f"{CHAIN_SIZES[1]} knots (once each; the programmes' interior-point iterations, "
+          f"at most 60 each):")
+    a, b = (json.loads(subprocess.run(
+        [sys.executable, __file__, "--one-size", str(n), str(len(OTHER_LINES))], check=True,
+        capture_output=True, text=True).stdout.splitlines()[-1]) for n in CHAIN_SIZES)
+    pt, mlogm = growth(a, b)
+    for r in (a, b):
+        its = r["iterations"]
+        print(f"    {r['M']} knots: {r['cpu']:.2f} s, {r['programmes']} programmes, "
+              f"{sum(its)} iterations ({sum(i >= 60 for i in its)} at the limit), duration "
+              f"{r['duration']:.6f} s")
+    print(f"    time M^{pt:.2f} (M log M: M^{mlogm:.2f}: "
+          f"{'met' if pt <= mlogm + 0.05 else 'NOT met'})")
     h = rows[0]
     if "banded" in h:
         print(f"  one programme of {h['lp_M']} knots, {h['lp_rows']} rows: banded interior "

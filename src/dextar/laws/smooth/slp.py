@@ -90,8 +90,10 @@ LEAN_ROWS = 8192
 #: on shorter programmes: on 80 random blended corners (47 to 80 intervals,
 #: ``bench_smooth.py blends``' paths, three seeds) the local search came out 0.5 to 1.5 %
 #: slower on average with it (0 to 0.3 % without; each corner moves by a few per cent
-#: either way, another path of the search); at 2000 intervals 12 of them moved by +1.4 % and
-#: -0.3 % on average (two seeds) against +0.7 % and -0.6 % without it.
+#: either way, another path of the search). On long programmes it costs less but not nothing:
+#: 48 random corners planned with 2000 intervals (four seeds) came out 0.65 % slower on
+#: average with it than without (median 0.22 %, 29 slower and 11 faster by over 0.1 %), the
+#: price of the planning time's growth on long paths.
 LONG_PROGRAMME = 2000
 PROX = 1e-4
 FEAS_TOL = 1e-4
