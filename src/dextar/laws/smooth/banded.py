@@ -162,10 +162,10 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
     right-hand side), the dual ones below ``dual_tol`` (relative to the largest cost) and
     the total complementarity (the duality gap) below ``gap_tol (1 + |c x|)`` (the
     sequential programmes need the objective to far fewer digits, their tests a reduction
-    of 1e-4 of it; the last digits cost the most iterations: with 1e-8, as before, 80
-    random blended corners took 7 % more programmes and 15 % more time for durations the
-    same on average, +0.04 %, -0.14 % and +0.34 % on three seeds against 1e-8's). Near the
-    end the
+    of 1e-4 of it; the last digits cost the most iterations: with 1e-8 and :data:`REG`
+    1e-11, as before, 80 random blended corners took 7-25 % more programmes and 19-34 %
+    more CPU time on three seeds, for durations the same on average: these +0.04 %,
+    -0.14 % and +0.34 % against those). Near the end the
     Newton systems lose accuracy (the barrier terms span many decades) and the dual
     residual may stall or grow: the best iterate met is returned, converged when it is
     within a hundred times those tolerances. With proximal weights (``lp.rq``) the
