@@ -82,18 +82,18 @@ LEAN_ROWS = 8192
 #: ``PROX / 2``, half of :data:`STEP_TOL` (every jerk at its box's edge), and so is the
 #: rise of the solution's ``c x`` over the linear programme's optimum (which understates
 #: the step's predicted reduction by as much); measured on the lines below, 1e-7 to 1e-6.
-#: Without it, the
-#: interior point walks the edge of a stretch of jerks on their box one to three knots per
-#: iteration (at 16k knots on the 20 mm lines of ``bench_smooth.py scaling``: 76 and 69
-#: iterations, 45 and 37 at 4k, the planning time M^1.28 and M^1.32); with it 38 and 35
-#: (36 and 30 at 4k), the durations of the four lines of the scaling the same to 1e-6. Not
-#: on shorter programmes: on 80 random blended corners (47 to 80 intervals,
-#: ``bench_smooth.py blends``' paths, three seeds) the local search came out 0.45 to 1.5 %
-#: slower on average with it than with the solver before it (-0.14 to +0.34 % without it;
-#: each corner moves by a few per cent either way, another path of the search). On long programmes it costs less but not nothing:
-#: 48 random corners planned with 2000 intervals (four seeds) came out 0.65 % slower on
-#: average with it than without (median 0.22 %, 29 slower and 11 faster by over 0.1 %), the
-#: price of the planning time's growth on long paths.
+#: Without it, the interior point walks the edge of a stretch of jerks on their box one to
+#: three knots per iteration (at 16k knots on the 20 mm lines of ``bench_smooth.py
+#: scaling``: 76 and 69 iterations, 45 and 37 at 4k, the planning time M^1.28 and M^1.32);
+#: with it 38 and 35 (36 and 30 at 4k), the durations of the four lines of the scaling the
+#: same to 1e-6. Not on shorter programmes: on 80 random blended corners (47 to 80
+#: intervals, ``bench_smooth.py blends``' paths, three seeds) the local search came out 0.45
+#: to 1.5 % slower on average with it than with the solver before it (-0.14 to +0.34 %
+#: without it; each corner moves by a few per cent either way, another path of the
+#: search). On long programmes it costs less but not nothing: 48 random corners planned
+#: with 2000 intervals (four seeds) came out 0.65 % slower on average with it than without
+#: (median 0.22 %, 29 slower and 11 faster by over 0.1 %), the price of the planning
+#: time's growth on long paths.
 LONG_PROGRAMME = 2000
 PROX = 1e-4
 FEAS_TOL = 1e-4

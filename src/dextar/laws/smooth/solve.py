@@ -501,8 +501,8 @@ def _build(r: Any) -> Law:
     if p.get("torque_limit") is None and p.get("speed_limit_deg_s") is not None:
         # the law's speed limit with the motors' limits: the lower of the two holds (it was
         # left out unless [law].torque_limit was given)
-        w = np.broadcast_to(np.asarray(p["speed_limit_deg_s"], float), (2,))
-        cons = (*cons, SpeedLimit((float(w[0]), float(w[1]))))
+        law_speed = MotorLimits.of(motors.peak_torque, p["speed_limit_deg_s"]).max_speed
+        cons = (*cons, SpeedLimit(law_speed))
     if motors.third_order:
         return solve_jerk_limited_law(r.dynamics, constraints=cons, grid=p["grid"],
                                       units=r.units)
