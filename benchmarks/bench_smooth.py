@@ -20,8 +20,9 @@ Floors (issue 29):
   in a new process, five times, the best CPU time read: on this shared machine one run of
   16k knots in three took 1.1 to 1.6 s with the same iterations; its peak resident memory
   above the process's after a warm-up), and at 4k and 16k on three other lines, three
-  times each (the floor read on each), and at 2k and 8k knots on a long blended chain (a
-  new user's trial, once each; its floor read too);
+  times each (the floor read on each), and about 2k and 8k knots on a long blended chain (a
+  new user's trial: at 0.95, 1 and 1.05 of each size, once each, the floor read on the
+  medians, as its number of programmes varies with the mesh);
   one programme of about 1000 knots solved by the banded
   interior point (compiled where built) and by HiGHS (scipy's linprog, dual simplex and
   IPX) on the same rows, which is why the programmes have their own solver.
@@ -74,6 +75,11 @@ OTHER_LINES = (((-0.04, 0.11), (-0.04, 0.09)), ((0.04, 0.09), (0.04, 0.11)),
 #: (m), 8 mm blends, 280 mm; its knots as ``one_size``'s line ``len(OTHER_LINES)``.
 CHAIN = ((-0.08, 0.18), (-0.02, 0.23), (0.04, 0.19), (0.08, 0.22), (0.06, 0.17), (0.02, 0.16))
 CHAIN_SIZES = (2000, 8000)
+#: The chain is planned at these fractions of each size, once each, its floor read on the
+#: medians: its SLP's programmes vary with the mesh far more than the lines' (measured at
+#: 1900, 2000 and 2100 intervals: 39, 62 and 56 programmes; at 7600, 8000 and 8400: 55, 62
+#: and 40), so one size each reads the search's path as much as the growth.
+CHAIN_SPREAD = (0.95, 1.0, 1.05)
 
 
 def chain_path():
@@ -474,20 +480,33 @@ def section_scaling(repeats: int = 5) -> None:
               f"{'met' if met[-1] else 'NOT met'}), peak {b['peak_MB']:.0f} MB")
     print(f"  the growth floor from 4000 to 16000 knots on every line: "
           f"{'met' if all(met) else 'NOT met'} ({sum(met)} of {len(met)} lines)")
-    print(f"  a blended chain of five lines (280 mm, 8 mm blends) at {CHAIN_SIZES[0]} and "
-          f"{CHAIN_SIZES[1]} knots (once each; the programmes' interior-point iterations, "
-          f"at most 60 each):")
-    a, b = (json.loads(subprocess.run(
-        [sys.executable, __file__, "--one-size", str(n), str(len(OTHER_LINES))], check=True,
-        capture_output=True, text=True).stdout.splitlines()[-1]) for n in CHAIN_SIZES)
+    print(f"  a blended chain of five lines (280 mm, 8 mm blends) at {CHAIN_SPREAD} of "
+          f"{CHAIN_SIZES[0]} and of {CHAIN_SIZES[1]} knots (each in a new process, once; the "
+          f"programmes' interior-point iterations, at most 60 each):")
+    groups = []
+    for size in CHAIN_SIZES:
+        group = []
+        for f in CHAIN_SPREAD:
+            r = json.loads(subprocess.run(
+                [sys.executable, __file__, "--one-size", str(round(f * size)),
+                 str(len(OTHER_LINES))], check=True, capture_output=True,
+                text=True).stdout.splitlines()[-1])
+            its = r["iterations"]
+            print(f"    {r['M']} knots: {r['cpu']:.2f} s, {r['programmes']} programmes, "
+                  f"{sum(its)} iterations ({sum(i >= 60 for i in its)} at the limit), "
+                  f"duration {r['duration']:.6f} s")
+            group.append(dict(r, per=r["cpu"] / r["programmes"],
+                              its=sum(its) / max(len(its), 1)))
+        groups.append({key: float(np.median([r[key] for r in group]))
+                       for key in ("M", "cpu", "per", "its", "programmes")})
+    a, b = groups
     pt, mlogm = growth(a, b)
-    for r in (a, b):
-        its = r["iterations"]
-        print(f"    {r['M']} knots: {r['cpu']:.2f} s, {r['programmes']} programmes, "
-              f"{sum(its)} iterations ({sum(i >= 60 for i in its)} at the limit), duration "
-              f"{r['duration']:.6f} s")
-    print(f"    time M^{pt:.2f} (M log M: M^{mlogm:.2f}: "
-          f"{'met' if pt <= mlogm + 0.05 else 'NOT met'})")
+    print(f"    medians: {a['cpu']:.2f} s and {b['cpu']:.2f} s, {a['programmes']:.0f} and "
+          f"{b['programmes']:.0f} programmes, {a['its']:.1f} and {b['its']:.1f} iterations "
+          f"per programme: time M^{pt:.2f} (M log M: M^{mlogm:.2f}: "
+          f"{'met' if pt <= mlogm + 0.05 else 'NOT met'}), per programme "
+          f"M^{growth(a, b, 'per')[0]:.2f}, iterations per programme "
+          f"x{b['its'] / a['its']:.2f}")
     h = rows[0]
     if "banded" in h:
         print(f"  one programme of {h['lp_M']} knots, {h['lp_rows']} rows: banded interior "
