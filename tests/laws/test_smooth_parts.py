@@ -817,3 +817,41 @@ def test_a_move_on_its_limits_after_one_programme_settles_there(monkeypatch):
     assert one.status == two.status == 0
     assert (one.solves, two.solves) == (1, 2)
     assert 0 <= one.duration / two.duration - 1 <= 1e-4
+
+
+def test_a_programme_s_box_holds_its_motion_even_at_a_negative_speed(setup):
+    """The trust region's box holds the motion's own states, so the programme (an elastic
+    penalty on its rows) is always feasible: a start's jerks on a new mesh can overshoot to
+    a speed below 0 at a knot (a new user's 28-line chain on a fine grid), and its box was
+    then [0, w + wr] with w + wr < 0, every programme failing in 1-3 iterations and the run
+    ending 28 % slower. There the box's lower side is the motion's speed (its row w >= 0
+    pulls it up); elsewhere the box is as before. The motion: the start's jerks with a
+    pulse down and up early on, meeting the ends and the pins (consistent)."""
+    model, me, J, Tk, _ = setup
+    T = float(Tk[0])
+    assert np.all(Tk == T)
+    J2 = J.copy()
+    J2[3:5] -= 300.0
+    J2[5:7] += 300.0
+    J2 = mesh.projected(me, J2 / T**3, Tk, model.length) * T**3
+    lp = slp.Programme(me, model.length)
+    for jerks in (J, J2):
+        mo = mesh.motion(me, jerks, Tk, model.length)
+        r = model.rows(mo)
+        scale, jscale = float(np.abs(mo.alpha).max()), float(np.abs(mo.J).max())
+        neg = mo.w[1:me.M].min() < 0
+        assert neg == (jerks is J2)  # (the pulse's speed: -0.075 at knot 7)
+        for delta in (0.3, 0.01):
+            use = r.F + lp.reach(r, mo, delta, scale, jscale) > -1e-9
+            prog, x0 = lp.build(r, use, mo, mo.T, delta, scale, jscale)
+            free = prog.lo < prog.hi
+            assert np.all(prog.lo <= prog.hi)
+            assert np.all((prog.lo[free] <= x0[free]) & (x0[free] <= prog.hi[free]))
+            lo_w = prog.lo[:-1].reshape(-1, 4)[1:me.M, 1]
+            wr = lp._speed_box(mo, delta)
+            expect = np.maximum(mo.w[1:me.M] - wr, 0.0)
+            if neg:
+                expect = np.where(mo.w[1:me.M] < 0, mo.w[1:me.M], expect)
+            assert np.array_equal(lo_w, expect)
+            res = banded.solve_staged(prog, x0)
+            assert res.status == 0, (delta, res.nit)

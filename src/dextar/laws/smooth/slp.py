@@ -320,7 +320,9 @@ class Programme:
         lo[inner, 2] = mo.alpha[inner] - delta * scale
         hi[inner, 2] = mo.alpha[inner] + delta * scale
         wr = self._speed_box(mo, delta)
-        lo[inner, 1] = np.maximum(mo.w[inner] - wr, 0.0)
+        # (the box holds the motion's own speed where it is below 0: a start's jerks on a
+        # new mesh can overshoot; its rows w >= 0 then pull it up)
+        lo[inner, 1] = np.minimum(np.maximum(mo.w[inner] - wr, 0.0), mo.w[inner])
         hi[inner, 1] = mo.w[inner] + wr
         Tn = knot_T(mo.Tk)
         lo[:, 3] = Tn * (1 - T_SHARE * delta)
