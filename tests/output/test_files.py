@@ -1,7 +1,9 @@
 """The one output mechanism: files appear whole, follow the umask, an output directory is
-refused unless forced and after a forced run holds that run's files only."""
+refused unless forced, is written all at once (an interrupted run leaves nothing and an
+earlier run's files as they were) and after a forced run holds that run's files only."""
 
 import os
+import signal
 import stat
 
 import pytest
@@ -72,3 +74,58 @@ def test_a_forced_run_removes_its_own_earlier_files_only(tmp_path):
         raise RuntimeError  # an interrupted run removes nothing
     assert (d / "a.png").exists() and not [p for p in tmp_path.iterdir()
                                            if p.name.startswith(".")]
+
+
+def test_an_interrupted_run_leaves_nothing_and_an_earlier_run_as_it_was(tmp_path):
+    """A run interrupted while writing (the drive's files written, the figures not yet)
+    leaves no directory, and forced into an earlier run's directory leaves that run's files
+    as they were: a new user's interrupted ``dextar program --force`` had left a new
+    setpoints.csv beside the earlier run's summary.json and drive files."""
+    names = ("setpoints.csv", "csp.csv", "summary.json")
+    d = tmp_path / "out"
+    with pytest.raises(KeyboardInterrupt), OutputDir(d, produces=names) as od:
+        od.write_text("setpoints.csv", "new")
+        od.write_text("csp.csv", "new")
+        raise KeyboardInterrupt
+    assert not d.exists() and list(tmp_path.iterdir()) == []
+    with OutputDir(d, produces=names) as od:
+        for name in names:
+            od.write_text(name, "old")
+    with pytest.raises(KeyboardInterrupt), OutputDir(d, force=True, produces=names) as od:
+        od.write_text("setpoints.csv", "new")
+        assert (d / "setpoints.csv").read_text() == "old"  # (staged until the run ends)
+        raise KeyboardInterrupt
+    assert {p.name: p.read_text() for p in d.iterdir()} == dict.fromkeys(names, "old")
+    assert [p.name for p in tmp_path.iterdir()] == ["out"]  # (no staging folder left)
+
+
+def test_a_signal_while_the_files_are_renamed_into_place_waits_for_all_of_them(
+        tmp_path, monkeypatch):
+    """An interrupt that arrives as a completed run's files are renamed into place is
+    delivered after the last one (its handler finds them all, the earlier run's stale file
+    gone)."""
+    names = ("a.csv", "b.csv", "c.csv", "d.json")
+    d = tmp_path / "out"
+    with OutputDir(d, produces=names) as od:
+        od.write_text("d.json", "old")
+    seen, sent = [], []
+    real = os.replace
+
+    def replace(src, dst):
+        if not sent:
+            sent.append(os.kill(os.getpid(), signal.SIGINT))
+        real(src, dst)
+
+    def handler(signum, frame):
+        seen.append(sorted(p.name for p in d.iterdir()))
+
+    monkeypatch.setattr(os, "replace", replace)
+    old = signal.signal(signal.SIGINT, handler)
+    try:
+        with OutputDir(d, force=True, produces=names) as od:
+            for name in names[:3]:
+                od.write_text(name, "new")
+        seen.append("finished")
+    finally:
+        signal.signal(signal.SIGINT, old)
+    assert seen == [["a.csv", "b.csv", "c.csv"], "finished"]

@@ -116,6 +116,7 @@ def run(args: argparse.Namespace, *, figures: bool = True) -> Result:
         sweep = jobs.design_sweep(sc, samples=args.samples, seed=args.seed)
     what = "sweep" if sweep.search is None else "search"
     with OutputDir(args.out, force=args.force, keep=args.resume, produces=written.DESIGN_FILES,
+                   staged=False,
                    hint=f"use --force to overwrite it or --resume to complete its {what}") as od:
         store = written.DesignsFile(od, sweep.designs if sweep.search is None else None,
                                     sweep.signature, resume=args.resume, label=shown(args.out),

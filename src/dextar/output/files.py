@@ -3,10 +3,13 @@
 One mechanism for every command: a file is written to a temporary name in its target folder
 (or in a staging folder beside an output directory) and renamed into place, so an interrupted
 run never leaves a half-written file. :class:`OutputDir` is an output directory: refused when
-it holds files unless forced (or resumed), created only when its first file is written (a
-command that fails first leaves nothing), and after a forced run it holds that run's files
-only: the files of the command's own names (``produces``) that this run did not write are
-removed; files of other names are left alone.
+it holds files unless forced (or resumed), and written all at once: its files wait in the
+staging folder until the run completes, then all are renamed into place with the
+interrupting signals held (a run interrupted or failed before that leaves nothing, not even
+the directory; after a forced run the directory holds that run's files only: the files of
+the command's own names, ``produces``, that this run did not write are removed; files of
+other names are left alone). A resumable command (a design sweep, whose rows are its
+checkpoints) writes straight into the directory instead (``staged=False``).
 """
 
 from __future__ import annotations
@@ -14,7 +17,9 @@ from __future__ import annotations
 import contextlib
 import os
 import shutil
+import signal
 import tempfile
+import threading
 from collections.abc import Collection, Iterator
 from pathlib import Path
 from typing import Any
@@ -74,41 +79,79 @@ def check_output_dir(path: Path, *, force: bool, hint: str = "use --force to ove
             raise ConfigError(f"output directory {str(path)!r} exists and is not empty; {hint}")
 
 
+#: The signals held while a run's files are renamed into place (those that end a run).
+_HELD = frozenset(getattr(signal, n) for n in ("SIGINT", "SIGTERM", "SIGHUP")
+                  if hasattr(signal, n))
+
+
+@contextlib.contextmanager
+def _signals_held() -> Iterator[None]:
+    """Hold the interrupting signals: their handlers replaced by a note of them, then put
+    back and the signals noted raised again (a mask would not do: another thread, such as
+    a BLAS worker, takes a signal the main thread masks, and Python then runs its handler
+    at once). On the main thread only (where handlers are set); elsewhere nothing."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    pending: list[int] = []
+
+    def note(signum: int, frame: object) -> None:
+        pending.append(signum)
+
+    old = {sig: signal.signal(sig, note) for sig in _HELD}
+    try:
+        yield
+    finally:
+        for sig, handler in old.items():
+            signal.signal(sig, handler)
+        for sig in pending:
+            signal.raise_signal(sig)
+
+
 class OutputDir:
     """An output directory whose files appear only when complete (see the module doc).
 
     ``produces``: the names the command may write (removed after a forced run when this run
     did not write them); ``keep``: a resumed run, the files already there are its own (no
-    check, nothing removed)."""
+    check, nothing removed); ``staged``: the files wait in the staging folder until the run
+    completes (:meth:`finish`), else each is renamed into place when written."""
 
     def __init__(self, path: str | os.PathLike[str], *, force: bool = False,
                  keep: bool = False, produces: Collection[str] = (),
-                 hint: str = "use --force to overwrite its files") -> None:
+                 hint: str = "use --force to overwrite its files", staged: bool = True
+                 ) -> None:
         """Check ``path``: refused when it exists, holds files and neither ``force`` nor
         ``keep`` is set. Nothing is created yet."""
         self.path = Path(path)
         if not keep:
             check_output_dir(self.path, force=force, hint=hint)
         self.keep = keep
+        self.staged = staged
         self.produces = frozenset(produces)
         self._staging: Path | None = None
         self.written: list[str] = []
 
     @property
     def staging(self) -> Path:
-        """The staging folder beside the directory (both created on first use)."""
+        """The staging folder beside the directory (created on first use, with the
+        directory itself unless the files are staged)."""
         if self._staging is None:
-            self.path.mkdir(parents=True, exist_ok=True)
+            if self.staged:
+                self.path.parent.mkdir(parents=True, exist_ok=True)
+            else:
+                self.path.mkdir(parents=True, exist_ok=True)
             self._staging = Path(tempfile.mkdtemp(prefix=f".{self.path.name}.staging-",
                                                   dir=self.path.parent))
         return self._staging
 
     def write_bytes(self, name: str, data: bytes) -> Path:
-        """Write ``name`` in the staging folder, then rename it into place."""
+        """Write ``name`` in the staging folder, then rename it into place (when the run
+        completes if staged); its final path."""
         tmp = self.staging / name
         tmp.write_bytes(data)
         target = self.path / name
-        os.replace(tmp, target)
+        if not self.staged:
+            os.replace(tmp, target)
         self.record(name)
         return target
 
@@ -122,14 +165,20 @@ class OutputDir:
             self.written.append(name)
 
     def finish(self) -> None:
-        """The run completed: remove the files of the command's names that this run did not
-        write (an earlier run's)."""
-        if self.keep or not self.path.is_dir():
-            return
-        for name in self.produces - set(self.written):
-            stale = self.path / name
-            if stale.is_file():
-                stale.unlink()
+        """The run completed: its staged files renamed into place and the files of the
+        command's names that this run did not write (an earlier run's) removed, with the
+        interrupting signals held (so all or none of it is done)."""
+        with _signals_held():
+            if self.staged and self._staging is not None:
+                self.path.mkdir(parents=True, exist_ok=True)
+                for name in self.written:
+                    os.replace(self._staging / name, self.path / name)
+            if self.keep or not self.path.is_dir():
+                return
+            for name in self.produces - set(self.written):
+                stale = self.path / name
+                if stale.is_file():
+                    stale.unlink()
 
     def close(self) -> None:
         """Remove the staging folder."""
