@@ -171,7 +171,13 @@ PROGRAM = ('[motors]\npeak_torque = 0.5\nmax_speed_rpm = 120\n[gravity]\nvector 
      "joint"),
     ('', "the task has no move"),
     ('[[move]]\ntype = "line"\nto = [10.0, 110.0]\nblend = 5.0\n[[move]]\ntype = "line"\n'
-     'to = [0.0, 100.0]\n', "move 0 (line), blended with move 1: blend: the path turns back"),
+     'to = [0.0, 100.0]\n', "move 0 (line), blended with move 1: the blend at the end of move "
+     "0, (10, 110) mm, into move 1: the path turns back"),
+    # (the corner named in a longer chain: the move whose blend to change, its end in mm)
+    ('[[move]]\ntype = "line"\nto = [10.0, 110.0]\nblend = 2.0\n[[move]]\ntype = "line"\n'
+     'to = [10.0, 130.0]\nblend = 2.0\n[[move]]\ntype = "line"\nto = [10.0, 115.0]\n',
+     "move 1 (line), in the motion blended from move 0: the blend at the end of move 1, "
+     "(10, 130) mm, into move 2: the path turns back by 180.0 deg"),
     ('[[move]]\ntype = "joint"\nto_deg = [0.0, 180.0]\nlaw = "min-jerk"\n',
      "move 0 (joint): at t = "),
     ('[[move]]\ntype = "joint"\nto_deg = [0.0, 180.0]\nlaw = "min-jerk"\n',

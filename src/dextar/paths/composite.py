@@ -271,7 +271,8 @@ def blended(pieces: Sequence[Path], blends: Sequence[float]) -> tuple[Composite,
     pieces ``k`` and ``k + 1``) with a blend of radius ``blends[k]``.
 
     Returns the composite path and, for each of its pieces, the index of the input piece it
-    belongs to (a blend belongs to the piece it leaves).
+    belongs to (a blend belongs to the piece it leaves). A corner that cannot be blended
+    raises :class:`ParameterError` with its index ``k`` as ``corner``.
     """
     if len(blends) != len(pieces) - 1:
         raise ParameterError("one blend per corner")
@@ -280,7 +281,11 @@ def blended(pieces: Sequence[Path], blends: Sequence[float]) -> tuple[Composite,
     out: list[Path] = []
     owner: list[int] = []
     for k in range(len(cur) - 1):
-        inc, nxt, q = blend_corner(cur[k], cur[k + 1], blends[k])
+        try:
+            inc, nxt, q = blend_corner(cur[k], cur[k + 1], blends[k])
+        except ParameterError as exc:
+            exc.corner = k  # type: ignore[attr-defined]  # (which corner, for the caller's words)
+            raise
         out += [inc, q]
         owner += [k, k]
         cur[k + 1] = nxt

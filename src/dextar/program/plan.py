@@ -736,7 +736,15 @@ def _plan_chain(ctx: PlanContext, group: list[tuple[int, Move]], state: PlanStat
     try:
         path, owner = _blended(tuple(pieces), blends)
     except ParameterError as exc:
-        raise ParameterError(f"blend: {exc}") from None
+        corner = getattr(exc, "corner", None)
+        if not isinstance(corner, int):
+            raise ParameterError(f"blend: {exc}") from None
+        x, y = (1e3 * float(v) for v in pieces[corner].position(pieces[corner].p1))
+        named = ParameterError(f"the blend at the end of move {group[corner][0]}, "
+                               f"({x:.6g}, {y:.6g}) mm, into move {group[corner + 1][0]}: "
+                               f"{exc}")
+        named.member = corner  # type: ignore[attr-defined]  # read back by _chain_name
+        raise named from None
     # the assembly modes the members ask for where they end (the next member's start)
     ends = [float(path.starts[owner.index(k + 1)]) for k in range(len(group) - 1)]
     targets = [(s_end, mv.get("assembly_mode"), move_name(i, mv))
