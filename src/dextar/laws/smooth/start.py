@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from ..._arrays import Array
+from ..._lazy import lazy_module
 from ..base import Law
 from ..constraints import (
     Constraint,
@@ -30,6 +31,8 @@ from .law import JerkLimitedLaw
 from .mesh import Mesh, make_mesh, projected
 from .rows import compiled_monitor
 from .table import DB, DG, Q1, Q2, Q3, A, B, Table, values_at
+
+ndimage = lazy_module("scipy.ndimage")
 
 
 def jumps(base: Any) -> tuple[Array, Array]:
@@ -107,12 +110,14 @@ class CapConstraint(Constraint):
 @dataclass(frozen=True)
 class Start:
     """The second-order law filtered by a moving average of width ``rho`` on a fine time
-    grid ``t`` (n,) from 0 to ``T = T2 + rho``: arc length, speed, acceleration."""
+    grid ``t`` (n,) from 0 to ``T = T2 + rho``: arc length, speed, acceleration; ``width``
+    the filter's ``rho`` (0 for a start made otherwise)."""
 
     t: Array
     s: Array
     v: Array
     a: Array
+    width: float = 0.0
 
     @property
     def T(self) -> float:
@@ -133,7 +138,33 @@ def filtered(base: Any, rho: float, length: float, n: int = 4001) -> Start:
     v = (s2 - sb) / rho
     a = (v2 - vb) / rho
     s = np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) * np.diff(t))])
-    return Start(t, s * (length / s[-1]), v, a)
+    return Start(t, s * (length / s[-1]), v, a, rho)
+
+
+def slowed_to_cap(start: Start, grid: Array, ok: Array, slack: float) -> Start:
+    """The start slowed where its speed passes ``ok`` (a speed cap at the arc lengths
+    ``grid``) by more than ``slack``: its time stretched by a factor that is at least the
+    speed's excess over the cap wherever it passes it (the excess's largest within half the
+    start's filter's width of each time, averaged over that width, so that the slowing is as
+    smooth as the start), then sampled again on as many equal times. The moving average of
+    the filter passes a short slow stretch (a blend's end, where the path's third derivative
+    jumps) far above its cap."""
+    t, s, v = start.t, start.s, start.v
+    with np.errstate(divide="ignore", invalid="ignore"):
+        over = np.where(v > 0, v / np.interp(s, grid, ok), 0.0)
+    if not over.max(initial=0.0) > 1.0 + slack:
+        return start
+    phi = np.maximum(np.nan_to_num(over, nan=0.0, posinf=0.0), 1.0)
+    dt = float(t[1] - t[0])
+    size = 2 * max(1, int(round(start.width / (2 * dt)))) + 1
+    phi = ndimage.uniform_filter1d(ndimage.maximum_filter1d(phi, size, mode="nearest"), size,
+                                   mode="nearest")
+    tw = np.concatenate([[0.0], np.cumsum(0.5 * (phi[1:] + phi[:-1]) * dt)])
+    tu = np.linspace(0.0, float(tw[-1]), len(t))
+    vu = np.interp(tu, tw, v / phi)
+    au = np.gradient(vu, tu)
+    au[0] = au[-1] = 0.0
+    return Start(tu, np.interp(tu, tw, s), vu, au, start.width)
 
 
 def fractions(start: Start, table: Table, cons: Sequence[Constraint], segments: int,
