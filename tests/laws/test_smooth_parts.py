@@ -918,7 +918,7 @@ def test_a_start_stretched_twice_or_more_is_slowed_at_the_blends_instead(tmp_pat
     whole = slp.time_scaled(model, start.start_jerks(st, me, dyn.length),
                             np.full(me.M, st.T), keep=False)
     factor = whole[0] / st.T  # (measured: 1.29 and 2.32)
-    placed, mesh_, _, Tk = solve._placed(st, tab, cons, solve.SEGMENTS, dyn.length)
+    placed, mesh_, _, Tk, _ = solve._placed(st, tab, cons, solve.SEGMENTS, dyn.length)
     ok = np.sqrt(start.third_order_cap(tab, third))
     slowed = start.slowed_to_cap(st, tab.s, ok, solve.START_SLACK)
     over = st.v / np.interp(st.s, tab.s, ok)

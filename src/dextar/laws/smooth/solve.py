@@ -276,17 +276,19 @@ def _solve(dynamics: PathDynamics, table: Table, cons: Sequence[Constraint], seg
     # the start: the second-order law, slower where the path's own third-order terms
     # (a blend's curvature changing fast) would use much of their limits at its speeds
     start = _start(dynamics, table, second, third, base, units)
-    start, mesh, J, Tk = _placed(start, table, cons, int(segments), length)
+    start, mesh, J, Tk, first = _placed(start, table, cons, int(segments), length)
+    placed: RowModel | None = first
     log.debug("%d knots; the path's joints at %s, pinned at knots %s", mesh.M + 1,
               table.joints, mesh.pins)
     scales = dict.fromkeys((c.kind for c in cons), 1.0)
     programmes = refined = tightened = stretched = retimed = 0
     delta = START_DELTA
-    fresh = True  # a new start: its duration brought within the rows first
+    fresh = False  # a new start: its duration brought within the rows first (here done)
     best: _Round | None = None
     while True:
-        model = RowModel(mesh, table, [c.scaled(scales) for c in second],
-                      [c.scaled(scales) for c in third], length)
+        model = placed or RowModel(mesh, table, [c.scaled(scales) for c in second],
+                                   [c.scaled(scales) for c in third], length)
+        placed = None  # (the start's rows, kept by time_scaled: the first programme's)
         if fresh:
             Tk = time_scaled(model, J, Tk)
             fresh = False
@@ -354,24 +356,25 @@ def _solve(dynamics: PathDynamics, table: Table, cons: Sequence[Constraint], seg
 
 
 def _placed(start: Start, table: Table, cons: Sequence[Constraint], segments: int,
-            length: float) -> tuple[Start, Mesh, Array, Array]:
+            length: float) -> tuple[Start, Mesh, Array, Array, RowModel]:
     """The start, its mesh, its jerks and their durations brought within the rows
-    (:func:`.slp.time_scaled`). A start whose rows ask its whole time stretched
-    :data:`STRETCH_GATE` times or more is slowed instead where it passes the speed cap of the
-    path's own third-order terms (:func:`.start.slowed_to_cap`) and placed again."""
+    (:func:`.slp.time_scaled`, which keeps the last rows in the model returned). A start
+    whose rows ask its whole time stretched :data:`STRETCH_GATE` times or more is slowed
+    instead where it passes the speed cap of the path's own third-order terms
+    (:func:`.start.slowed_to_cap`) and placed again."""
     second = [c for c in cons if c.order == 2]
     third = [c for c in cons if c.order == 3]
     while True:
         mesh = pinned(fractions(start, table, cons, segments, KNOT_TOL), start, table.joints)
         J = start_jerks(start, mesh, length)
-        Tk = time_scaled(RowModel(mesh, table, second, third, length), J,
-                         np.full(mesh.M, start.T), keep=False)
+        model = RowModel(mesh, table, second, third, length)
+        Tk = time_scaled(model, J, np.full(mesh.M, start.T))
         if Tk[0] < STRETCH_GATE * start.T:
-            return start, mesh, J, Tk
+            return start, mesh, J, Tk, model
         slowed = slowed_to_cap(start, table.s, np.sqrt(third_order_cap(table, third)),
                                START_SLACK)
         if slowed is start:
-            return start, mesh, J, Tk
+            return start, mesh, J, Tk, model
         log.debug("the start's rows ask its time stretched %.3g times: slowed to the cap",
                   float(Tk[0] / start.T))
         start = slowed
