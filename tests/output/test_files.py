@@ -129,3 +129,27 @@ def test_a_signal_while_the_files_are_renamed_into_place_waits_for_all_of_them(
     finally:
         signal.signal(signal.SIGINT, old)
     assert seen == [["a.csv", "b.csv", "c.csv"], "finished"]
+
+
+def test_signals_held_are_raised_once_and_recorded_names_are_not_moved(tmp_path, monkeypatch):
+    """A signal sent at every rename reaches its handler once, after the last; a name
+    counted with ``record`` (a file written into the folder some other way) is not looked
+    for in the staging folder."""
+    d = tmp_path / "out"
+    calls = []
+    real = os.replace
+
+    def replace(src, dst):
+        os.kill(os.getpid(), signal.SIGINT)
+        real(src, dst)
+
+    monkeypatch.setattr(os, "replace", replace)
+    old = signal.signal(signal.SIGINT, lambda *_: calls.append(sorted(os.listdir(d))))
+    try:
+        with OutputDir(d, produces=("a.csv", "b.csv", "c.csv")) as od:
+            for name in ("a.csv", "b.csv"):
+                od.write_text(name, "new")
+            od.record("c.csv")
+    finally:
+        signal.signal(signal.SIGINT, old)
+    assert calls == [["a.csv", "b.csv"]]

@@ -87,18 +87,27 @@ _HELD = frozenset(getattr(signal, n) for n in ("SIGINT", "SIGTERM", "SIGHUP")
 @contextlib.contextmanager
 def _signals_held() -> Iterator[None]:
     """Hold the interrupting signals: their handlers replaced by a note of them, then put
-    back and the signals noted raised again (a mask would not do: another thread, such as
-    a BLAS worker, takes a signal the main thread masks, and Python then runs its handler
-    at once). On the main thread only (where handlers are set); elsewhere nothing."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
+    back and each signal noted raised again, once (a mask would not do: another thread,
+    such as a BLAS worker, takes a signal the main thread masks, and Python then runs its
+    handler at once). Only on the main thread and for the signals whose handlers Python set
+    (a handler set from C reads as None and cannot be put back); elsewhere nothing."""
     pending: list[int] = []
 
     def note(signum: int, frame: object) -> None:
-        pending.append(signum)
+        if signum not in pending:
+            pending.append(signum)
 
-    old = {sig: signal.signal(sig, note) for sig in _HELD}
+    old: dict[int, Any] = {}
+    if threading.current_thread() is threading.main_thread():
+        for sig in _HELD:
+            handler = signal.getsignal(sig)
+            if handler is None:
+                continue
+            try:
+                signal.signal(sig, note)
+            except (ValueError, OSError):  # (a sub-interpreter: no handlers to set)
+                continue
+            old[sig] = handler
     try:
         yield
     finally:
@@ -129,6 +138,7 @@ class OutputDir:
         self.staged = staged
         self.produces = frozenset(produces)
         self._staging: Path | None = None
+        self._staged: list[str] = []  # (the names waiting in the staging folder)
         self.written: list[str] = []
 
     @property
@@ -152,6 +162,8 @@ class OutputDir:
         target = self.path / name
         if not self.staged:
             os.replace(tmp, target)
+        elif name not in self._staged:
+            self._staged.append(name)
         self.record(name)
         return target
 
@@ -166,19 +178,21 @@ class OutputDir:
 
     def finish(self) -> None:
         """The run completed: its staged files renamed into place and the files of the
-        command's names that this run did not write (an earlier run's) removed, with the
-        interrupting signals held (so all or none of it is done)."""
-        with _signals_held():
-            if self.staged and self._staging is not None:
-                self.path.mkdir(parents=True, exist_ok=True)
-                for name in self.written:
-                    os.replace(self._staging / name, self.path / name)
-            if self.keep or not self.path.is_dir():
-                return
-            for name in self.produces - set(self.written):
-                stale = self.path / name
-                if stale.is_file():
-                    stale.unlink()
+        command's names that this run did not write (an earlier run's) removed (with the
+        interrupting signals held when called by the ``with`` block's end: an interrupt
+        then acts after all of it; an error of the file system midway, a target name that
+        is a folder, still leaves it part done)."""
+        if self._staged:
+            self.path.mkdir(parents=True, exist_ok=True)
+            assert self._staging is not None
+            for name in self._staged:
+                os.replace(self._staging / name, self.path / name)
+        if self.keep or not self.path.is_dir():
+            return
+        for name in self.produces - set(self.written):
+            stale = self.path / name
+            if stale.is_file():
+                stale.unlink()
 
     def close(self) -> None:
         """Remove the staging folder."""
@@ -189,8 +203,9 @@ class OutputDir:
         return self
 
     def __exit__(self, exc_type: object, *exc: object) -> None:
-        try:
-            if exc_type is None:
-                self.finish()
-        finally:
-            self.close()
+        with _signals_held():  # (the renames and the staging folder's removal, whole)
+            try:
+                if exc_type is None:
+                    self.finish()
+            finally:
+                self.close()

@@ -286,8 +286,9 @@ def _solve(dynamics: PathDynamics, table: Table, cons: Sequence[Constraint], seg
     fresh = False  # a new start: its duration brought within the rows first (here done)
     best: _Round | None = None
     while True:
-        model = placed or RowModel(mesh, table, [c.scaled(scales) for c in second],
-                                   [c.scaled(scales) for c in third], length)
+        model = placed if placed is not None else RowModel(
+            mesh, table, [c.scaled(scales) for c in second],
+            [c.scaled(scales) for c in third], length)
         placed = None  # (the start's rows, kept by time_scaled: the first programme's)
         if fresh:
             Tk = time_scaled(model, J, Tk)
@@ -364,20 +365,21 @@ def _placed(start: Start, table: Table, cons: Sequence[Constraint], segments: in
     (:func:`.start.slowed_to_cap`) and placed again."""
     second = [c for c in cons if c.order == 2]
     third = [c for c in cons if c.order == 3]
-    while True:
+    for _ in range(START_ROUNDS):  # (one slowing brings it within the cap, as measured)
         mesh = pinned(fractions(start, table, cons, segments, KNOT_TOL), start, table.joints)
         J = start_jerks(start, mesh, length)
         model = RowModel(mesh, table, second, third, length)
         Tk = time_scaled(model, J, np.full(mesh.M, start.T))
         if Tk[0] < STRETCH_GATE * start.T:
-            return start, mesh, J, Tk, model
+            break
         slowed = slowed_to_cap(start, table.s, np.sqrt(third_order_cap(table, third)),
                                START_SLACK)
         if slowed is start:
-            return start, mesh, J, Tk, model
+            break
         log.debug("the start's rows ask its time stretched %.3g times: slowed to the cap",
                   float(Tk[0] / start.T))
         start = slowed
+    return start, mesh, J, Tk, model
 
 
 #: A path's joint closer than this fraction of its length to a grid point is that point.

@@ -152,7 +152,7 @@ def slowed_to_cap(start: Start, grid: Array, ok: Array, slack: float) -> Start:
     t, s, v = start.t, start.s, start.v
     with np.errstate(divide="ignore", invalid="ignore"):
         over = np.where(v > 0, v / np.interp(s, grid, ok), 0.0)
-    if not over.max(initial=0.0) > 1.0 + slack:
+    if not over.max(initial=0.0) > 1.0 + slack:  # (also NaN: the start as it is)
         return start
     phi = np.maximum(np.nan_to_num(over, nan=0.0, posinf=0.0), 1.0)
     dt = float(t[1] - t[0])
