@@ -89,6 +89,11 @@ def test_sizing_recomputed_from_the_setpoints(pick_place):
         assert m["peak_speed_rad_s"] == pytest.approx(np.abs(dq).max())
         assert m["energy_J"] == pytest.approx(np.trapezoid(np.maximum(tau * dq, 0), t), rel=1e-9)
         assert m["peak_torque_ratio"] <= 1 + 1e-3 and m["peak_speed_ratio"] <= 1 + 1e-3
+    # the thresholds of "fits" as the sizing applies them, stated with the result
+    from dextar.program.sizing import SIZING_TOL, SIZING_TOL_RATES
+
+    assert s["tolerances"] == {"other": SIZING_TOL, **SIZING_TOL_RATES} == {
+        "other": 1e-3, "jerk": 1e-2, "torque_rate": 1e-2}
 
 
 def test_dwell_holds_still_against_gravity(pick_place):

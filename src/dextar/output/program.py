@@ -20,6 +20,7 @@ from ..geometry import FiveBar
 from ..kinematics import workspace_map
 from ..program import ModeChoice, MoveTiming, ProgramResult, RmsFit, Sizing
 from ..program.drive import DriveUnits, PvtPoints, csp_columns, pvt_points
+from ..program.sizing import SIZING_TOLERANCES
 from .figures import new_figure, plot_workspace, png_bytes, svg_bytes, tight_layout, warm_up
 from .files import OutputDir
 from .html_page import figures, grid, page
@@ -98,7 +99,7 @@ class ProgramSummary:
                "moves": [asdict(m) for m in self.moves],
                "motors": [m.as_dict() for m in self.sizing.motors],
                "violations": [v.as_dict() for v in self.sizing.violations], "encoder_offset_deg": list(self.encoder_offset_deg),
-               "units": self.units}
+               "tolerances": SIZING_TOLERANCES, "units": self.units}
         if self.rms_fit is not None:
             out["rms_fit"] = self.rms_fit.as_dict()
         if self.mode_choice is not None:

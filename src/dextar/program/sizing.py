@@ -16,6 +16,9 @@ from .plan import ProgramResult
 SIZING_TOL = 1e-3
 #: ... for the rates measured by finite differences at the servo rate (jerk, torque rate).
 SIZING_TOL_RATES = {"jerk": 1e-2, "torque_rate": 1e-2}
+#: Both, as ``summary.json`` states them: a limit is exceeded beyond ``1 + tolerance`` times
+#: it (``other``: torque, speed, RMS torque, acceleration).
+SIZING_TOLERANCES = {"other": SIZING_TOL, **SIZING_TOL_RATES}
 
 
 @dataclass(frozen=True)
