@@ -138,7 +138,7 @@ class OutputDir:
         self.staged = staged
         self.produces = frozenset(produces)
         self._staging: Path | None = None
-        self._staged: list[str] = []  # (the names waiting in the staging folder)
+        self._waiting: list[str] = []  # (the names waiting in the staging folder)
         self.written: list[str] = []
 
     @property
@@ -162,8 +162,8 @@ class OutputDir:
         target = self.path / name
         if not self.staged:
             os.replace(tmp, target)
-        elif name not in self._staged:
-            self._staged.append(name)
+        elif name not in self._waiting:
+            self._waiting.append(name)
         self.record(name)
         return target
 
@@ -182,10 +182,10 @@ class OutputDir:
         interrupting signals held when called by the ``with`` block's end: an interrupt
         then acts after all of it; an error of the file system midway, a target name that
         is a folder, still leaves it part done)."""
-        if self._staged:
+        if self._waiting:
             self.path.mkdir(parents=True, exist_ok=True)
             assert self._staging is not None
-            for name in self._staged:
+            for name in self._waiting:
                 os.replace(self._staging / name, self.path / name)
         if self.keep or not self.path.is_dir():
             return
