@@ -142,6 +142,41 @@ def test_the_integration_is_exact_and_the_end_rows_agree():
                        rtol=1e-12, atol=1e-14)
 
 
+
+
+@pytest.mark.parametrize("pins", [40, 20])
+def test_the_projection_meets_every_pinned_knot_and_is_the_least_change(pins):
+    """The jerks projected on a mesh with many pinned knots (a long blended chain's: one
+    in ten knots, two in neighbouring knots), by the banded system (40) and by the dense
+    rows (20), meet the ends and every pinned arc length to rounding, and are the least
+    change that does: the minimum-norm solution of the dense rows (``knot_rows``) by SVD."""
+    assert (pins + 3 <= mesh.DENSE_ROWS) == (pins == 20)
+    rng = np.random.default_rng(5)
+    M = 400
+    f = np.concatenate([[0.0], np.cumsum(rng.uniform(0.5, 1.5, M))])
+    f /= f[-1]
+    pk = np.sort(rng.choice(np.arange(2, M - 2), pins, replace=False))
+    pk[1] = pk[0] + 1  # (two pinned knots in a row: a stretch of one interval)
+    Tk = np.full(M, 0.8)
+    j = rng.normal(size=M)
+    a, v, s = mesh.integrate(np.diff(f) * 0.8, j)
+    length = float(s[-1]) + 0.05
+    me = mesh.make_mesh(f, f[pk], s[pk] + 0.01 * rng.normal(size=pk.size))
+    got = mesh.projected(me, j, Tk, length)
+    a2, v2, s2 = mesh.integrate(me.h * Tk, got)
+    # (to 1e-10 of the length: the integration's rounding was 4e-12 of it here; the dense
+    # normal equations solved by least squares had left 1e-4 of it on a long chain's mesh)
+    assert np.max(np.abs(s2[me.pins] - me.pin_s)) <= 1e-10 * length
+    assert abs(a2[-1]) <= 1e-10 * np.abs(a2).max() and abs(v2[-1]) <= 1e-10 * np.abs(v2).max()
+    assert abs(s2[-1] - length) <= 1e-10 * length
+    Ea, Ev, Es = mesh.knot_rows(me.h * Tk, np.concatenate([[M], me.pins]))
+    E = np.vstack([Ea[:1], Ev[:1], Es])
+    e = np.concatenate([[0.0, 0.0, length], me.pin_s])
+    least = j + np.linalg.lstsq(E, e - E @ j, rcond=None)[0]
+    assert np.allclose(got, least, rtol=1e-7, atol=1e-7 * np.abs(least).max())
+    # (the least change: any other jerks that meet the rows change more)
+    other = least + np.linalg.svd(E)[2][-1]  # (a direction of E's null space)
+    assert np.linalg.norm(other - j) > np.linalg.norm(got - j)
 def test_the_table_finds_the_joints_and_the_derivatives(chain):
     """The blend's two joints (where the curvature's derivative jumps) found on the grid,
     and the derivative columns (``q'''``, ``a'``, ``b'``, ``g'``) against central differences

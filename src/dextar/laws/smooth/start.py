@@ -264,14 +264,20 @@ def pinned(f: Array, start: Start, joints: Array) -> Mesh:
     M = len(f) - 1
     pin_f: list[float] = []
     pin_s: list[float] = []
-    for sj in joints[(joints > 0) & (joints < s[-1])]:
-        fj = float(np.interp(sj, s, t)) / start.T
-        k = int(np.argmin(np.abs(f - fj)))
-        if 0 < k < M and not any(abs(f[k] - x) < 1e-12 for x in pin_f) and \
-                f[k - 1] < fj < f[k + 1]:
+    taken: set[int] = set()
+    inner = joints[(joints > 0) & (joints < s[-1])]
+    for sj, fj in zip(inner.tolist(), (np.interp(inner, s, t) / start.T).tolist(),
+                      strict=True):
+        # the nearest knot (the first of two as near; the knots stay increasing as each
+        # pinned one stays between its neighbours), by bisection: a long chain has
+        # hundreds of joints and thousands of knots
+        i = int(np.searchsorted(f, fj))
+        k = i - 1 if i > M or (i > 0 and fj - f[i - 1] <= f[i] - fj) else i
+        if 0 < k < M and k not in taken and f[k - 1] < fj < f[k + 1]:
             f[k] = fj
+            taken.add(k)
             pin_f.append(fj)
-            pin_s.append(float(sj))
+            pin_s.append(sj)
     return make_mesh(f, np.asarray(pin_f, float), np.asarray(pin_s, float))
 
 
