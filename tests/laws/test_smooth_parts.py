@@ -963,3 +963,48 @@ def test_a_start_stretched_twice_or_more_is_slowed_at_the_blends_instead(tmp_pat
         # 1.861 s against 2.143 s stretched whole; the plans 1.039 s and 1.098 s)
         assert Tk[0] / placed.T <= 1.3
         assert float(Tk @ mesh_.h) < factor * st.T
+
+
+@pytest.mark.parametrize("floor", [start.STRETCH_INTERVALS, 0])
+def test_a_slow_start_s_knots_leave_every_joint_a_stretch(tmp_path, monkeypatch, floor):
+    """The knots of a start far slower than its limits (a start slowed to the cap many
+    times: its rows change slowly in time, and the monitor asks few knots) still give every
+    stretch between two of the path's joints at least about ``STRETCH_INTERVALS``: every
+    joint is pinned and its jerks placed within the limits need no more time than the
+    start at its own speed. Without that floor (``floor = 0``, the check must fail) the
+    trial's six lines slowed 20 times had 17 intervals for 10 joints, one joint left
+    unpinned, stretches of one interval, and the placed motion 1.388 s against 1.256 s
+    (with it: 45 intervals, stretches of 3 or more, 1.201 s). A 224-line spiral slowed
+    12.7 times had been placed with 752 knots for 450 joints and its search came out 20 %
+    slower."""
+    from dextar.config import load_scenario
+    from dextar.program.plan import chain_grid
+
+    monkeypatch.setattr(start, "STRETCH_INTERVALS", floor)
+    cfg = tmp_path / "robot.toml"
+    cfg.write_text(TRIAL_ROBOT)
+    sc = load_scenario(str(cfg))
+    pts = [tuple(1e-3 * np.asarray(p)) for p in TRIAL_CHAIN]
+    path, _ = blended([Line(a, b) for a, b in zip(pts, pts[1:], strict=False)],
+                      (0.006,) * (len(pts) - 2))
+    dyn = RobotAlongPath(sc.si_model, path, sc.mode)
+    cons = motor_constraints(sc.si_motors)
+    second = [c for c in cons if c.order == 2]
+    third = [c for c in cons if c.order == 3]
+    tab = table.make_table(dyn, solve.with_joints(dyn, chain_grid(path, 400)))
+    base = solve._second_order(dyn, tab, second, None)
+    st = solve._start(dyn, tab, second, third, base, None)
+
+    def placed(s: start.Start) -> tuple[object, float]:
+        me = start.pinned(start.fractions(s, tab, cons, 16, solve.KNOT_TOL), s, tab.joints)
+        model = rows.RowModel(me, tab, second, third, dyn.length)
+        Tk = slp.time_scaled(model, start.start_jerks(s, me, dyn.length),
+                             np.full(me.M, s.T), keep=False)
+        return me, float(Tk @ me.h)
+
+    own = placed(st)[1]  # (measured: 1.246 s without the floor, 1.256 s with it)
+    me, slow = placed(start.Start(st.t * 20, st.s, st.v / 20, st.a / 400))
+    stretches = np.diff(np.concatenate([[0], me.pins, [me.M]]))
+    good = (len(me.pins) == len(tab.joints) and stretches.min() >= 3
+            and slow <= 1.05 * own)  # (measured: 1.201 s, 1.388 s without the floor)
+    assert good == (floor > 0), (len(me.pins), len(tab.joints), stretches.min(), slow, own)
