@@ -1008,3 +1008,41 @@ def test_a_slow_start_s_knots_leave_every_joint_a_stretch(tmp_path, monkeypatch,
     good = (len(me.pins) == len(tab.joints) and stretches.min() >= 3
             and slow <= 1.05 * own)  # (measured: 1.201 s, 1.388 s without the floor)
     assert good == (floor > 0), (len(me.pins), len(tab.joints), stretches.min(), slow, own)
+
+
+@pytest.mark.parametrize("remesh", [solve.REMESH, np.inf])
+def test_a_run_settled_on_knots_too_coarse_for_its_motion_is_solved_on_its_own(
+        tmp_path, monkeypatch, remesh):
+    """A search from a start eight times slower than the trial's six lines' (its knots
+    placed for that slow motion: 51 intervals) that settles on them is solved again on the
+    knots its own motion's rows ask (``fractions``): the law's intervals are within
+    ``REMESH`` of those (measured: 115 of 118, 0.9175 s against 0.9290 s). Without the rule
+    (``remesh = inf``, the check must fail) it ends on 51 intervals where its motion asks
+    115."""
+    from dextar.config import load_scenario
+    from dextar.program.plan import chain_grid
+
+    factor = solve.REMESH
+    monkeypatch.setattr(solve, "REMESH", remesh)
+    cfg = tmp_path / "robot.toml"
+    cfg.write_text(TRIAL_ROBOT)
+    sc = load_scenario(str(cfg))
+    pts = [tuple(1e-3 * np.asarray(p)) for p in TRIAL_CHAIN]
+    path, _ = blended([Line(a, b) for a, b in zip(pts, pts[1:], strict=False)],
+                      (0.006,) * (len(pts) - 2))
+    dyn = RobotAlongPath(sc.si_model, path, sc.mode)
+    cons = motor_constraints(sc.si_motors)
+    tab = table.make_table(dyn, solve.with_joints(dyn, chain_grid(path, 400)))
+    own_start = solve._start
+
+    def slow(*args: object) -> start.Start:
+        st = own_start(*args)
+        return start.Start(st.t * 8, st.s, st.v / 8, st.a / 64, st.width * 8)
+
+    monkeypatch.setattr(solve, "_start", slow)
+    law = solve._solve(dyn, tab, cons, solve.SEGMENTS, 1e-3, solve.RATE_TOL, None).law
+    assert law.status == 0
+    own = start.without_idle(law, always=True)
+    assert own is not None
+    asked = len(start.fractions(own, tab, cons, solve.SEGMENTS, solve.KNOT_TOL)) - 1
+    assert (law.jerk.size * factor >= asked) == np.isfinite(remesh), (law.jerk.size, asked)
