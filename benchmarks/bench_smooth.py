@@ -3,7 +3,7 @@ to the second-order law as the jerk limit grows, its planning time per pick-and-
 against the second-order law's, the issue's programs, and its growth with the knots.
 
 Run: python benchmarks/bench_smooth.py [ruckig] [convergence] [moves] [programs] [blends]
-[scaling]
+[scaling] [length]
 (all sections without arguments; ruckig: pip install -e '.[bench]').
 
 Floors (issue 29):
@@ -26,6 +26,10 @@ Floors (issue 29):
   one programme of about 1000 knots solved by the banded
   interior point (compiled where built) and by HiGHS (scipy's linprog, dual simplex and
   IPX) on the same rows, which is why the programmes have their own solver.
+
+The length section plans blended spirals of 28 to 224 lines as programs, on their own grid
+and mesh (the knots grow with the length, as a user's long program's do): the planning
+time's growth with the length, read against the same floor (L log L + 0.05, L the lines).
 
 The blends section plans 40 random blended corners through the API (no floor: how often the
 programmes settle, at what cost, how far from the second-order law and from the same corner
@@ -359,19 +363,13 @@ def one_size(segments: int, line: int = -1) -> dict[str, Any]:
         iterations.append(out.nit)
         return out
 
-    def status(key: str) -> float:
-        for line in Path("/proc/self/status").read_text().splitlines():
-            if line.startswith(key):
-                return float(line.split()[1]) / 1024
-        return float("nan")
-
     slp.solve_staged = keep
     Path("/proc/self/clear_refs").write_text("5")
-    base = status("VmRSS")
+    base = _status("VmRSS")
     t0, c0 = time.perf_counter(), time.process_time()
     law = solve_jerk_limited_law(mv, motors=motors, grid=400, segments=segments)
     cpu, wall = time.process_time() - c0, time.perf_counter() - t0
-    peak = status("VmHWM") - base
+    peak = _status("VmHWM") - base
     slp.solve_staged = real
     out = {"M": law.jerk.size, "cpu": cpu, "wall": wall, "peak_MB": peak,
            "programmes": law.solves, "iterations": iterations, "duration": law.duration,
@@ -379,6 +377,83 @@ def one_size(segments: int, line: int = -1) -> dict[str, Any]:
     if segments == SIZES[0] and line < 0:  # one programme of that size, by HiGHS too
         out.update(highs(*captured[0]))
     return out
+
+
+#: Long blended chains (the length of a program, at its own grid): a spiral of ``n`` lines,
+#: 10 a lap about (0, 195) mm, its semi-axes breathing from 70 x 35 mm to 45 x 22.5 mm and
+#: back every four laps (lines of 16 to 43 mm), 5 mm blends, planned as a program (the
+#: example's robot and motors).
+LENGTHS = (28, 56, 112, 224)
+#: Each length is planned from these starting angles (deg) on the spiral, its figures read on
+#: the medians: the local search's path makes a program's planning vary nearly as much as
+#: its length (the 112 lines: 8.4 to 10.7 s CPU, 2095 to 2978 intervals, cycles 11.83 to
+#: 13.19 s).
+LENGTH_PHASES = (0.0, 12.0, 24.0)
+
+
+def spiral(n: int, phase: float = 0.0) -> str:
+    """The program of a blended spiral of ``n`` lines from ``phase`` deg (see
+    :data:`LENGTHS`)."""
+    k = np.arange(n + 1)
+    big = 57.5 + 12.5 * np.cos(np.pi * k / 20.0)
+    th = k * np.pi / 5 + np.radians(phase)
+    x, y = big * np.cos(th), 195.0 + 0.5 * big * np.sin(th)
+    moves = "".join(f'[[move]]\ntype = "line"\nto = [{x[i]:.3f}, {y[i]:.3f}]\n'
+                    f'blend = {5.0 if i < n else 0.0}\n' for i in range(1, n + 1))
+    text = program_text(moves)
+    return text.replace("start = [-60.0, 200.0]", f"start = [{x[0]:.3f}, {y[0]:.3f}]")
+
+
+def one_length(n: int, phase: float = 0.0) -> dict[str, Any]:
+    """Plan the spiral of ``n`` lines from ``phase`` deg in this process: CPU time, peak
+    resident memory above the process's after a warm-up (as :func:`one_size`), intervals,
+    programmes, cycle."""
+    with tempfile.TemporaryDirectory() as tmp:
+        plan_once(spiral(14), Path(tmp), "warm")
+        cfg = Path(tmp) / "spiral.toml"
+        cfg.write_text(spiral(n, phase))
+        req = load_scenario(str(cfg)).program_request()
+        Path("/proc/self/clear_refs").write_text("5")
+        base = _status("VmRSS")
+        c0 = time.process_time()
+        res = req.plan()
+        cpu = time.process_time() - c0
+        peak = _status("VmHWM") - base
+    law = res.moves[0].law
+    return {"lines": n, "M": int(law.jerk.size), "cpu": cpu, "peak_MB": peak,
+            "programmes": int(law.solves), "cycle": res.cycle_time_s,
+            "status": int(law.status)}
+
+
+def _status(key: str) -> float:
+    """A figure of /proc/self/status in MB (Linux)."""
+    for line in Path("/proc/self/status").read_text().splitlines():
+        if line.startswith(key):
+            return float(line.split()[1]) / 1024
+    return float("nan")
+
+
+def section_length() -> None:
+    """Planning time and memory against a program's length: :data:`LENGTHS`."""
+    print(f"length: blended spirals of {LENGTHS} lines (5 mm blends) planned as programs, the "
+          f"example's robot and motors, the program's own grid, from {LENGTH_PHASES} deg "
+          f"(each in a new process, once; the medians read; load {load()} at the start):")
+    print("   lines  phase       M  CPU s  programmes  CPU s/line  peak MB  cycle s")
+    rows = []
+    for n in LENGTHS:
+        runs = [in_new_process(n, round(p), kind="--one-length") for p in LENGTH_PHASES]
+        for p, r in zip(LENGTH_PHASES, runs, strict=True):
+            print(f"  {n:6d} {p:6.0f} {r['M']:7d} {r['cpu']:6.2f} {r['programmes']:11d} "
+                  f"{r['cpu'] / n:11.3f} {r['peak_MB']:8.1f}  {r['cycle']:.4f}")
+        rows.append({"lines": n, **{key: float(np.median([r[key] for r in runs]))
+                                    for key in ("M", "cpu", "programmes", "peak_MB")}})
+    print("  medians:")
+    for a, b in zip(rows, rows[1:], strict=False):
+        pt, mlogm = growth(dict(a, M=a["lines"]), dict(b, M=b["lines"]))
+        print(f"    {a['lines']} -> {b['lines']} lines: {a['cpu']:.2f} -> {b['cpu']:.2f} s, "
+              f"time L^{pt:.2f} (L log L: L^{mlogm:.2f}: {floor(pt, mlogm)}), intervals "
+              f"x{b['M'] / a['M']:.2f}, programmes x{b['programmes'] / a['programmes']:.2f}, "
+              f"peak memory {b['peak_MB']:.0f} MB")
 
 
 def highs(lp, x0) -> dict[str, float]:
@@ -412,9 +487,11 @@ def highs(lp, x0) -> dict[str, float]:
     return out
 
 
-def in_new_process(segments: int, line: int = -1) -> dict[str, Any]:
-    """:func:`one_size` in a new process (its time and memory its own)."""
-    p = subprocess.run([sys.executable, __file__, "--one-size", str(segments), str(line)],
+def in_new_process(segments: int, line: int = -1, kind: str = "--one-size"
+                   ) -> dict[str, Any]:
+    """:func:`one_size` (or with ``kind = "--one-length"`` :func:`one_length` of
+    ``segments`` lines from ``line`` deg) in a new process (its time and memory its own)."""
+    p = subprocess.run([sys.executable, __file__, kind, str(segments), str(line)],
                        check=True, capture_output=True, text=True)
     return dict(json.loads(p.stdout.splitlines()[-1]))
 
@@ -523,12 +600,15 @@ def section_scaling(repeats: int = 5) -> None:
 
 SECTIONS = {"ruckig": section_ruckig, "convergence": section_convergence,
             "moves": section_moves, "programs": section_programs, "blends": section_blends,
-            "scaling": section_scaling}
+            "scaling": section_scaling, "length": section_length}
 
 
 def main(argv: list[str]) -> None:
     if argv[:1] == ["--one-size"]:
         print(json.dumps(one_size(int(argv[1]), int(argv[2]) if len(argv) > 2 else -1)))
+        return
+    if argv[:1] == ["--one-length"]:
+        print(json.dumps(one_length(int(argv[1]), float(argv[2]))))
         return
     for name in argv or list(SECTIONS):
         SECTIONS[name]()
