@@ -401,6 +401,7 @@ def spiral(n: int, phase: float = 0.0) -> str:
     moves = "".join(f'[[move]]\ntype = "line"\nto = [{x[i]:.3f}, {y[i]:.3f}]\n'
                     f'blend = {5.0 if i < n else 0.0}\n' for i in range(1, n + 1))
     text = program_text(moves)
+    assert "start = [-60.0, 200.0]" in text  # (the example's start, replaced)
     return text.replace("start = [-60.0, 200.0]", f"start = [{x[0]:.3f}, {y[0]:.3f}]")
 
 

@@ -321,14 +321,16 @@ def _solve(dynamics: PathDynamics, table: Table, cons: Sequence[Constraint], seg
                 best = _Round(law, ratio, bad, mesh, run, refined, stretched)
             again = (without_idle(law, always=not run.converged) if retimed < MAX_RETIME
                      else None)
+            asked = None
             if again is None and retimed < MAX_RETIME:
                 # settled, on knots placed for a slower motion than the one reached: again
                 # on the knots its own rows ask, where they are many more
                 own = without_idle(law, always=True)
                 assert own is not None
-                if len(fractions(own, table, cons, int(segments), KNOT_TOL)) - 1 > \
-                        REMESH * mesh.M:
-                    log.debug("settled on %d knots, its motion asks more: again", mesh.M)
+                asked = fractions(own, table, cons, int(segments), KNOT_TOL)
+                if len(asked) - 1 > REMESH * mesh.M:
+                    log.debug("settled on %d intervals, its motion asks %d: again", mesh.M,
+                              len(asked) - 1)
                     again = own
             if again is None:
                 break
@@ -336,8 +338,9 @@ def _solve(dynamics: PathDynamics, table: Table, cons: Sequence[Constraint], seg
             # end, or the programmes had not settled: again from it, with that time cut out
             # and the knots placed anew (denser where its rows change fast)
             retimed += 1
-            mesh = pinned(fractions(again, table, cons, int(segments), KNOT_TOL), again,
-                          table.joints)
+            if asked is None:
+                asked = fractions(again, table, cons, int(segments), KNOT_TOL)
+            mesh = pinned(asked, again, table.joints)
             J, Tk = start_jerks(again, mesh, length), np.full(mesh.M, again.T)
             log.debug("re-timed: %d knots, %.9g s", mesh.M + 1, again.T)
             fresh, delta, refined = True, START_DELTA, 0

@@ -212,11 +212,12 @@ def fractions(start: Start, table: Table, cons: Sequence[Constraint], segments: 
     dt = t[1] - t[0]
     c2 = _monitor(table, s, v, a, kinds, lims, dt)
     density = np.maximum(np.sqrt(c2 / (32 * tol)), segments / start.T)
-    # between two of the path's joints (pinned knots) at least STRETCH_INTERVALS
+    # between two of the path's joints (pinned knots) at least STRETCH_INTERVALS (a span
+    # shorter than two samples as two samples: the density is sampled, and bounded)
     tj = np.interp(table.joints[(table.joints > 0) & (table.joints < s[-1])], s, t)
     if tj.size:
         edges = np.concatenate([[0.0], tj, [t[-1]]])
-        span = np.maximum(np.diff(edges), 1e-12 * start.T)
+        span = np.maximum(np.diff(edges), 2 * dt)
         density = np.maximum(density, STRETCH_INTERVALS / span[
             np.clip(np.searchsorted(edges, t, side="right") - 1, 0, len(span) - 1)])
     cdf = np.concatenate([[0.0], np.cumsum(0.5 * (density[1:] + density[:-1]) * dt)])
