@@ -172,18 +172,24 @@ def projected(mesh: Mesh, j: Array, Tk: Array, length: float) -> Array:
     if len(pk) + 3 <= DENSE_ROWS or not well:
         E = _rows(u, pk)
         G = np.einsum("ik,jk->ij", E, E)
-        x = jn
+        x, r = jn, e - np.einsum("ij,j->i", E, jn)
         try:
-            for _ in range(3):  # (the solve, then two refinements)
-                r = e - np.einsum("ij,j->i", E, x)
+            for tol in (1e-12, 1e-12, PROJECTION_TOL):  # (the solve, refined where it misses)
                 x = x + np.einsum("i,ij->j", np.linalg.solve(G, r), E)
+                r = e - np.einsum("ij,j->i", E, x)
+                # (each row's miss against its terms' size: the rounding's scale)
+                if np.all(np.abs(r) <= tol * (np.einsum("ij,j->i", np.abs(E), np.abs(x))
+                                              + np.abs(e))):
+                    return np.asarray(x / T**3)
         except np.linalg.LinAlgError:
-            x = jn + np.full(M, np.nan)
+            pass
     else:
         x = jn + _banded(u, jn, pk, e)
-    if not _meets(u, x, pk, e):
+        if _meets(u, x, pk, e):
+            return np.asarray(x / T**3)
         E = _rows(u, pk)
-        x = jn + np.linalg.lstsq(E, e - E @ jn, rcond=None)[0]
+    # (pinned knots too close to be met: the least miss)
+    x = jn + np.linalg.lstsq(E, e - E @ jn, rcond=None)[0]
     return np.asarray(x / T**3)
 
 

@@ -76,14 +76,16 @@ MAX_STRETCH = 6
 #: rounds 0-1 did not settle, 0.2-0.3 % on average, up to 4.3 %, for 13-15 % more CPU time
 #: on those corners (the programs that settle are unchanged).
 MAX_RETIME = 6
-#: A run that settles on knots fewer than its own motion's rows ask (:func:`.start.fractions`
-#: on it) by more than this factor is solved again on those (counted as a re-timing): knots
-#: placed for a slow start (one slowed to the cap, :func:`_placed`) are too coarse for the
-#: faster motion the programmes reach. Measured on blended spirals of 28 to 224 lines
-#: (``bench_smooth.py length``, three starting angles each): 7 of 12 plans 1.2 to 5.9 %
-#: faster, none slower, for 36 % more CPU time in all; at 1.25, 6 of 12 (one by 1.3 % instead
-#: of 2.2 %), 21 % more. Of 160 random corners 24 were solved again: -0.05 % on average
-#: (-1.1 to +0.05 %), 1-2 % more CPU time (at 1.25 none).
+#: A run that settles faster than the motion its knots were placed for by more than this
+#: factor, on knots fewer than its own motion's rows ask (:func:`.start.fractions` on it) by
+#: more than it, is solved again on those (counted as a re-timing): knots placed for a slow
+#: start (one slowed to the cap, :func:`_placed`) are too coarse for the faster motion the
+#: programmes reach (the first test spares a short move the monitor's cost). Measured on
+#: blended spirals of 28 to 224 lines (``bench_smooth.py length``, three starting angles
+#: each): 7 of 12 plans 0.6 to 5.9 % faster, none slower, for 27 % more CPU time in all
+#: (1.25: 6 of 12; without the first test one of them 2.2 % faster instead of 0.6 %, but
+#: every settled move paid the monitor: a pick-and-place move 1.93 times the second-order
+#: law's planning time instead of 1.78). Random corners: within the local search's spread.
 REMESH = 1.1
 #: Rounds of the start's cap (see :func:`_start`), and the excess over it accepted.
 START_ROUNDS = 4
@@ -286,6 +288,7 @@ def _solve(dynamics: PathDynamics, table: Table, cons: Sequence[Constraint], seg
     # (a blend's curvature changing fast) would use much of their limits at its speeds
     start = _start(dynamics, table, second, third, base, units)
     start, mesh, J, Tk, first = _placed(start, table, cons, int(segments), length)
+    placed_T = start.T  # (the duration of the motion the knots were placed for)
     placed: RowModel | None = first
     log.debug("%d knots; the path's joints at %s, pinned at knots %s", mesh.M + 1,
               table.joints, mesh.pins)
@@ -322,7 +325,7 @@ def _solve(dynamics: PathDynamics, table: Table, cons: Sequence[Constraint], seg
             again = (without_idle(law, always=not run.converged) if retimed < MAX_RETIME
                      else None)
             asked = None
-            if again is None and retimed < MAX_RETIME:
+            if again is None and retimed < MAX_RETIME and law.duration * REMESH < placed_T:
                 # settled, on knots placed for a slower motion than the one reached: again
                 # on the knots its own rows ask, where they are many more
                 own = without_idle(law, always=True)
@@ -342,6 +345,7 @@ def _solve(dynamics: PathDynamics, table: Table, cons: Sequence[Constraint], seg
                 asked = fractions(again, table, cons, int(segments), KNOT_TOL)
             mesh = pinned(asked, again, table.joints)
             J, Tk = start_jerks(again, mesh, length), np.full(mesh.M, again.T)
+            placed_T = again.T
             log.debug("re-timed: %d knots, %.9g s", mesh.M + 1, again.T)
             fresh, delta, refined = True, START_DELTA, 0
             continue
