@@ -178,10 +178,9 @@ def test_the_projection_meets_every_pinned_knot_and_is_the_least_change(pins):
     pk[1] = pk[0] + 1  # (two pinned knots in a row: a stretch of one interval)
     me, j, Tk, length = _pinned_mesh(M, pk, 5)
     got = mesh.projected(me, j, Tk, length)
-    # (measured: 1.2e-13 and 1.8e-10 of the length, the dense rows refined until their
-    # misses are rounding against their terms' size; the dense normal equations solved by
+    # (measured: 1.2e-13 and 1.8e-13 of the length; the dense normal equations solved by
     # least squares, in physical units, had left 1e-4 of it on a long chain's mesh)
-    assert _misses(me, got, Tk, length) <= mesh.PROJECTION_TOL
+    assert _misses(me, got, Tk, length) <= 1e-10
     Ea, Ev, Es = mesh.knot_rows(me.h * Tk, np.concatenate([[M], me.pins]))
     E = np.vstack([Ea[:1], Ev[:1], Es])
     Q = np.linalg.qr(E.T)[0]
