@@ -949,17 +949,9 @@ TRIAL_CHAIN = ((140.0, 235.0), (123.658, 266.902), (83.859, 291.334), (29.317, 3
                (-28.705, 302.374), (-78.716, 287.878), (-111.270, 263.706))
 
 
-@pytest.mark.parametrize("segments", [400, 1600])
-def test_a_start_stretched_twice_or_more_is_slowed_at_the_blends_instead(tmp_path, segments):
-    """A start (the second-order law, filtered) whose rows ask its whole time stretched
-    ``STRETCH_GATE`` times or more is slowed instead where it passes the speed cap of the
-    path's own third-order terms (a blend's end, where the third derivative jumps): slowed
-    there, its speed within the cap (to START_SLACK), and placed again it needs its time
-    stretched far less. On a program grid of 1600 the filter passed this chain's 6 mm
-    blends' ends at 3 times the cap: a joint jerk 11.5 times the limit, the whole motion
-    stretched 2.3 times before the first programme and the plan 25 % slower than on the
-    default grid (1.098 s against 0.881 s; now 1.039 s). On the default grid (1.29 times)
-    the start is stretched whole, as before."""
+def _trial_chain(tmp_path, grid: int):
+    """The trial's six lines with its robot and motors: the robot along them, the motors'
+    constraints and the table on a program's grid of ``grid``."""
     from dextar.config import load_scenario
     from dextar.program.plan import chain_grid
 
@@ -971,9 +963,23 @@ def test_a_start_stretched_twice_or_more_is_slowed_at_the_blends_instead(tmp_pat
                       (0.006,) * (len(pts) - 2))
     dyn = RobotAlongPath(sc.si_model, path, sc.mode)
     cons = motor_constraints(sc.si_motors)
+    return dyn, cons, table.make_table(dyn, solve.with_joints(dyn, chain_grid(path, grid)))
+
+
+@pytest.mark.parametrize("segments", [400, 1600])
+def test_a_start_stretched_twice_or_more_is_slowed_at_the_blends_instead(tmp_path, segments):
+    """A start (the second-order law, filtered) whose rows ask its whole time stretched
+    ``STRETCH_GATE`` times or more is slowed instead where it passes the speed cap of the
+    path's own third-order terms (a blend's end, where the third derivative jumps): slowed
+    there, its speed within the cap (to START_SLACK), and placed again it needs its time
+    stretched far less. On a program grid of 1600 the filter passed this chain's 6 mm
+    blends' ends at 3 times the cap: a joint jerk 11.5 times the limit, the whole motion
+    stretched 2.3 times before the first programme and the plan 25 % slower than on the
+    default grid (1.098 s against 0.881 s; now 1.039 s). On the default grid (1.29 times)
+    the start is stretched whole, as before."""
+    dyn, cons, tab = _trial_chain(tmp_path, segments)
     second = [c for c in cons if c.order == 2]
     third = [c for c in cons if c.order == 3]
-    tab = table.make_table(dyn, solve.with_joints(dyn, chain_grid(path, segments)))
     base = solve._second_order(dyn, tab, second, None)
     st = solve._start(dyn, tab, second, third, base, None)
     me = start.pinned(start.fractions(st, tab, cons, solve.SEGMENTS, solve.KNOT_TOL), st,
@@ -1013,21 +1019,10 @@ def test_a_slow_start_s_knots_leave_every_joint_a_stretch(tmp_path, monkeypatch,
     (with it: 45 intervals, stretches of 3 or more, 1.201 s). A 224-line spiral slowed
     12.7 times had been placed with 752 knots for 450 joints and its search came out 20 %
     slower."""
-    from dextar.config import load_scenario
-    from dextar.program.plan import chain_grid
-
     monkeypatch.setattr(start, "STRETCH_INTERVALS", floor)
-    cfg = tmp_path / "robot.toml"
-    cfg.write_text(TRIAL_ROBOT)
-    sc = load_scenario(str(cfg))
-    pts = [tuple(1e-3 * np.asarray(p)) for p in TRIAL_CHAIN]
-    path, _ = blended([Line(a, b) for a, b in zip(pts, pts[1:], strict=False)],
-                      (0.006,) * (len(pts) - 2))
-    dyn = RobotAlongPath(sc.si_model, path, sc.mode)
-    cons = motor_constraints(sc.si_motors)
+    dyn, cons, tab = _trial_chain(tmp_path, 400)
     second = [c for c in cons if c.order == 2]
     third = [c for c in cons if c.order == 3]
-    tab = table.make_table(dyn, solve.with_joints(dyn, chain_grid(path, 400)))
     base = solve._second_order(dyn, tab, second, None)
     st = solve._start(dyn, tab, second, third, base, None)
 
@@ -1054,19 +1049,8 @@ def test_a_run_settled_on_knots_too_coarse_for_its_motion_is_solved_on_its_own(
     knots its own motion's rows ask (``fractions``: 115; measured: the law on 115
     intervals, 0.9175 s against 0.9290 s). Without the rule (``remesh = inf``, the check
     must fail) it ends on the 51."""
-    from dextar.config import load_scenario
-    from dextar.program.plan import chain_grid
-
     monkeypatch.setattr(solve, "REMESH", remesh)
-    cfg = tmp_path / "robot.toml"
-    cfg.write_text(TRIAL_ROBOT)
-    sc = load_scenario(str(cfg))
-    pts = [tuple(1e-3 * np.asarray(p)) for p in TRIAL_CHAIN]
-    path, _ = blended([Line(a, b) for a, b in zip(pts, pts[1:], strict=False)],
-                      (0.006,) * (len(pts) - 2))
-    dyn = RobotAlongPath(sc.si_model, path, sc.mode)
-    cons = motor_constraints(sc.si_motors)
-    tab = table.make_table(dyn, solve.with_joints(dyn, chain_grid(path, 400)))
+    dyn, cons, tab = _trial_chain(tmp_path, 400)
     own_start = solve._start
 
     def slow(*args: object) -> start.Start:
