@@ -1063,3 +1063,24 @@ def test_a_run_settled_on_knots_too_coarse_for_its_motion_is_solved_on_its_own(
     assert law.status == 0
     again = [r.getMessage() for r in caplog.records if r.getMessage().startswith("settled on")]
     assert bool(again) == np.isfinite(remesh), again
+
+
+def test_a_start_placed_every_round_is_returned_with_its_own_knots(tmp_path, monkeypatch):
+    """With every round's start asking to be slowed (``STRETCH_GATE = 0``) and every
+    slowing giving a new one (here 10 % slower whole), ``_placed`` returns after
+    ``START_ROUNDS`` the start its knots were placed for (before, the last round slowed it
+    once more and returned it with the previous start's knots: the duration of the motion
+    they were placed for, which the re-mesh rule compares, was wrong)."""
+    monkeypatch.setattr(solve, "STRETCH_GATE", 0.0)
+    monkeypatch.setattr(solve, "slowed_to_cap", lambda s, *args: start.Start(
+        s.t * 1.1, s.s, s.v / 1.1, s.a / 1.21, s.width * 1.1))
+    dyn, cons, tab = _trial_chain(tmp_path, 1600)
+    second = [c for c in cons if c.order == 2]
+    third = [c for c in cons if c.order == 3]
+    base = solve._second_order(dyn, tab, second, None)
+    st = solve._start(dyn, tab, second, third, base, None)
+    placed, me, _, _, _ = solve._placed(st, tab, cons, solve.SEGMENTS, dyn.length)
+    assert placed is not st  # (slowed at least once)
+    own = start.pinned(start.fractions(placed, tab, cons, solve.SEGMENTS, solve.KNOT_TOL),
+                       placed, tab.joints)
+    assert np.array_equal(own.f, me.f) and np.array_equal(own.pins, me.pins)

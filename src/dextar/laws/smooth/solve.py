@@ -390,13 +390,13 @@ def _placed(start: Start, table: Table, cons: Sequence[Constraint], segments: in
     (:func:`.start.slowed_to_cap`) and placed again."""
     second = [c for c in cons if c.order == 2]
     third = [c for c in cons if c.order == 3]
-    for _ in range(START_ROUNDS):  # (one slowing brings it within the cap, as measured)
+    for i in range(START_ROUNDS):  # (one slowing brings it within the cap, as measured)
         mesh = pinned(fractions(start, table, cons, segments, KNOT_TOL), start, table.joints)
         J = start_jerks(start, mesh, length)
         model = RowModel(mesh, table, second, third, length)
         Tk = time_scaled(model, J, np.full(mesh.M, start.T))
-        if Tk[0] < STRETCH_GATE * start.T:
-            break
+        if Tk[0] < STRETCH_GATE * start.T or i == START_ROUNDS - 1:
+            break  # (the last round's start is the one its knots were placed for)
         slowed = slowed_to_cap(start, table.s, np.sqrt(third_order_cap(table, third)),
                                START_SLACK)
         if slowed is start:
