@@ -364,12 +364,8 @@ def one_size(segments: int, line: int = -1) -> dict[str, Any]:
         return out
 
     slp.solve_staged = keep
-    Path("/proc/self/clear_refs").write_text("5")
-    base = _status("VmRSS")
-    t0, c0 = time.perf_counter(), time.process_time()
-    law = solve_jerk_limited_law(mv, motors=motors, grid=400, segments=segments)
-    cpu, wall = time.process_time() - c0, time.perf_counter() - t0
-    peak = _status("VmHWM") - base
+    law, cpu, wall, peak = measured(
+        lambda: solve_jerk_limited_law(mv, motors=motors, grid=400, segments=segments))
     slp.solve_staged = real
     out = {"M": law.jerk.size, "cpu": cpu, "wall": wall, "peak_MB": peak,
            "programmes": law.solves, "iterations": iterations, "duration": law.duration,
@@ -413,25 +409,33 @@ def one_length(n: int, phase: float = 0.0) -> dict[str, Any]:
         plan_once(spiral(14), Path(tmp), "warm")
         cfg = Path(tmp) / "spiral.toml"
         cfg.write_text(spiral(n, phase))
-        req = load_scenario(str(cfg)).program_request()
-        Path("/proc/self/clear_refs").write_text("5")
-        base = _status("VmRSS")
-        c0 = time.process_time()
-        res = req.plan()
-        cpu = time.process_time() - c0
-        peak = _status("VmHWM") - base
+        res, cpu, _, peak = measured(load_scenario(str(cfg)).program_request().plan)
     law = res.moves[0].law
     return {"lines": n, "M": int(law.jerk.size), "cpu": cpu, "peak_MB": peak,
             "programmes": int(law.solves), "cycle": res.cycle_time_s,
             "status": int(law.status)}
 
 
-def _status(key: str) -> float:
-    """A figure of /proc/self/status in MB (Linux)."""
-    for line in Path("/proc/self/status").read_text().splitlines():
-        if line.startswith(key):
-            return float(line.split()[1]) / 1024
-    return float("nan")
+def measured(fn: Any) -> tuple[Any, float, float, float]:
+    """``fn()``, its CPU and wall time, and its peak resident memory above the process's
+    before it (MB; Linux: the high-water mark reset through /proc/self/clear_refs)."""
+    def status(key: str) -> float:
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith(key):
+                return float(line.split()[1]) / 1024
+        return float("nan")
+
+    Path("/proc/self/clear_refs").write_text("5")
+    base = status("VmRSS")
+    t0, c0 = time.perf_counter(), time.process_time()
+    out = fn()
+    cpu, wall = time.process_time() - c0, time.perf_counter() - t0
+    return out, cpu, wall, status("VmHWM") - base
+
+
+def medians(runs: list[dict[str, Any]], keys: tuple[str, ...]) -> dict[str, float]:
+    """The medians of ``keys`` over ``runs``."""
+    return {key: float(np.median([r[key] for r in runs])) for key in keys}
 
 
 def section_length() -> None:
@@ -442,12 +446,11 @@ def section_length() -> None:
     print("   lines  phase       M  CPU s  programmes  CPU s/line  peak MB  cycle s")
     rows = []
     for n in LENGTHS:
-        runs = [in_new_process(n, round(p), kind="--one-length") for p in LENGTH_PHASES]
+        runs = [in_new_process(n, p, kind="--one-length") for p in LENGTH_PHASES]
         for p, r in zip(LENGTH_PHASES, runs, strict=True):
             print(f"  {n:6d} {p:6.0f} {r['M']:7d} {r['cpu']:6.2f} {r['programmes']:11d} "
                   f"{r['cpu'] / n:11.3f} {r['peak_MB']:8.1f}  {r['cycle']:.4f}")
-        rows.append({"lines": n, **{key: float(np.median([r[key] for r in runs]))
-                                    for key in ("M", "cpu", "programmes", "peak_MB")}})
+        rows.append({"lines": n, **medians(runs, ("M", "cpu", "programmes", "peak_MB"))})
     print("  medians:")
     for a, b in zip(rows, rows[1:], strict=False):
         pt, mlogm = growth(dict(a, M=a["lines"]), dict(b, M=b["lines"]))
@@ -488,11 +491,10 @@ def highs(lp, x0) -> dict[str, float]:
     return out
 
 
-def in_new_process(segments: int, line: int = -1, kind: str = "--one-size"
-                   ) -> dict[str, Any]:
-    """:func:`one_size` (or with ``kind = "--one-length"`` :func:`one_length` of
-    ``segments`` lines from ``line`` deg) in a new process (its time and memory its own)."""
-    p = subprocess.run([sys.executable, __file__, kind, str(segments), str(line)],
+def in_new_process(*args: float, kind: str = "--one-size") -> dict[str, Any]:
+    """:func:`one_size` (or with ``kind = "--one-length"`` :func:`one_length`) of ``args``
+    in a new process (its time and memory its own)."""
+    p = subprocess.run([sys.executable, __file__, kind, *map(str, args)],
                        check=True, capture_output=True, text=True)
     return dict(json.loads(p.stdout.splitlines()[-1]))
 
@@ -580,8 +582,7 @@ def section_scaling(repeats: int = 5) -> None:
                   f"duration {r['duration']:.6f} s")
             group.append(dict(r, per=r["cpu"] / r["programmes"],
                               its=sum(its) / max(len(its), 1)))
-        groups.append({key: float(np.median([r[key] for r in group]))
-                       for key in ("M", "cpu", "per", "its", "programmes")})
+        groups.append(medians(group, ("M", "cpu", "per", "its", "programmes")))
     a, b = groups
     pt, mlogm = growth(a, b)
     print(f"    medians: {a['cpu']:.2f} s and {b['cpu']:.2f} s, {a['programmes']:.0f} and "

@@ -174,6 +174,13 @@ def slowed_to_cap(start: Start, grid: Array, ok: Array, slack: float) -> Start:
 STRETCH_INTERVALS = 4
 
 
+def joints_passed(start: Start, joints: Array) -> tuple[Array, Array]:
+    """The path's ``joints`` (arc lengths) the start passes inside its ends, and when."""
+    s = start.s
+    inner = joints[(joints > 0) & (joints < s[-1])]
+    return inner, np.interp(inner, s, start.t)
+
+
 def fractions(start: Start, table: Table, cons: Sequence[Constraint], segments: int,
                tol: float = 2e-3) -> Array:
     """The knots' fractions of the duration (M + 1,): at least ``segments`` per duration,
@@ -214,7 +221,7 @@ def fractions(start: Start, table: Table, cons: Sequence[Constraint], segments: 
     density = np.maximum(np.sqrt(c2 / (32 * tol)), segments / start.T)
     # between two of the path's joints (pinned knots) at least STRETCH_INTERVALS (a span
     # shorter than two samples as two samples: the density is sampled, and bounded)
-    tj = np.interp(table.joints[(table.joints > 0) & (table.joints < s[-1])], s, t)
+    tj = joints_passed(start, table.joints)[1]
     if tj.size:
         edges = np.concatenate([[0.0], tj, [t[-1]]])
         span = np.maximum(np.diff(edges), 2 * dt)
@@ -274,15 +281,13 @@ def pinned(f: Array, start: Start, joints: Array) -> Mesh:
     """The mesh of the knots ``f`` with, for each of the path's ``joints`` (arc lengths) the
     start motion passes, the nearest inner knot moved to where it passes it and pinned there
     (the path's curvature's derivative jumps at a joint: the jerk may jump at a knot)."""
-    t, s = start.t, start.s
     f = np.array(f, float)
     M = len(f) - 1
     pin_f: list[float] = []
     pin_s: list[float] = []
     taken: set[int] = set()
-    inner = joints[(joints > 0) & (joints < s[-1])]
-    for sj, fj in zip(inner.tolist(), (np.interp(inner, s, t) / start.T).tolist(),
-                      strict=True):
+    inner, tj = joints_passed(start, joints)
+    for sj, fj in zip(inner.tolist(), (tj / start.T).tolist(), strict=True):
         # the nearest knot (the first of two as near; the knots stay increasing as each
         # pinned one stays between its neighbours), by bisection: a long chain has
         # hundreds of joints and thousands of knots
