@@ -295,6 +295,7 @@ def _solve(dynamics: PathDynamics, table: Table, cons: Sequence[Constraint], seg
     scales = dict.fromkeys((c.kind for c in cons), 1.0)
     programmes = refined = tightened = stretched = retimed = 0
     delta = START_DELTA
+    shares: dict[float, float] = {}
     fresh = False  # a new start: its duration brought within the rows first (here done)
     best: _Round | None = None
     while True:
@@ -306,7 +307,8 @@ def _solve(dynamics: PathDynamics, table: Table, cons: Sequence[Constraint], seg
             Tk = time_scaled(model, J, Tk)
             fresh = False
         run = slp(model, J, Tk, MAX_PROGRAMMES if retimed == MAX_RETIME else FIRST_PROGRAMMES,
-                  delta)
+                  delta, shares)
+        shares = run.shares  # (the pinned knots' shares of the trust region: the next run's)
         if run.worst > FEAS_TOL:  # the programmes left a limit exceeded: slower instead
             run = replace(run, Tk=time_scaled(model, run.J, run.Tk, keep=False))
         delta = RESTART_DELTA
@@ -438,9 +440,9 @@ def with_joints(dynamics: PathDynamics, grid: int | Array) -> Array:
 #: spiral of 112 lines (``bench_smooth.py length``), whose coarse grid of 40 segments spans
 #: two or three of its lines each: the law on it stopped dead at inner points and took
 #: 5.38 s, against 3.96 s on the whole grid of 10357 points (10 ms); with the second
-#: search's acceleration cap (in a run with the pinned knots' shares of the next change,
-#: before this test) the coarse law took 5.6e6 s, against 8.49 s on the whole grid, and
-#: that search planned on it for 70 s of CPU time to no answer.
+#: search's acceleration cap (in a run with the pinned knots' shares of
+#: :data:`.slp.RHO_SHARE`, before this test) the coarse law took 5.6e6 s, against 8.49 s on
+#: the whole grid, and that search planned on it for 70 s of CPU time to no answer.
 COARSE_STOP = 1e-3
 
 
