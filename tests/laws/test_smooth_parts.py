@@ -897,14 +897,19 @@ def test_each_pinned_knot_boxes_the_stretches_ratio_by_its_own_share(setup):
         assert abs(use - 1e-4 / (lp.shares[i] * delta)) < 1e-6
 
 
-@pytest.mark.parametrize("beside, cut", [(0.02, True), (0.005, False)])
-def test_a_pinned_knot_s_share_is_cut_where_a_turned_down_step_broke_its_rows(beside, cut):
+@pytest.mark.parametrize("beside, eps, pred, cut", [(0.02, 0.0, 0.12, True),
+                                                   (0.005, 0.0, 0.12, False),
+                                                   (0.02, 0.015, 0.12, False),
+                                                   (0.02, 0.0, 0.0, False)])
+def test_a_pinned_knot_s_share_is_cut_where_a_turned_down_step_broke_its_rows(beside, eps,
+                                                                               pred, cut):
     """slp.cut_shares: a step predicting 0.12 leaves rows up to 0.25 * 0.12 / PENALTY =
-    0.01 where its model held; a knot whose rows beside it the step took to 0.02 has its
-    share cut by RHO_CUT, never below RHO_FLOOR, one at 0.005 keeps it (so does a knot
-    whose rows stayed within)."""
+    0.01 above the programme's slack where its model held; a knot whose rows beside it the
+    step took to 0.02 has its share cut by RHO_CUT, never below RHO_FLOOR; one at 0.005
+    keeps it, so does a knot whose rows stayed within, one at 0.02 where the programme's
+    own slack was 0.015, and every knot after a step that predicted nothing."""
     shares = np.array([slp.RHO_SHARE, 0.02, slp.RHO_SHARE])
-    got = slp.cut_shares(shares, np.array([beside, beside, -1.0]), 0.12)
+    got = slp.cut_shares(shares, np.array([beside, beside, -1.0]), pred, eps)
     want = [slp.RHO_SHARE * slp.RHO_CUT, slp.RHO_FLOOR, slp.RHO_SHARE] if cut else shares
     np.testing.assert_allclose(got, want, rtol=1e-15)
 
@@ -918,15 +923,17 @@ def test_the_rows_beside_a_pinned_knot_are_those_of_its_two_intervals(setup):
     rng = np.random.default_rng(5)
     k = rng.integers(0, me.M, 400)
     F = rng.standard_normal(400)
-    got = lp.beside_pins(rows.Rows(F, k, np.zeros((400, 5)), np.ones(400),
-                                   np.zeros((400, 5), np.float32)))
+
+    def beside():
+        return lp.beside_pins(rows.Rows(F, k, np.zeros((400, 5)), np.ones(400),
+                                        np.zeros((400, 5), np.float32)))
+
+    got = beside()
     want = [F[(k == p - 1) | (k == p)].max(initial=-np.inf) for p in me.pins]
     np.testing.assert_array_equal(got, want)
     far = np.flatnonzero(k == me.pins[0] + 1)
     F[far] = 10.0
-    again = lp.beside_pins(rows.Rows(F, k, np.zeros((400, 5)), np.ones(400),
-                                     np.zeros((400, 5), np.float32)))
-    assert again[0] == got[0] and far.size
+    assert far.size and beside()[0] == got[0]
 
 
 def test_a_run_starts_from_the_shares_the_last_run_left(setup, chain, monkeypatch):
@@ -964,12 +971,13 @@ def test_a_run_starts_from_the_shares_the_last_run_left(setup, chain, monkeypatc
     assert fresh[0] == 0 and len(fresh) <= 2  # (a search starts afresh: two searches here)
     assert len(calls) - len(fresh) >= 2
     assert all(now == before[1] for before, (now, _) in itertools.pairwise(calls) if now)
-    assert any(min(out.values()) < slp.RHO_SHARE for _, out in calls)
+    assert any(min(out.values(), default=slp.RHO_SHARE) < slp.RHO_SHARE for _, out in calls)
 
 
 def _spiral(n: int):
     """The jerk example's robot along a spiral of ``n`` lines of 16-43 mm blended within
-    5 mm (``bench_smooth.py length``'s, from 0 deg), the motors, and its program grid."""
+    5 mm (the shape of ``bench_smooth.py length``'s spirals, from 0 deg; here a path, not
+    a program), the motors, and the program grid of the path."""
     from dextar.program.plan import chain_grid
 
     sc = load_scenario(str(EXAMPLES / "jerk_pick_place.toml"))
@@ -982,13 +990,15 @@ def _spiral(n: int):
     return RobotAlongPath(sc.si_model, path, sc.mode), sc.si_motors, chain_grid(path, 400)
 
 
+@pytest.mark.slow
 def test_a_long_program_s_stretches_shift_their_durations_against_each_other(monkeypatch):
     """A blended spiral of 20 lines: its stretches (each line and blend between pinned
     knots) must shift their durations against each other by tens of per cent, which a
-    fixed share of 0.01 (RHO_FLOOR, the box before) allows 0.3 % a programme: the runs end
-    before. With the pinned knots' shares the plan is 5 % faster or more than with the
-    share held at the floor (measured 13.7 % from this angle, 4.0 to 13.7 % from four; 3.4
-    to 10.7 % at 28 lines)."""
+    fixed share of 0.01 (RHO_FLOOR, the box before) allows 0.01 delta a programme: the
+    runs end before. With the pinned knots' shares the plan is 5 % faster or more than
+    with the share held at the floor (measured 13.7 %; the same spiral from 12, 24 and 36
+    deg 4.0, 10.6 and 6.7 %, a margin too thin for a test; the spirals of
+    ``bench_smooth.py length`` 2 to 13 %)."""
     dyn, motors, g = _spiral(20)
     now = solve_jerk_limited_law(dyn, motors=motors, grid=g)
     monkeypatch.setattr(slp, "RHO_SHARE", slp.RHO_FLOOR)
@@ -1008,13 +1018,11 @@ def test_the_start_s_coarse_grid_that_stops_inside_the_path_gives_way(monkeypatc
     whole = time_optimal.solve_time_optimal_law(dyn, constraints=second, grid=tab.s,
                                                 check=False)
     law = solve._second_order(dyn, tab, second, None)
-    v = np.asarray(law.knots_v)
-    assert v[1:-1].min() > 0.1 * v.max()
+    assert not solve.stops_inside(law, 0.1)
     assert abs(law.duration / whole.duration - 1) < 1e-6
     monkeypatch.setattr(solve, "COARSE_STOP", 0.0)
     coarse = solve._second_order(dyn, tab, second, None)
-    v = np.asarray(coarse.knots_v)
-    assert v[1:-1].min() < 1e-6 * v.max() and coarse.duration > 1.2 * whole.duration
+    assert solve.stops_inside(coarse, 1e-6) and coarse.duration > 1.1 * whole.duration
 
 
 def test_a_move_on_its_limits_after_one_programme_settles_there(monkeypatch):

@@ -40,18 +40,20 @@ RESTART_DELTA = 0.1
 #: The trust region's share for ``T``: it moves by at most this times ``delta`` (relative).
 T_SHARE = 0.5
 #: The trust region's share for the durations of neighbouring stretches relative to each
-#: other (their ratio moves by at most this times ``delta``), at first; a pinned knot whose
-#: rows beside it a step took far beyond their model has its share cut by ``RHO_CUT``, down
-#: to ``RHO_FLOOR`` (:func:`cut_shares`). The ratio enters the integration into the pinned
-#: knot squared and over that interval's length (the acceleration at its end ``rho^2
-#: alpha``), so its model is worst where that interval is short and the acceleration large.
-#: A search keeps the shares from run to run (by the knots' arc lengths). Measured
-#: (``bench_smooth.py length``, 80 random corners), against the fixed share 0.01 before: a
-#: long program's stretches must shift their durations against each other by tens of per
-#: cent, 0.3 % a programme at most with 0.01, and the runs ended before: blended spirals of
-#: 28 to 224 lines, three starting angles each, came out 2 to 13 % faster (cycles), the 224
-#: lines in 35 % less CPU time; the corners the same on average (+0.03 %), 2 % more CPU.
-#: With a fixed 0.1 the corners, whose pinned knots sit at short intervals, took twice the
+#: other (their ratio moves by at most this times ``delta``), at first; where a whole step
+#: is turned down and the rows beside a pinned knot at the step are beyond what a good step
+#: leaves, that knot's share is cut by ``RHO_CUT``, down to ``RHO_FLOOR``
+#: (:func:`cut_shares`). The ratio enters the integration into the pinned knot squared and
+#: over that interval's length (the acceleration at its end ``rho^2 alpha``), so its model
+#: is worst where that interval is short and the acceleration large. A search keeps the
+#: shares from run to run (by the knots' arc lengths). Measured against the fixed share
+#: 0.01 before: a long program's stretches must shift their durations against each other
+#: by tens of per cent, 0.01 ``delta`` a programme with 0.01 (0.3 % at the first trust
+#: region), and the runs ended before: the blended spirals of 28 to 224 lines of
+#: ``bench_smooth.py length`` (three starting angles each) came out 2 to 13 % faster
+#: (cycles), the 224 lines in 35 % less CPU time; 80 random corners (``bench_smooth.py``'s
+#: corners, two seeds, two grids) the same on average (+0.03 %), 2 % more CPU. With a
+#: fixed 0.1 the corners, whose pinned knots sit at short intervals, took twice the
 #: programmes (steps turned down at their pins); with the shares not kept from run to run
 #: 20 % more CPU.
 RHO_SHARE = 0.1
@@ -131,14 +133,17 @@ def settled(worst: float, pred: float, actual: float, moved: float, still: bool,
             and abs(actual - pred) <= STEP_TOL))
 
 
-def cut_shares(shares: Array, beside: Array, pred: float) -> Array:
+def cut_shares(shares: Array, beside: Array, pred: float, eps: float) -> Array:
     """The pinned knots' shares of the trust region for the stretches' ratio (see
-    :data:`RHO_SHARE`) after a step turned down: cut by :data:`RHO_CUT`, down to
+    :data:`RHO_SHARE`) after a whole step turned down: cut by :data:`RHO_CUT`, down to
     :data:`RHO_FLOOR`, where the largest row beside the knot (``beside``: of the intervals
-    into it and out of it, at the step) is beyond a quarter of the step's predicted
-    reduction ``pred`` over :data:`PENALTY` (a step whose rows stay below that everywhere
-    keeps at least three quarters of its prediction: the model was good there)."""
-    hit = beside > 0.25 * max(pred, 0.0) / PENALTY
+    into it and out of it, at the step) is above the programme's own slack ``eps`` (its
+    model's rows) by more than a quarter of the step's predicted reduction ``pred`` over
+    :data:`PENALTY` (a step whose rows stay below that everywhere keeps at least three
+    quarters of its prediction). None where the step predicted no reduction."""
+    if not pred > 0.0:
+        return shares
+    hit = beside - max(eps, 0.0) > 0.25 * pred / PENALTY
     return np.where(hit, np.maximum(shares * RHO_CUT, RHO_FLOOR), shares)
 
 
@@ -199,9 +204,21 @@ class Programme:
         self._terms: tuple[Motion, tuple[Array, Array, Array, Array, Array, Array]] | None = None
         self._x0: tuple[Motion, Array] | None = None
         self._kp, self._kj = np.flatnonzero(self.into_pin), np.flatnonzero(~self.into_pin)
+        # (the pinned knots are inner and distinct, as start.pinned and make_mesh make them:
+        # the intervals into them are theirs, in order)
+        assert np.array_equal(self._kp + 1, mesh.pins)
         #: each pinned knot's share of the trust region for the stretches' ratio (see
         #: :data:`RHO_SHARE`), in the order of ``mesh.pins``
         self.shares = np.full(len(self._kp), RHO_SHARE)
+
+    def shares_from(self, shares: Mapping[float, float]) -> None:
+        """The pinned knots' shares an earlier run left (by their arc lengths; a knot not
+        among them :data:`RHO_SHARE`)."""
+        self.shares = np.array([shares.get(x, RHO_SHARE) for x in self.mesh.pin_s.tolist()])
+
+    def shares_by_arc(self) -> dict[float, float]:
+        """The pinned knots' shares by their arc lengths (for the next run)."""
+        return dict(zip(self.mesh.pin_s.tolist(), self.shares.tolist(), strict=True))
 
     def region_use(self, x: Array, mo: Motion, delta: float, scale: float, jscale: float
                    ) -> float:
@@ -441,7 +458,7 @@ def slp(model: RowModel, J: Array, Tk: Array, budget: int, delta: float,
     mesh, S = model.mesh, model.length
     lp = Programme(mesh, S)
     if shares:
-        lp.shares = np.array([shares.get(x, RHO_SHARE) for x in mesh.pin_s.tolist()])
+        lp.shares_from(shares)
     mo = motion(mesh, J, Tk, S)
     T_ref = mo.T
     first = model.rows(mo)
@@ -510,9 +527,9 @@ def slp(model: RowModel, J: Array, Tk: Array, budget: int, delta: float,
             log.debug("    T %.7f eps %.1e max row %.2e (%s) rows %d/%d pred %.1e ratio %.2f "
                       "delta %.2g iterations %d", mn.T, eps, new.F.max(), new.kind_of(i),
                       int(use.sum()), len(use), pred, ratio, delta, res.nit)
-        if ratio <= 0.1 and len(lp.shares):  # (the pinned knots where the model failed)
-            lp.shares = cut_shares(lp.shares, lp.beside_pins(new), pred)
         if ratio <= 0.1:  # back along the step: the rows are evaluated, no programme
+            if len(lp.shares):  # (first: the pinned knots where the model failed)
+                lp.shares = cut_shares(lp.shares, lp.beside_pins(new), pred, eps)
             if rows is None:  # (lean: the rows at the motion again, one set at a time)
                 new = Rows(new.F, new.k, np.zeros((0, 5)), new.norm,
                            np.zeros((0, 5), np.float32), new.kinds)
@@ -557,5 +574,4 @@ def slp(model: RowModel, J: Array, Tk: Array, budget: int, delta: float,
             break
     if rows is None:
         rows = model.rows(mo, gradients=False)
-    return Run(mo.J, mo.Tk, n, converged, float(rows.F.max()),
-               dict(zip(mesh.pin_s.tolist(), lp.shares.tolist(), strict=True)))
+    return Run(mo.J, mo.Tk, n, converged, float(rows.F.max()), lp.shares_by_arc())

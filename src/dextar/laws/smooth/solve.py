@@ -55,7 +55,8 @@ log = logging.getLogger(__name__)
 SEGMENTS = 32
 #: Segments of the second-order law that starts the search (a coarse grid: it only gives the
 #: start motion, which the programmes improve; the whole grid where the coarse one finds no
-#: motion, e.g. a blend narrower than its segments).
+#: motion, e.g. a blend narrower than its segments, or stops inside the path: see
+#: :data:`COARSE_STOP`).
 START_GRID = 40
 #: Greatest number of linear programmes of one SLP run, and of a run that can be followed by
 #: a re-timing (a motion far from the answer, on knots placed for its start, moves slowly:
@@ -439,11 +440,18 @@ def with_joints(dynamics: PathDynamics, grid: int | Array) -> Array:
 #: a path whose limits leave it any speed): the whole grid instead. Measured on a blended
 #: spiral of 112 lines (``bench_smooth.py length``), whose coarse grid of 40 segments spans
 #: two or three of its lines each: the law on it stopped dead at inner points and took
-#: 5.38 s, against 3.96 s on the whole grid of 10357 points (10 ms); with the second
-#: search's acceleration cap (in a run with the pinned knots' shares of
-#: :data:`.slp.RHO_SHARE`, before this test) the coarse law took 5.6e6 s, against 8.49 s on
-#: the whole grid, and that search planned on it for 70 s of CPU time to no answer.
+#: 5.38 s, against 3.96 s on the whole grid of 10357 points (10 ms of CPU time for that
+#: law); with the second search's acceleration cap (in a run with the pinned knots' shares
+#: of :data:`.slp.RHO_SHARE`, before this test) the coarse law took 5.6e6 s, against 8.49 s
+#: on the whole grid, and that search planned on it for 70 s of CPU time to no answer.
 COARSE_STOP = 1e-3
+
+
+def stops_inside(law: TimeOptimalLaw, below: float) -> bool:
+    """Whether a second-order law's speed at an inner grid point is at most ``below`` of its
+    largest."""
+    v = np.asarray(law.knots_v)
+    return bool(v[1:-1].min(initial=np.inf) <= below * v.max())
 
 
 def _second_order(dynamics: PathDynamics, table: Table, second: Sequence[Constraint],
@@ -464,8 +472,7 @@ def _second_order(dynamics: PathDynamics, table: Table, second: Sequence[Constra
         try:
             law = solve_time_optimal_law(cached, constraints=second, grid=coarse,
                                          units=units, check=False)
-            v = np.asarray(law.knots_v)
-            if v[1:-1].min(initial=np.inf) > COARSE_STOP * v.max():
+            if not stops_inside(law, COARSE_STOP):
                 return law
             log.debug("the start's coarse grid stops inside the path: the whole grid")
         except InfeasibleError as exc:
