@@ -156,7 +156,15 @@ def test_one_worker_gives_the_same_file(sweep2, tmp_path):
 
 @pytest.mark.slow
 def test_a_killed_sweep_resumes_to_the_same_file(sweep2, tmp_path, scheduler):
-    task, out2 = sweep2
+    """A sweep killed half-way (SIGKILL, a row cut short) resumes to the bytes of a whole
+    sweep. The killed run takes one design per unit of work (the whole sweep four): with
+    four its eight units ran two at a time and their rows came in bursts, and in one run of
+    four the file went from 9 rows to all 32 between two looks (the kill then found the
+    sweep done); the file holds the rows in design order whatever the units."""
+    _, out2 = sweep2
+    task = write_task(tmp_path, design="[design]" + TASK.split("[design]")[1].replace(
+        "chunk = 4", "chunk = 1"))
+    assert "chunk = 1" in task.read_text()
     out = tmp_path / "killed"
     proc = subprocess.Popen([sys.executable, "-m", "dextar", "design", str(task), "--out",
                              str(out), "--scheduler", scheduler, "--quiet"],
@@ -168,7 +176,7 @@ def test_a_killed_sweep_resumes_to_the_same_file(sweep2, tmp_path, scheduler):
             break
         if proc.poll() is not None:
             break
-        time.sleep(0.05)
+        time.sleep(0.01)
     os.killpg(proc.pid, signal.SIGKILL)
     proc.wait()
     partial = csv_path.read_text()
