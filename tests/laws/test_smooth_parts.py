@@ -995,16 +995,20 @@ def test_a_long_program_s_stretches_shift_their_durations_against_each_other(mon
     """A blended spiral of 20 lines: its stretches (each line and blend between pinned
     knots) must shift their durations against each other by tens of per cent, which a
     fixed share of 0.01 (RHO_FLOOR, the box before) allows 0.01 delta a programme: the
-    runs end before. With the pinned knots' shares the plan is 5 % faster or more than
-    with the share held at the floor (measured 13.7 %; the same spiral from 12, 24 and 36
-    deg 4.0, 10.6 and 6.7 %, a margin too thin for a test; the spirals of
-    ``bench_smooth.py length`` 2 to 13 %)."""
+    runs end before. With the pinned knots' shares the plan is faster than with the share
+    held at the floor, by 1 % or more: a local search's outcome, so the margin is the least
+    measured, 3.8 % (13.7 % here with the default BLAS; 3.8, 9.0 and 13.7 % with
+    OpenBLAS's Haswell and Zen, Prescott, Nehalem and Sandybridge, and SkylakeX kernels,
+    whose rounding sends both searches other ways: 2.441 s against 2.539 on Haswell; the
+    same spiral from 12, 24 and 36 deg 4.0, 10.6 and 6.7 %; the spirals of
+    ``bench_smooth.py length`` 2 to 13 %). With the shares broken (held at the floor) the
+    two plans are the same and the check fails."""
     dyn, motors, g = _spiral(20)
     now = solve_jerk_limited_law(dyn, motors=motors, grid=g)
     monkeypatch.setattr(slp, "RHO_SHARE", slp.RHO_FLOOR)
     before = solve_jerk_limited_law(dyn, motors=motors, grid=g)
     assert now.status == before.status == 0
-    assert now.duration < 0.95 * before.duration
+    assert now.duration < 0.99 * before.duration
 
 
 def test_the_start_s_coarse_grid_that_stops_inside_the_path_gives_way(monkeypatch):
