@@ -156,11 +156,13 @@ def test_one_worker_gives_the_same_file(sweep2, tmp_path):
 
 @pytest.mark.slow
 def test_a_killed_sweep_resumes_to_the_same_file(sweep2, tmp_path, scheduler):
-    """A sweep killed half-way (SIGKILL, a row cut short) resumes to the bytes of a whole
-    sweep. The killed run takes one design per unit of work (the whole sweep four): with
-    four its eight units ran two at a time and their rows came in bursts, and in one run of
-    four the file went from 9 rows to all 32 between two looks (the kill then found the
-    sweep done); the file holds the rows in design order whatever the units."""
+    """A sweep killed half-way (SIGKILL; then a row cut short, as a kill during a write
+    leaves it) resumes to the bytes of a whole sweep. The killed run takes one design per
+    unit of work (the whole sweep four): with four its eight units ran two at a time and
+    their rows came in bursts, and in one run of four the file went from 9 rows to all 32
+    between two looks (the kill then found the sweep done); the finished file holds the rows
+    in design order whatever the units (the grouping of a resumed sweep's designs into
+    units: test_the_designs_left_go_in_runs_of_consecutive_numbers)."""
     _, out2 = sweep2
     task = write_task(tmp_path, design="[design]" + TASK.split("[design]")[1].replace(
         "chunk = 4", "chunk = 1"))
@@ -172,7 +174,7 @@ def test_a_killed_sweep_resumes_to_the_same_file(sweep2, tmp_path, scheduler):
     csv_path = out / "designs.csv"
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline:
-        if csv_path.exists() and len(csv_path.read_text().splitlines()) > 10:
+        if csv_path.exists() and len(csv_path.read_text().splitlines()) > 4:
             break
         if proc.poll() is not None:
             break
@@ -189,6 +191,16 @@ def test_a_killed_sweep_resumes_to_the_same_file(sweep2, tmp_path, scheduler):
     assert csv_path.read_bytes() == (out2 / "designs.csv").read_bytes()
     s = json.loads((out / "summary.json").read_text())
     assert s["resumed"] == done and s["evaluated"] == 32 - done
+
+
+def test_the_designs_left_go_in_runs_of_consecutive_numbers():
+    """sweep.chunks_of: a resumed sweep's designs left (sorted) in units of at most
+    ``size`` consecutive design numbers; a gap starts a new unit."""
+    from dextar.design.sweep import chunks_of
+
+    assert chunks_of([0, 1, 2, 5, 6, 7, 8, 9, 11], 4) == [[0, 1, 2], [5, 6, 7, 8], [9], [11]]
+    assert chunks_of(list(range(8)), 4) == [[0, 1, 2, 3], [4, 5, 6, 7]]
+    assert chunks_of([], 4) == []
 
 
 @pytest.mark.parametrize("design, message", [
