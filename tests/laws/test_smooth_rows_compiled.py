@@ -76,7 +76,8 @@ def motions(model, J, Tk):
 def test_the_compiled_rows_are_the_numpy_rows_with_a_jerk_limit(setup, monkeypatch):  # noqa: F811
     """The chain's rows (second order at the knots and middles, w >= 0, the joint jerks at
     every interval's start, middle and end), with and without gradients, and built a few
-    intervals at a time (blocks that start past the first knot)."""
+    intervals at a time (blocks that start past the first knot, the compiled ones written
+    into one set of arrays that then owns its rows)."""
     needs_build()
     model, _, J, Tk, _ = setup
     for mo in motions(model, J, Tk):
@@ -85,9 +86,11 @@ def test_the_compiled_rows_are_the_numpy_rows_with_a_jerk_limit(setup, monkeypat
             assert len(a.F) > 10 * model.mesh.M and (len(a.C) > 0) == gradients
             assert_same(a, b)
     monkeypatch.setattr(rows, "CHUNK", 7)
-    a, b = both(monkeypatch, model, motions(model, J, Tk)[1])
-    assert len(a.kinds) > 4 * 3  # several blocks
-    assert_same(a, b)
+    for gradients in (True, False):  # (several blocks, written into one set of arrays)
+        a, b = both(monkeypatch, model, motions(model, J, Tk)[1], gradients)
+        assert len(a.kinds) > 4 * 3 and (len(b.C) > 0) == gradients
+        assert_same(a, b)
+        assert all(x.base is None for x in (b.F, b.k, b.C, b.norm, b.sizes))  # (their own)
     # every quarter's row kept (near any use, above any chord), blocks of 7 and of all
     monkeypatch.setattr(rows, "QUARTER_NEAR", 10.0)
     monkeypatch.setattr(rows, "QUARTER_BULGE", -10.0)

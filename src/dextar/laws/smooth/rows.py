@@ -288,8 +288,24 @@ class RowModel:
         """All rows at the motion (:meth:`rows`)."""
         self._grad = gradients
         cols, m, phmax = self._columns(self.tangent(mo))
+        starts = range(0, self.mesh.M, CHUNK)
+        if USE_COMPILED and _compiled is not None and len(starts) > 1:
+            # every block written into one set of arrays, each after the rows before it
+            # (joining the blocks' arrays afterwards cost as much as a tenth of a 16k-knot
+            # plan: a copy of every row, four times a programme)
+            room = sum(self._room(m, k0, min(k0 + CHUNK, self.mesh.M)) for k0 in starts)
+            out = self._empty(room)
+            kinds: list[tuple[str, int]] = []
+            at = 0
+            for k0 in starts:
+                part = self._block_compiled(mo, cols, m, phmax, k0,
+                                            min(k0 + CHUNK, self.mesh.M), out, at)
+                at += len(part.F)
+                kinds.extend(part.kinds)
+                del part  # (views of ``out``, which _cut resizes in place)
+            return self._cut(out, at, tuple(kinds))
         parts = [self._block(mo, cols, m, phmax, k0, min(k0 + CHUNK, self.mesh.M))
-                 for k0 in range(0, self.mesh.M, CHUNK)]
+                 for k0 in starts]
         if len(parts) == 1:
             return parts[0]
         return Rows(np.concatenate([r.F for r in parts]), np.concatenate([r.k for r in parts]),
@@ -435,20 +451,49 @@ class RowModel:
                     np.concatenate(norms), sizes,
                     tuple((n, len(f)) for n, f in zip(names, Fs, strict=True)))
 
-    def _block_compiled(self, mo: Motion, cols: Array, m: int, phmax: float, k0: int,
-                        k1: int) -> Rows:
-        """:meth:`_block` by the compiled rows (_rows.c: the same rows, the same order)."""
-        assert _compiled is not None
-        tab = self.table
-        kinds, lims, fric = self._third_spec
+    def _room(self, m: int, k0: int, k1: int) -> int:
+        """The most rows the intervals ``k0`` to ``k1`` (excluded) can have (_rows.c's
+        bound)."""
         nint = k1 - k0
         n2 = max(k1 - max(k0, 1), 0) + nint  # (knots and middles; the quarters 2 nint)
         cap = self.root_cap is not None
-        rmax = (n2 + 2 * nint) * m + (n2 if cap else 0) + n2 + 12 * nint * len(kinds)
-        F, norm, k = np.empty(rmax), np.empty(rmax), np.empty(rmax, np.int32)
+        return (n2 + 2 * nint) * m + (n2 if cap else 0) + n2 + 12 * nint * len(
+            self._third_spec[0])
+
+    def _empty(self, n: int) -> tuple[Array, Array, Array, Array, Array]:
+        """Room for ``n`` rows: ``F, norm, k, C, sizes`` (the gradients only where asked)."""
+        g = n if self._grad else 0
+        return (np.empty(n), np.empty(n), np.empty(n, np.int32), np.empty((g, 5)),
+                np.empty((g, 5), np.float32))
+
+    def _cut(self, out: tuple[Array, Array, Array, Array, Array], n: int,
+             names: tuple[tuple[str, int], ...]) -> Rows:
+        """The first ``n`` rows of ``out`` as :class:`Rows` (the room left given back in
+        place, no copy)."""
+        F, norm, k, C, sizes = out
+        for x in (F, norm, k):
+            x.resize(n, refcheck=False)
+        for g in (C, sizes):
+            g.resize((n if self._grad else 0, 5), refcheck=False)
+        return Rows(F, k, C, norm, sizes, names)
+
+    def _block_compiled(self, mo: Motion, cols: Array, m: int, phmax: float, k0: int,
+                        k1: int, out: tuple[Array, Array, Array, Array, Array] | None = None,
+                        at: int = 0) -> Rows:
+        """:meth:`_block` by the compiled rows (_rows.c: the same rows, the same order);
+        written into ``out`` from row ``at`` (its room for them) where given, the rows
+        returned then views of it."""
+        assert _compiled is not None
+        tab = self.table
+        kinds, lims, fric = self._third_spec
+        cap = self.root_cap is not None
+        rmax = self._room(m, k0, k1)
         grad = self._grad
-        C = np.empty((rmax if grad else 0, 5))
-        sizes = np.empty((rmax if grad else 0, 5), np.float32)
+        mine = out is None
+        if out is None:
+            out = self._empty(rmax)
+        F, norm, k = (x[at:at + rmax] for x in out[:3])
+        C, sizes = (g[at:at + rmax] if grad else g for g in out[3:])
 
         def f64(x: Array) -> Array:
             return np.ascontiguousarray(x, dtype=float)
@@ -460,15 +505,14 @@ class RowModel:
             1e-9 * phmax + 1e-300, self.length, -1.0 / self.length, QUARTER_NEAR,
             QUARTER_BULGE, grad)
         R = n_second + n_cap + n_w + n_third
-        names = [("second-order", n_second), *([("cap", n_cap)] if cap else []),
-                 ("w>=0", n_w), ("third", n_third)]
-        # the room for rows left out (a limit not finite, a quarter not near its limit)
-        # given back: the arrays cut to their rows in place (no copy)
-        for x in (F, norm, k):
-            x.resize(R, refcheck=False)
-        for g in (C, sizes):
-            g.resize((R if grad else 0, 5), refcheck=False)
-        return Rows(F, k, C, norm, sizes, tuple(names))
+        names = (("second-order", n_second), *([("cap", n_cap)] if cap else []),
+                 ("w>=0", n_w), ("third", n_third))
+        if mine:
+            # the room for rows left out (a limit not finite, a quarter not near its limit)
+            # given back: the arrays cut to their rows in place (no copy)
+            return self._cut(out, R, names)
+        return Rows(F[:R], k[:R], C[:R] if grad else C, norm[:R],
+                    sizes[:R] if grad else sizes, names)
 
     def _third_at(self, mo: Motion, k: Array, theta: Array, v: Array, d: Array, w: Array,
                   al: Array) -> tuple[Array, list[list[Array]], Array, Array]:
