@@ -288,24 +288,10 @@ class RowModel:
         """All rows at the motion (:meth:`rows`)."""
         self._grad = gradients
         cols, m, phmax = self._columns(self.tangent(mo))
-        starts = range(0, self.mesh.M, CHUNK)
-        if USE_COMPILED and _compiled is not None and len(starts) > 1:
-            # every block written into one set of arrays, each after the rows before it
-            # (joining the blocks' arrays afterwards cost as much as a tenth of a 16k-knot
-            # plan: a copy of every row, four times a programme)
-            room = sum(self._room(m, k0, min(k0 + CHUNK, self.mesh.M)) for k0 in starts)
-            out = self._empty(room)
-            kinds: list[tuple[str, int]] = []
-            at = 0
-            for k0 in starts:
-                part = self._block_compiled(mo, cols, m, phmax, k0,
-                                            min(k0 + CHUNK, self.mesh.M), out, at)
-                at += len(part.F)
-                kinds.extend(part.kinds)
-                del part  # (views of ``out``, which _cut resizes in place)
-            return self._cut(out, at, tuple(kinds))
-        parts = [self._block(mo, cols, m, phmax, k0, min(k0 + CHUNK, self.mesh.M))
-                 for k0 in starts]
+        spans = [(k0, min(k0 + CHUNK, self.mesh.M)) for k0 in range(0, self.mesh.M, CHUNK)]
+        if USE_COMPILED and _compiled is not None:
+            return self._compiled_rows(mo, cols, m, phmax, spans)
+        parts = [self._block(mo, cols, m, phmax, k0, k1) for k0, k1 in spans]
         if len(parts) == 1:
             return parts[0]
         return Rows(np.concatenate([r.F for r in parts]), np.concatenate([r.k for r in parts]),
@@ -383,7 +369,7 @@ class RowModel:
         """The rows of the intervals ``k0`` to ``k1`` (excluded), from the second-order
         rows' ``m`` columns at the table's points (:func:`columns`)."""
         if USE_COMPILED and _compiled is not None:
-            return self._block_compiled(mo, cols, m, phmax, k0, k1)
+            return self._compiled_rows(mo, cols, m, phmax, [(k0, k1)])
         mesh, tab, S = self.mesh, self.table, self.length
         h = mesh.h
         k, th, kk, tt, quarter, n2, kM, k3, th3, end3 = self._points(k0, k1, m)
@@ -468,8 +454,8 @@ class RowModel:
 
     def _cut(self, out: tuple[Array, Array, Array, Array, Array], n: int,
              names: tuple[tuple[str, int], ...]) -> Rows:
-        """The first ``n`` rows of ``out`` as :class:`Rows` (the room left given back in
-        place, no copy)."""
+        """The first ``n`` rows of ``out`` as :class:`Rows` (the room for rows left out, a
+        limit not finite or a quarter not near its limit, given back in place: no copy)."""
         F, norm, k, C, sizes = out
         for x in (F, norm, k):
             x.resize(n, refcheck=False)
@@ -477,21 +463,34 @@ class RowModel:
             g.resize((n if self._grad else 0, 5), refcheck=False)
         return Rows(F, k, C, norm, sizes, names)
 
+    def _compiled_rows(self, mo: Motion, cols: Array, m: int, phmax: float,
+                       spans: list[tuple[int, int]]) -> Rows:
+        """The rows of the intervals ``k0`` to ``k1`` (excluded) of each of ``spans`` by
+        the compiled rows (_rows.c: :meth:`_block`'s rows in its order), written into one
+        set of arrays, each block after the rows before it, then cut in place (joining the
+        blocks' arrays afterwards cost as much as a tenth of a 16k-knot plan: a copy of
+        every row, four times a programme)."""
+        out = self._empty(sum(self._room(m, k0, k1) for k0, k1 in spans))
+        kinds: list[tuple[str, int]] = []
+        at = 0
+        for k0, k1 in spans:
+            n, names = self._block_compiled(mo, cols, m, phmax, k0, k1, out, at)
+            at += n
+            kinds.extend(names)
+        return self._cut(out, at, tuple(kinds))
+
     def _block_compiled(self, mo: Motion, cols: Array, m: int, phmax: float, k0: int,
-                        k1: int, out: tuple[Array, Array, Array, Array, Array] | None = None,
-                        at: int = 0) -> Rows:
-        """:meth:`_block` by the compiled rows (_rows.c: the same rows, the same order);
-        written into ``out`` from row ``at`` (its room for them) where given, the rows
-        returned then views of it."""
+                        k1: int, out: tuple[Array, Array, Array, Array, Array], at: int
+                        ) -> tuple[int, tuple[tuple[str, int], ...]]:
+        """The compiled rows of the intervals ``k0`` to ``k1`` (excluded) written into
+        ``out`` from row ``at`` (its room for them, :meth:`_room`): how many, and their
+        kinds."""
         assert _compiled is not None
         tab = self.table
         kinds, lims, fric = self._third_spec
         cap = self.root_cap is not None
         rmax = self._room(m, k0, k1)
         grad = self._grad
-        mine = out is None
-        if out is None:
-            out = self._empty(rmax)
         F, norm, k = (x[at:at + rmax] for x in out[:3])
         C, sizes = (g[at:at + rmax] if grad else g for g in out[3:])
 
@@ -505,14 +504,8 @@ class RowModel:
             1e-9 * phmax + 1e-300, self.length, -1.0 / self.length, QUARTER_NEAR,
             QUARTER_BULGE, grad)
         R = n_second + n_cap + n_w + n_third
-        names = (("second-order", n_second), *([("cap", n_cap)] if cap else []),
-                 ("w>=0", n_w), ("third", n_third))
-        if mine:
-            # the room for rows left out (a limit not finite, a quarter not near its limit)
-            # given back: the arrays cut to their rows in place (no copy)
-            return self._cut(out, R, names)
-        return Rows(F[:R], k[:R], C[:R] if grad else C, norm[:R],
-                    sizes[:R] if grad else sizes, names)
+        return R, (("second-order", n_second), *([("cap", n_cap)] if cap else []),
+                   ("w>=0", n_w), ("third", n_third))
 
     def _third_at(self, mo: Motion, k: Array, theta: Array, v: Array, d: Array, w: Array,
                   al: Array) -> tuple[Array, list[list[Array]], Array, Array]:
