@@ -103,6 +103,23 @@ def test_a_trapezoid_error_speaks_the_configs_units(tmp_path, capsys):
                      r"mm/s\^2", err), err
 
 
+@pytest.mark.parametrize("payload, code", [(1e300, 2), (1e3, 0)])
+def test_a_mass_too_large_for_a_finite_cost_is_refused(tmp_path, capsys, payload, code):
+    """The paper's optimal law with a payload of 1e300 kg: its inertial cost (eta times the
+    mass squared) overflows; exit 2 in one line naming the mass and eta in kg and s^2/kg,
+    no file (the fuzz found the cost printed as inf). A tonne plans, its cost finite."""
+    cfg = tmp_path / "heavy.toml"
+    cfg.write_text(f"[inertia]\ndistal_mass = 0.0\npayload = {payload!r}\n")
+    out = tmp_path / "p.csv"
+    assert main(["plan", str(cfg), "--out", str(out)]) == code
+    said, err = capsys.readouterr()
+    if code:
+        assert err.count("\n") == 1 and "kg" in err and "s^2/kg" in err and "overflows" in err
+        assert said == "" and not out.exists()
+    else:
+        assert out.exists() and not re.search(r"\b(inf|nan)\b", said, re.IGNORECASE), said
+
+
 @pytest.mark.slow
 def test_a_plant_that_meets_a_singularity_is_a_result(tmp_path, capsys):
     """line_si.toml with a 0.1 N m torque limit: the saturated plant runs into a parallel

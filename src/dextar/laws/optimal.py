@@ -619,6 +619,12 @@ def solve_optimal_law(path: Path, *, duration: float = 1.0, eta: float = 0.1, ma
         kin, inert = 0.5 * m * S * S / T * v2, 0.5 * eta * m * m * S * S / T**3 * a2
     else:
         kin, inert = law_cost(law, path, m, eta, nodes=max(64, 2 * nodes))
+    if not (math.isfinite(kin) and math.isfinite(inert)):
+        part = "kinetic part, which grows as the mass" if not math.isfinite(kin) else \
+            "inertial part, which grows as eta times the mass squared"
+        raise ParameterError(f"{said['mass']} and {said['eta']} are too large for a finite "
+                             f"cost on a path of length {said['length']}: its {part}, "
+                             "overflows (a smaller mass or eta)")
     law = replace(law, kinetic=kin, inertial=inert)
     bc = law.evaluate(np.array([0.0, T]))
     bc_err = max(abs(bc[0, 0]), abs(bc[0, 1] - S), abs(bc[1, 0]) * T, abs(bc[1, 1]) * T) / S
