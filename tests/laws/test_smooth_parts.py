@@ -339,6 +339,73 @@ def test_the_rows_linear_model_matches_finite_differences(setup):
     assert errs[1][0] < errs[0][0] / 30
 
 
+def _middles(model, mo, M):
+    """The chain's rows with every middle kept and no quarter (the inner knots' second-order
+    rows (M - 1, m), the intervals' middles' (M, m), the joint jerks' (2 signs, start /
+    middle / end, M, 2 joints)), and each inner interval's middles' bulge above the chord of
+    its start and end: second order (M - 2, m), third order (2, M - 2, 2)."""
+    every = model._rows(mo, False)
+    n = dict(every.kinds)
+    m = n["second-order"] // (2 * M - 1)
+    assert n["second-order"] == m * (2 * M - 1) and n["third"] == 12 * M
+    second = every.F[:n["second-order"]].reshape(2 * M - 1, m)
+    knots, mids = second[:M - 1], second[M - 1:]
+    third = every.F[-n["third"]:].reshape(2, 3, M, 2)
+    sb = mids[1:-1] - (knots[:-1] + knots[1:]) / 2
+    tb = third[:, 1, 1:-1] - (third[:, 0, 1:-1] + third[:, 2, 1:-1]) / 2
+    return every, knots, mids, third, sb, tb
+
+
+@pytest.mark.parametrize("compiled", [False, True])
+def test_an_intervals_middle_rows_are_those_above_the_chord_of_its_ends(
+        setup, compiled, monkeypatch):
+    """MIDDLE_BULGE: an interval's middle rows, of the second order (the torque limits) and
+    of the third (the joint jerks, both signs), are kept where they pass the chord of the
+    same rows at its start and end by more than MIDDLE_BULGE, and in the first and last
+    intervals always; the other rows are those with every middle kept. On the chain's start
+    at the default bulge and at one between each order's middles' bulges (so that some are
+    kept and some left out of each), numpy's rows and the compiled ones."""
+    if compiled and rows._compiled is None:
+        pytest.skip("the compiled rows are not built here")
+    monkeypatch.setattr(rows, "USE_COMPILED", compiled)
+    monkeypatch.setattr(rows, "QUARTER_NEAR", -np.inf)  # (no quarters)
+    model, me, J, Tk, _ = setup
+    M = me.M
+    mo = mesh.motion(me, J, Tk, model.length)
+    default = rows.MIDDLE_BULGE
+    monkeypatch.setattr(rows, "MIDDLE_BULGE", -np.inf)
+    every, knots, mids, third, sb, tb = _middles(model, mo, M)
+    bulges = np.concatenate([sb.ravel(), tb.ravel()])
+
+    def split(b):
+        """A bulge between the middle two of ``b``, sorted."""
+        b = np.sort(b.ravel())
+        i = len(b) // 2
+        while b[i + 1] - b[i] < 1e-8:
+            i += 1
+        return (b[i] + b[i + 1]) / 2
+
+    left = {}
+    for bulge in (default, split(sb), split(tb)):
+        # (none within rounding of the bulge: the chord here is of the knots' rows, the
+        # rule's of the rows at the interval's ends)
+        assert np.abs(bulges - bulge).min() > 1e-9
+        monkeypatch.setattr(rows, "MIDDLE_BULGE", bulge)
+        got = model._rows(mo, False)
+        keep2 = np.ones(mids.shape, bool)
+        keep2[1:-1] = sb > bulge
+        keep3 = np.ones(third.shape, bool)
+        keep3[:, 1, 1:-1] = tb > bulge
+        want = np.concatenate([knots.ravel(), mids.ravel()[keep2.ravel()],
+                               every.F[len(knots.ravel()) + mids.size:-third.size],
+                               third.ravel()[keep3.ravel()]])
+        np.testing.assert_allclose(got.F, want, rtol=1e-12, atol=1e-15)
+        left[bulge] = (~keep2).sum(), (~keep3).sum()
+    # the rule both ways in each order; the default leaves some out
+    assert 0 < left[split(sb)][0] < sb.size and 0 < left[split(tb)][1] < tb.size, left
+    assert sum(left[default]) > 0, left
+
+
 @pytest.mark.parametrize("bulge", [rows.QUARTER_BULGE, 4.5e-3])
 @pytest.mark.parametrize("compiled", [False, True])
 def test_the_second_order_rows_at_the_quarters_are_the_knots_of_a_finer_mesh(
@@ -355,6 +422,7 @@ def test_the_second_order_rows_at_the_quarters_are_the_knots_of_a_finer_mesh(
         pytest.skip("the compiled rows are not built here")
     monkeypatch.setattr(rows, "USE_COMPILED", compiled)
     monkeypatch.setattr(rows, "QUARTER_BULGE", bulge)
+    monkeypatch.setattr(rows, "MIDDLE_BULGE", -np.inf)  # (every middle: the mesh's knots)
     _, me, J, Tk, tab = setup
     cons = motor_constraints(replace(MOTORS, max_speed=(6.0, 6.0), knee_speed=(2.0, 2.0)))
     model = rows.RowModel(me, tab, [c for c in cons if c.order == 2],

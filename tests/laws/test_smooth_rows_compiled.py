@@ -91,9 +91,11 @@ def test_the_compiled_rows_are_the_numpy_rows_with_a_jerk_limit(setup, monkeypat
         assert len(a.kinds) > 4 * 3 and (len(b.C) > 0) == gradients
         assert_same(a, b)
         assert all(x.base is None for x in (b.F, b.k, b.C, b.norm, b.sizes))  # (their own)
-    # every quarter's row kept (near any use, above any chord), blocks of 7 and of all
+    # every quarter's and middle's row kept (near any use, above any chord), blocks of 7
+    # and of all
     monkeypatch.setattr(rows, "QUARTER_NEAR", 10.0)
     monkeypatch.setattr(rows, "QUARTER_BULGE", -10.0)
+    monkeypatch.setattr(rows, "MIDDLE_BULGE", -np.inf)
     M = model.mesh.M
     for chunk in (7, 2048):
         monkeypatch.setattr(rows, "CHUNK", chunk)
@@ -271,7 +273,8 @@ def test_the_compiled_rows_refuse_inconsistent_sizes(setup, bad):  # noqa: F811
                                     mo.Tk, mo.sigma, mo.w, mo.alpha, kinds, lims, a["fric"],
                                     a["F"], a["norm"], a["C"], a["k"], a["sizes"], a["m"], 0,
                                     0, a["k1"], 1e-300, model.length, -1.0 / model.length,
-                                    rows.QUARTER_NEAR, -1.0, True)  # (every quarter kept)
+                                    rows.QUARTER_NEAR, -1.0, -np.inf,
+                                    True)  # (every quarter and middle kept)
 
     with pytest.raises(ValueError, match="inconsistent"):
         call()

@@ -52,12 +52,14 @@
 #endif
 
 /* The interface version: rows.py uses a build of this version only. */
-#define ROWS_VERSION 4
+#define ROWS_VERSION 5
 /* The second-order rows' points: the inner knots, and in every interval its middle, then
  * its first and third quarters (rows.py's RowModel: the same offsets by the same
  * operations; a row at a quarter only where it is near its limit, above -near, and above
- * the chord of its interval's rows on either side of it by more than bulge). The speed
- * cap's and w >= 0's rows: at the knots and the middles (the first two passes). */
+ * the chord of its interval's rows on either side of it by more than bulge; at a middle
+ * only above the chord of the interval's start and end by more than mid_bulge, but in the
+ * first and last intervals always). The speed cap's and w >= 0's rows: at the knots and
+ * the middles (the first two passes). */
 #define POINTS 4
 /* The table's per-point columns columns() takes (2 each): a, b, g, q', q'', the friction's
  * sides up and down, the viscous slope |q'| f_v, the Coulomb torque. */
@@ -177,14 +179,15 @@ static double row_at(const Motion *mo, const double *grid, Py_ssize_t n1, const 
     return second_row(&pt, m, j, cfloor, &pu, &px, &ph, &c);
 }
 
-/* The middle of the chord a quarter's row is measured against: the row at the interval's
- * start and middle (first quarter, pass 2) or middle and end (third quarter) */
+/* The middle of the chord a middle's or a quarter's row is measured against: the row at the
+ * interval's start and end (middle, pass 1), start and middle (first quarter, pass 2) or
+ * middle and end (third quarter) */
 static double chord(const Motion *mo, const double *grid, Py_ssize_t n1, const double *pc,
                     Py_ssize_t P, Py_ssize_t m, Py_ssize_t k, int pass, Py_ssize_t j,
                     double cfloor)
 {
     double h = mo->h[k];
-    double fa = row_at(mo, grid, n1, pc, P, m, k, pass == 2 ? 0.0 : h / 2, j, cfloor);
+    double fa = row_at(mo, grid, n1, pc, P, m, k, pass == 3 ? h / 2 : 0.0, j, cfloor);
     double fb = row_at(mo, grid, n1, pc, P, m, k, pass == 2 ? h / 2 : h, j, cfloor);
     return (fa + fb) / 2;
 }
@@ -223,6 +226,47 @@ static void put(Out *o, Py_ssize_t k, double F, double norm, double th, double h
     z[4] = (float)fabs(gT);
 }
 
+/* The third-order rows of one limit, written from row base (both signs, each the intervals'
+ * starts, middles, then ends, two joints a point: 4 n3 rows, n3 = 3 nint) with the middles
+ * within mid_bulge of their chord left out (the first and last intervals' kept: M the
+ * mesh's intervals, k0 the first's), the rows after them moved up in place (rows.py's
+ * _third_middles; keep holds 4 n3 flags): the rows kept. */
+static Py_ssize_t drop_middles(Out *o, Py_ssize_t base, Py_ssize_t nint, Py_ssize_t k0,
+                               Py_ssize_t M, double mid_bulge, unsigned char *keep)
+{
+    const Py_ssize_t n3 = 3 * nint;
+    for (Py_ssize_t i = 0; i < 4 * n3; i++)
+        keep[i] = 1;
+    for (int sg = 0; sg < 2; sg++)
+        for (Py_ssize_t q = 0; q < nint; q++) {
+            Py_ssize_t k = k0 + q;
+            if (k == 0 || k == M - 1)
+                continue;
+            for (int j = 0; j < 2; j++) {
+                Py_ssize_t at = sg * 2 * n3 + j;
+                double fs = o->F[base + at + 2 * q], fm = o->F[base + at + 2 * (nint + q)];
+                double fe = o->F[base + at + 2 * (2 * nint + q)];
+                keep[at + 2 * (nint + q)] = fm > (fs + fe) / 2 + mid_bulge;
+            }
+        }
+    Py_ssize_t n = 0;
+    for (Py_ssize_t i = 0; i < 4 * n3; i++) {
+        if (!keep[i])
+            continue;
+        Py_ssize_t from = base + i, to = base + n++;
+        if (from == to)
+            continue;
+        o->F[to] = o->F[from];
+        o->norm[to] = o->norm[from];
+        o->k[to] = o->k[from];
+        if (o->grad) {
+            memcpy(o->C + 5 * to, o->C + 5 * from, 5 * sizeof(double));
+            memcpy(o->sizes + 5 * to, o->sizes + 5 * from, 5 * sizeof(float));
+        }
+    }
+    return n;
+}
+
 /* a buffer of 4-byte items of the struct code ``code`` ('i' int32, 'f' float32) */
 static int get_buffer4(PyObject *obj, Py_buffer *view, char code, const char *name)
 {
@@ -250,12 +294,12 @@ static PyObject *block(PyObject *self, PyObject *args)
     PyObject *objs[NIN + NOUT], *kobj, *zobj;
     Py_ssize_t m, k0, k1;
     int has_cap, grad;
-    double cfloor, S, neg_inv_S, near, bulge;
-    if (!PyArg_ParseTuple(args, "OOOOOOOOOOOOOOOOOOninnddddd" "p", &objs[0], &objs[1],
+    double cfloor, S, neg_inv_S, near, bulge, mid_bulge;
+    if (!PyArg_ParseTuple(args, "OOOOOOOOOOOOOOOOOOninndddddd" "p", &objs[0], &objs[1],
                           &objs[2], &objs[3], &objs[4], &objs[5], &objs[6], &objs[7],
                           &objs[8], &objs[9], &objs[10], &objs[11], &objs[12], &objs[13],
                           &objs[14], &objs[15], &kobj, &zobj, &m, &has_cap, &k0, &k1,
-                          &cfloor, &S, &neg_inv_S, &near, &bulge, &grad))
+                          &cfloor, &S, &neg_inv_S, &near, &bulge, &mid_bulge, &grad))
         return NULL;
     static const char *const names[NIN + NOUT] = {
         "grid", "pcols", "tlo", "thi", "h", "J", "Tk", "sigma", "w", "alpha", "kinds",
@@ -320,6 +364,10 @@ static PyObject *block(PyObject *self, PyObject *args)
                     if (pass >= 2 && !(F > -near && F > chord(&mo, grid, n1, pc, P, m, k,
                                                                pass, j, cfloor) + bulge))
                         continue;
+                    if (pass == 1 && k > 0 && k < M - 1
+                        && !(F > chord(&mo, grid, n1, pc, P, m, k, pass, j, cfloor)
+                                     + mid_bulge))
+                        continue;
                     put(&o, k, F, c, th, mo.h[k], (dpu * al + dpx * w * w - dph * T * T) / c,
                         2 * px * w / c, pu / c, 0.0, -2 * ph * T / c);
                 }
@@ -348,6 +396,11 @@ static PyObject *block(PyObject *self, PyObject *args)
         /* the third-order rows at every interval's start, middle and end (at its end, the
          * table's segment before the point): per limit, both signs, per point, per joint */
         Py_ssize_t n_third = 0;
+        unsigned char *keep3 = malloc((size_t)(4 * n3 > 0 ? 4 * n3 : 1));
+        if (keep3 == NULL) {
+            PyErr_NoMemory();
+            goto done;
+        }
         for (Py_ssize_t ci = 0; ci < nc; ci++) {
             int torque_rate = kinds[ci] != 0.0;
             Py_ssize_t base = o.n;
@@ -404,9 +457,11 @@ static PyObject *block(PyObject *self, PyObject *args)
                     }
                 }
             }
-            o.n = base + 4 * n3;
-            n_third += 4 * n3;
+            Py_ssize_t kept = drop_middles(&o, base, nint, k0, M, mid_bulge, keep3);
+            o.n = base + kept;
+            n_third += kept;
         }
+        free(keep3);
         result = Py_BuildValue("nnnn", n_second, has_cap ? n2 : (Py_ssize_t)0, n2, n_third);
     }
 done:
