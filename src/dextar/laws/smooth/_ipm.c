@@ -63,7 +63,7 @@ static void *big_alloc(size_t size)
 #endif
 
 /* The interface version: banded.py uses a build of this version only. */
-#define IPM_VERSION 3
+#define IPM_VERSION 4
 
 /* States per knot, equalities per interval, band positions per knot, the band's
  * half-widths and its storage's width with the fill-in of the pivoting (banded.py's D, Q,
@@ -77,6 +77,9 @@ static void *big_alloc(size_t size)
 #define REG 1e-14
 #define ETA 0.99
 #define MU0 1e-3
+/* the corrector's target at least this fraction of the mean complementarity the gap's
+ * tolerance allows, or the mean where it is below (TARGET_FLOOR in banded.py) */
+#define TARGET_FLOOR 0.1
 /* the start's slacks at least this much: of 1 + |rb| for a row, of the width for a bound
  * (SLACK_FLOOR, BOUND_FLOOR in banded.py) */
 #define SLACK_FLOOR 1e-3
@@ -718,7 +721,8 @@ static int ipm(Prog *p, const double *x0, double *x, double tol, double dual_tol
                     mu_aff += (sl[i] + ap * ds[i]) * (z[i] + ad * dz[i]);
                 mu_aff /= (double)m;
                 double sigma = mu_aff / mu;
-                double target = sigma * sigma * sigma * mu;
+                double target = fmax(sigma * sigma * sigma * mu,
+                                     fmin(mu, TARGET_FLOOR * gap_tol * (1.0 + cx) / (double)m));
                 targets(p, Dz, rp, sl, z, target, cc, dz, ds, nw.rhs);
                 step_rhs(p, &nw, rd, re);
                 band_solve(nw.L, nb, nw.piv, nw.ext, nw.full);
