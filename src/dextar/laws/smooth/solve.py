@@ -561,10 +561,13 @@ def _verdict(r: _Round, scales: dict[str, float], programmes: int, T2: float, no
     how = (f"{mesh.M} intervals of constant jerk"
            + (f" ({refined} refinement(s))" if refined else "")
            + f", {programmes} linear programmes")
+    rel = T / T2 - 1
+    against = (f"{rel:+.2%} against the second-order law on the start's grid" if rel >= 0
+               else f"{-rel:.2%} below the second-order law, which is computed on the "
+               f"start's grid, coarser than these intervals")
     if ok:
         msg = (f"jerk-limited time-optimal within the limits: {words} on the check samples "
-               f"({how}; {T / T2 - 1:+.2%} against the second-order law on the start's "
-               f"grid){margin}")
+               f"({how}; {against}){margin}")
     else:
         msg = f"limits exceeded on the check samples ({how}): {words}"
     if not run.converged:
