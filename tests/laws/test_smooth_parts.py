@@ -396,7 +396,8 @@ def test_an_intervals_middle_rows_are_those_above_the_chord_of_its_ends(
     same rows at its start and end by more than MIDDLE_BULGE, and in the first and last
     intervals always; the other rows are those with every middle kept. On the chain's start
     at the default bulge and at one between each order's middles' bulges (so that some are
-    kept and some left out of each), numpy's rows and the compiled ones."""
+    kept and some left out of each), numpy's rows and the compiled ones, built at once and
+    seven intervals at a time."""
     if compiled and rows._compiled is None:
         pytest.skip("the compiled rows are not built here")
     monkeypatch.setattr(rows, "USE_COMPILED", compiled)
@@ -433,6 +434,17 @@ def test_an_intervals_middle_rows_are_those_above_the_chord_of_its_ends(
                                third.ravel()[keep3.ravel()]])
         np.testing.assert_allclose(got.F, want, rtol=1e-12, atol=1e-15)
         left[bulge] = (~keep2).sum(), (~keep3).sum()
+        # the same rows, with their gradients, built 7 intervals at a time (blocks from
+        # past the first knot, one holding the last interval), in another order
+        one = model._rows(mo, True)
+        monkeypatch.setattr(rows, "CHUNK", 7)
+        many = model._rows(mo, True)
+        monkeypatch.setattr(rows, "CHUNK", 2048)
+        a, b = (np.lexsort((r.F, r.k)) for r in (one, many))
+        np.testing.assert_array_equal(many.k[b], one.k[a])
+        for name in ("F", "norm", "C"):
+            np.testing.assert_allclose(getattr(many, name)[b], getattr(one, name)[a],
+                                       rtol=1e-12, atol=1e-15, err_msg=name)
     # the rule both ways in each order; the default leaves some out
     assert 0 < left[split(sb)][0] < sb.size and 0 < left[split(tb)][1] < tb.size, left
     assert sum(left[default]) > 0, left
@@ -780,7 +792,8 @@ def test_a_law_below_the_second_order_one_says_why(chain):
     coarser than the law's intervals, so a law with a jerk limit far above the binding one
     may come out a little below it (a torque-limited line at 1e4 times its binding jerk:
     -0.052 %, bench_smooth.py convergence): the message then says by how much it is below
-    and why, never a negative "against"; above it, the signed difference as before."""
+    and why, never a negative "against"; above it (or below by less than the last digit
+    printed), the signed difference as before."""
     dyn, path = chain
     law = solve_jerk_limited_law(dyn, motors=MOTORS, grid=grid(path))
     mesh_ = SimpleNamespace(M=law.jerk.size)
@@ -788,7 +801,8 @@ def test_a_law_below_the_second_order_one_says_why(chain):
     for T2, want in ((law.duration * 1.001, "0.10% below the second-order law, which is "
                       "computed on the start's grid, coarser than these intervals"),
                      (law.duration / 1.5, "+50.00% against the second-order law on the "
-                      "start's grid")):
+                      "start's grid"),
+                     (law.duration * (1 + 1e-5), "+0.00% against the second-order law")):
         r = solve._Round(law, dict(law.ratios), np.zeros(law.jerk.size, bool), mesh_, run,
                          0, 0)
         msg = solve._verdict(r, {}, law.solves, T2).message

@@ -179,15 +179,14 @@ static double row_at(const Motion *mo, const double *grid, Py_ssize_t n1, const 
     return second_row(&pt, m, j, cfloor, &pu, &px, &ph, &c);
 }
 
-/* The middle of the chord a middle's or a quarter's row is measured against: the row at the
- * interval's start and end (middle, pass 1), start and middle (first quarter, pass 2) or
- * middle and end (third quarter) */
+/* The middle of the chord a quarter's row is measured against: the row at the interval's
+ * start and middle (first quarter, pass 2) or middle and end (third quarter) */
 static double chord(const Motion *mo, const double *grid, Py_ssize_t n1, const double *pc,
                     Py_ssize_t P, Py_ssize_t m, Py_ssize_t k, int pass, Py_ssize_t j,
                     double cfloor)
 {
     double h = mo->h[k];
-    double fa = row_at(mo, grid, n1, pc, P, m, k, pass == 3 ? h / 2 : 0.0, j, cfloor);
+    double fa = row_at(mo, grid, n1, pc, P, m, k, pass == 2 ? 0.0 : h / 2, j, cfloor);
     double fb = row_at(mo, grid, n1, pc, P, m, k, pass == 2 ? h / 2 : h, j, cfloor);
     return (fa + fb) / 2;
 }
@@ -353,6 +352,13 @@ static PyObject *block(PyObject *self, PyObject *args)
                 double th = offset(pass, mo.h[k]);
                 Point pt = point_at(&mo, grid, n1, pc, P, k, th);
                 const double *a = pt.a, *b = pt.b, ds = pt.ds, w = pt.w, al = pt.al, T = pt.T;
+                /* a middle's chord: the interval's start and end, once for its rows */
+                int mid = pass == 1 && k > 0 && k < M - 1;
+                Point p0 = pt, p1 = pt;
+                if (mid) {
+                    p0 = point_at(&mo, grid, n1, pc, P, k, 0.0);
+                    p1 = point_at(&mo, grid, n1, pc, P, k, mo.h[k]);
+                }
                 for (Py_ssize_t j = 0; j < m; j++) {
                     double fin = a[3 * m + j] + (b[3 * m + j] - a[3 * m + j]) * pt.u;
                     if (!(fin > 1 - 1e-12))
@@ -364,10 +370,13 @@ static PyObject *block(PyObject *self, PyObject *args)
                     if (pass >= 2 && !(F > -near && F > chord(&mo, grid, n1, pc, P, m, k,
                                                                pass, j, cfloor) + bulge))
                         continue;
-                    if (pass == 1 && k > 0 && k < M - 1
-                        && !(F > chord(&mo, grid, n1, pc, P, m, k, pass, j, cfloor)
-                                     + mid_bulge))
-                        continue;
+                    if (mid) {
+                        double u0, u1, u2, u3;
+                        double f0 = second_row(&p0, m, j, cfloor, &u0, &u1, &u2, &u3);
+                        double f1 = second_row(&p1, m, j, cfloor, &u0, &u1, &u2, &u3);
+                        if (!(F > (f0 + f1) / 2 + mid_bulge))
+                            continue;
+                    }
                     put(&o, k, F, c, th, mo.h[k], (dpu * al + dpx * w * w - dph * T * T) / c,
                         2 * px * w / c, pu / c, 0.0, -2 * ph * T / c);
                 }

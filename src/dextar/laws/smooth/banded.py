@@ -97,10 +97,10 @@ MU0 = 1e-3
 #: within its tolerance ten times over, and a smaller target only makes the barrier terms
 #: span more decades, the Newton directions less accurate, and the residuals still to close
 #: grow instead. Without it, on the refined chain at 8000 knots (13 of its programmes):
-#: four ran to ``maxiter`` with the gap closed from 1.2 to 1e-5 of its tolerance in five
-#: iterations while the dual residual grew from 0.86 to 3.5e7 of its own; with it they
-#: converge in 28, 34 and 28 iterations (615 iterations -> 518); the line's programmes at
-#: 4k and 16k knots in 29 and 36 (29 and 37 without), the same solutions.
+#: four ran to ``maxiter``, one with the gap closed from 1.2 to 1e-5 of its tolerance in five
+#: iterations while the dual residual grew from 0.86 to 3.5e7 of its own; with it those four
+#: take 52, 29, 34 and 29 iterations (615 iterations -> 520); the benchmark's line at 4k and
+#: 16k knots the same solutions in the same iterations (24 and 31).
 TARGET_FLOOR = 0.1
 #: The start's slacks at least this much: of ``1 + |rb|`` for a row, of the box's width for
 #: a bound. Measured on the pick-and-place line's two programmes (``bench_smooth.py

@@ -65,8 +65,8 @@ QUARTER_BULGE = 1e-4
 #: stretch, three nearly parallel rows an interval, on which the interior point takes
 #: short steps. Measured (``bench_smooth.py scaling``, and the refined chain): the rows
 #: 30 % fewer, the same plans (the line's durations to 2e-8), the interior point's
-#: iterations 10-25 % fewer, the chain's CPU time 29 % less (six sizes, numpy rows both);
-#: 80 random corners' durations the same on average (+0.04 % and -0.09 % on two seeds).
+#: iterations 10-25 % fewer, the chain's CPU time 29 % less (six sizes); 80 random corners'
+#: durations the same on average (-0.05 % and +0.02 % on two seeds, CPU -2.5 % and -6.5 %).
 MIDDLE_BULGE = 1e-4
 #: Intervals whose rows are built at once (the temporaries of a block are a few hundred
 #: bytes a row).
@@ -534,9 +534,11 @@ class RowModel:
     def _third_at(self, mo: Motion, k: Array, theta: Array, v: Array, d: Array, w: Array,
                   al: Array) -> tuple[Array, list[list[Array]], Array, Array]:
         """The joint jerk and torque-rate rows, on both sides of each limit, at offsets
-        ``theta`` into the intervals ``k`` (n,), with the table's columns ``v`` and slopes
-        ``d`` (n, 18) and the states ``w, al`` (n,) there: rows, their gradients' arguments
-        (:meth:`_loc`), intervals, normalisations."""
+        ``theta`` into the intervals ``k`` (n,: their starts, then middles, then ends, as
+        :meth:`_points` gives them; the middles within :data:`MIDDLE_BULGE` of their chord
+        left out), with the table's columns ``v`` and slopes ``d`` (n, 18) and the states
+        ``w, al`` (n,) there: rows, their gradients' arguments (:meth:`_loc`), intervals,
+        normalisations."""
         T = mo.Tk[k][:, None]
         h = self.mesh.h
         q1, q2, q3 = v[:, Q1], v[:, Q2], v[:, Q3]

@@ -562,7 +562,8 @@ def _verdict(r: _Round, scales: dict[str, float], programmes: int, T2: float, no
            + (f" ({refined} refinement(s))" if refined else "")
            + f", {programmes} linear programmes")
     rel = T / T2 - 1
-    against = (f"{rel:+.2%} against the second-order law on the start's grid" if rel >= 0
+    against = (f"{max(rel, 0.0):+.2%} against the second-order law on the start's grid"
+               if rel > -5e-5  # (below by less than the last digit printed: +0.00 %)
                else f"{-rel:.2%} below the second-order law, which is computed on the "
                f"start's grid, coarser than these intervals")
     if ok:
