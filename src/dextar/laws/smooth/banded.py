@@ -341,15 +341,16 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
         del gx
         re = Ex(x)
         gap = float(sl @ z)
+        cx = abs(float(c @ x))
         miss = max(max(float(np.abs(rp).max(initial=0.0)), float(np.abs(re).max(initial=0.0)))
                    / (tol * scale_p), float(np.abs(rd).max()) / (dual_tol * scale_d),
-                   gap / (gap_tol * (1.0 + abs(float(c @ x)))))
+                   gap / (gap_tol * (1.0 + cx)))
         if miss < best[0]:
             best = (miss, x.copy())
         if miss <= 1.0:
             status = 0
             break
-        if it == maxiter or gap <= 1e-6 * gap_tol * (1.0 + abs(float(c @ x))):
+        if it == maxiter or gap <= 1e-6 * gap_tol * (1.0 + cx):
             break  # (the gap closed: further steps only lose accuracy)
         mu = gap / m_all
         Dz = z / sl
@@ -397,7 +398,7 @@ def solve_staged(lp: StagedLP, x0: Array, *, tol: float = 1e-9, dual_tol: float 
         ad = min(1.0, _to_bound(z, adz))
         mu_aff = float((sl + ap * ads) @ (z + ad * adz)) / m_all
         target = max((mu_aff / mu) ** 3 * mu,
-                     min(mu, TARGET_FLOOR * gap_tol * (1.0 + abs(float(c @ x))) / m_all))
+                     min(mu, TARGET_FLOOR * gap_tol * (1.0 + cx) / m_all))
         cc = sl * z + ads * adz - target
         del adz, ads
         dx, dy, dz, ds = newton.step(cc)

@@ -403,15 +403,16 @@ class RowModel:
         kq = k[n2:]
         hq = h[kq]
         first = np.arange(len(kq)) < len(kq) // 2  # (the first quarters, then the third)
-        chord = (self._second_F(mo, cols, m, phmax, kq, np.where(first, 0.0, hq / 2))
-                 + self._second_F(mo, cols, m, phmax, kq, np.where(first, hq / 2, hq))) / 2
+        fa = self._second_F(mo, cols, m, phmax, kq, np.where(first, 0.0, hq / 2))
+        fb = self._second_F(mo, cols, m, phmax, kq, np.where(first, hq / 2, hq))
         bulge = np.concatenate([np.ones((n2, m), bool),
-                                F[n2:] > chord + QUARTER_BULGE]).reshape(-1)
+                                F[n2:] > (fa + fb) / 2 + QUARTER_BULGE]).reshape(-1)
         keep = (vals[:, 3 * m:4 * m] > 1 - 1e-12).reshape(-1) & (
             ~quarter | ((flat(F) > -QUARTER_NEAR) & bulge))
         # the middles (after the inner knots) only above the chord of the interval's ends
-        ends = (self._second_F(mo, cols, m, phmax, kM, np.zeros(len(kM)))
-                + self._second_F(mo, cols, m, phmax, kM, h[kM])) / 2
+        # (the rows at its start and end: the first quarters' and the third quarters'
+        # chords' own, kq being the intervals kM twice)
+        ends = (fa[:len(kM)] + fb[len(kM):]) / 2
         mid = np.zeros((len(F), m), bool)
         mid[n2 - len(kM):n2] = ~(self._outer(kM)[:, None]
                                  | (F[n2 - len(kM):n2] > ends + MIDDLE_BULGE))
