@@ -388,7 +388,8 @@ def split_segments(s: Array, pieces: Array) -> Array:
     many = pieces > 1
     n = pieces[many]
     k = np.repeat(np.flatnonzero(many), n - 1)
-    j = np.concatenate([np.arange(1, v) for v in n]) if n.size else np.zeros(0)
+    # (each new point's place in its segment, 1 .. n - 1)
+    j = np.arange(k.size) - np.repeat(np.cumsum(n - 1) - (n - 1), n - 1) + 1
     return np.sort(np.concatenate([s, s[k] + (s[k + 1] - s[k]) * j / np.repeat(n, n - 1)]))
 
 
