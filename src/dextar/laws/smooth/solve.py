@@ -136,7 +136,9 @@ def solve_jerk_limited_law(dynamics: PathDynamics, *, motors: MotorLimits | None
         torques, one the jerk or the torque rate.
     segments : int
         Fewest intervals of constant jerk of the first transcription (at least 16; more
-        where the path's dynamics change fast, refined where the check needs).
+        where the path's dynamics change fast, refined where the check needs). A mesh more
+        than :data:`COARSE` times finer than the rows ask is reached from searches on
+        coarser ones (the law's ``solves`` counts their programmes too).
     grid : int or ndarray, shape (N + 1,)
         The coefficient table along the path: a number of equal segments or its arc lengths
         (from 0 to the length; the second-order start law takes every few of them); a
@@ -403,7 +405,7 @@ def _solve(dynamics: PathDynamics, table: Table, cons: Sequence[Constraint], seg
 #: about 2000 and 8000 intervals): 1.46 and 4.87 s CPU, M^0.87 (3.38 and 28.38 s, M^1.55,
 #: from the fine start), the six motions 0.94203 s on average (0.94995); with 8 times
 #: coarser 1.53 and 6.96 s (M^1.23); at once from the rows' own mesh (about 150 intervals)
-#: 2.25 and 17.2 s, 0.9505 s. The benchmark's line, whose start is near its answer on any
+#: 2.25 and 17.2 s, 0.9476 s. The benchmark's line, whose start is near its answer on any
 #: mesh, pays for the coarser searches: 0.06, 0.23 and 1.04 s at 1000, 4000 and 16000
 #: intervals (0.04, 0.17 and 0.74 s), the same motion to 3e-5. 80 random corners at 800
 #: intervals: half the CPU time, the motions 0.35 and 0.76 % slower on average (two seeds;
