@@ -767,6 +767,18 @@ def test_the_coarser_searchs_motion_is_split_exactly(chain):
     a, b = coarse.law.evaluate(t), split.evaluate(t)
     span = np.abs(a).max(axis=1, keepdims=True)
     assert np.all(np.abs(b - a) <= 1e-9 * span), np.abs(b - a).max(axis=1)
+    # a coarser law outside the limits is not a start: the fine mesh's own start instead
+    real = solve._solve
+
+    def exceeding(*args, **kw):
+        s = real(*args, **kw)
+        return replace(s, last=replace(s.last, bad=np.ones_like(s.last.bad)))
+
+    solve._solve = exceeding
+    try:
+        assert solve._coarser(dyn, tab, cons, st, 800, 1e-3, solve.RATE_TOL, None) is None
+    finally:
+        solve._solve = real
 
 
 @pytest.mark.parametrize("n", [2, 3, 50])

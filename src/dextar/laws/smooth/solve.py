@@ -441,7 +441,7 @@ def _coarser(dynamics: PathDynamics, table: Table, cons: Sequence[Constraint], s
         return None
     search = _solve(dynamics, table, cons, -(-segments // COARSE), tol, rate_tol, units)
     r = search.last
-    if r.law.status != 0 or r.bad.any():
+    if r.bad.any():  # (outside the limits: from the start on the fine mesh instead)
         return None
     Tk = np.diff(r.law.knots_t) / r.mesh.h  # (the law's own: a stretched one's too)
     split = _split(r.mesh, r.law.jerk * Tk**3, Tk, np.full(r.mesh.M, COARSE))
