@@ -279,35 +279,41 @@ class _Search:
 
 
 def _solve(dynamics: PathDynamics, table: Table, cons: Sequence[Constraint], segments: int,
-           tol: float, rate_tol: float, units: Units | None) -> _Search:
+           tol: float, rate_tol: float, units: Units | None,
+           first: tuple[TimeOptimalLaw, Start] | None = None) -> _Search:
     """One search of :func:`solve_jerk_limited_law` on the table, from the second-order law
-    within ``cons`` filtered."""
+    within ``cons`` filtered (``first``: that law and its start, made already)."""
     second = [c for c in cons if c.order == 2]
     third = [c for c in cons if c.order == 3]
     length = float(dynamics.length)
-    base = _second_order(dynamics, table, second, units)
+    if first is None:
+        base = _second_order(dynamics, table, second, units)
+        # the start: the second-order law, slower where the path's own third-order terms
+        # (a blend's curvature changing fast) would use much of their limits at its speeds
+        start = _start(dynamics, table, second, third, base, units)
+    else:
+        base, start = first
     T2 = float(base.duration)
-    # the start: the second-order law, slower where the path's own third-order terms
-    # (a blend's curvature changing fast) would use much of their limits at its speeds
-    start = _start(dynamics, table, second, third, base, units)
-    coarse = _coarser(dynamics, table, cons, start, segments, tol, rate_tol, units)
+    coarse = _coarser(dynamics, table, cons, base, start, segments, tol, rate_tol, units)
+    split = None if coarse is None else coarse.split
     placed: RowModel | None = None
-    if coarse is None:
+    if split is None:
         start, mesh, J, Tk, placed = _placed(start, table, cons, int(segments), length)
         placed_T = start.T  # (the duration of the motion the knots were placed for)
     else:  # its motion on its mesh split (the same motion), its duration brought within the
         # rows and the trust region of a motion near the answer
-        mesh, J, Tk = coarse.split
-        placed_T = float(coarse.search.law.duration)
+        mesh, J, Tk = split.mesh, split.run.J, split.run.Tk
+        placed_T = float(split.law.duration)
     log.debug("%d knots; the path's joints at %s, pinned at knots %s", mesh.M + 1,
               table.joints, mesh.pins)
     scales = dict.fromkeys((c.kind for c in cons), 1.0)
     refined = tightened = stretched = retimed = 0
     programmes = 0 if coarse is None else coarse.search.programmes
-    delta = START_DELTA if coarse is None else SPLIT_DELTA
-    shares: dict[float, float] = {} if coarse is None else dict(coarse.search.last.run.shares)
-    fresh = coarse is not None  # a new start: its duration brought within the rows first
-    best: _Round | None = None
+    delta = START_DELTA if split is None else SPLIT_DELTA
+    shares: dict[float, float] = {} if split is None else dict(split.run.shares)
+    fresh = split is not None  # a new start: its duration brought within the rows first
+    # (the split motion, where it passes the check, is the law to beat)
+    best: _Round | None = split if split is not None and not split.bad.any() else None
     while True:
         model = placed if placed is not None else RowModel(
             mesh, table, [c.scaled(scales) for c in second],
@@ -423,29 +429,34 @@ SPLIT_DELTA = 0.03
 
 @dataclass(frozen=True)
 class _Coarser:
-    """A search on a coarser mesh and its motion on that mesh split (mesh, normalised jerks,
-    intervals' durations)."""
+    """A search on a coarser mesh, and its motion on that mesh split with its check (None
+    where the search's motion is outside the limits)."""
 
     search: _Search
-    split: tuple[Mesh, Array, Array]
+    split: _Round | None
 
 
-def _coarser(dynamics: PathDynamics, table: Table, cons: Sequence[Constraint], start: Start,
-             segments: int, tol: float, rate_tol: float,
+def _coarser(dynamics: PathDynamics, table: Table, cons: Sequence[Constraint],
+             base: TimeOptimalLaw, start: Start, segments: int, tol: float, rate_tol: float,
              units: Units | None) -> _Coarser | None:
-    """The search on a mesh :data:`COARSE` times coarser, its intervals split, where
-    ``segments`` asks a mesh that fine (see :data:`COARSE`) and that search found a motion
-    within the limits; None otherwise."""
+    """The search on a mesh :data:`COARSE` times coarser from ``base`` and ``start``, and
+    its motion with its intervals split, where ``segments`` asks a mesh that fine (see
+    :data:`COARSE`); None otherwise."""
     if segments <= COARSE * SEGMENTS or segments <= COARSE * (
             len(fractions(start, table, cons, SEGMENTS, KNOT_TOL)) - 1):
         return None
-    search = _solve(dynamics, table, cons, -(-segments // COARSE), tol, rate_tol, units)
+    search = _solve(dynamics, table, cons, -(-segments // COARSE), tol, rate_tol, units,
+                    (base, start))
     r = search.last
     if r.bad.any():  # (outside the limits: from the start on the fine mesh instead)
-        return None
+        return _Coarser(search, None)
     Tk = np.diff(r.law.knots_t) / r.mesh.h  # (the law's own: a stretched one's too)
-    split = _split(r.mesh, r.law.jerk * Tk**3, Tk, np.full(r.mesh.M, COARSE))
-    return _Coarser(search, split)
+    mesh, J, Tk = _split(r.mesh, r.law.jerk * Tk**3, Tk, np.full(r.mesh.M, COARSE))
+    run = replace(r.run, J=J, Tk=Tk)
+    law = _law(run, mesh, float(dynamics.length), base)
+    ratio, excess = check(dynamics, cons, law, tol, rate_tol)  # (the finer samples')
+    return _Coarser(search, _Round(law, ratio, excess > 0, mesh, run, r.refined,
+                                   r.stretched))
 
 
 def _placed(start: Start, table: Table, cons: Sequence[Constraint], segments: int,
