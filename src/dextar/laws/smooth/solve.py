@@ -408,12 +408,12 @@ def _solve(dynamics: PathDynamics, table: Table, cons: Sequence[Constraint], seg
 #: Programming*, 2nd ed., SIAM 2010, ch. 4). From the start placed on the fine mesh the
 #: programmes move each switch of the jerk by a knot an interior-point iteration. Measured
 #: on the five-line blended chain of ``bench_smooth.py scaling`` (medians of three meshes
-#: about 2000 and 8000 intervals): 1.46 and 4.87 s CPU, M^0.87 (3.38 and 28.38 s, M^1.55,
-#: from the fine start), the six motions 0.94203 s on average (0.94995); with 8 times
-#: coarser 1.53 and 6.96 s (M^1.23); at once from the rows' own mesh (about 150 intervals)
-#: 2.25 and 17.2 s, 0.9476 s. The benchmark's line, whose start is near its answer on any
-#: mesh, pays for the coarser searches: 0.06, 0.23 and 1.04 s at 1000, 4000 and 16000
-#: intervals (0.04, 0.17 and 0.74 s), the same motion to 3e-5. 80 random corners at 800
+#: about 2000 and 8000 intervals): 1.47 and 4.98 s CPU, M^0.88 (3.38 and 28.38 s, M^1.55,
+#: from the fine start), the six motions 0.9425 s on average (0.9500); with 8 times coarser
+#: 1.53 and 6.96 s (2408 and 8280 intervals, M^1.23); at once from the rows' own mesh
+#: (about 150 intervals) 2.25 and 17.2 s, 0.9476 s. The benchmark's line, whose start is
+#: near its answer on any mesh, pays for the coarser searches: 0.06, 0.24 and 1.10 s at
+#: 1000, 4000 and 16000 intervals (0.04, 0.17 and 0.75 s), the same motion to 3e-5. 80 random corners at 800
 #: intervals: half the CPU time, the motions 0.35 and 0.76 % slower on average (two seeds;
 #: -2.9 to +6.8 %, the local search's spread: one corner planned directly at 100 to 3200
 #: intervals lands between 0.378 and 0.413 s), both 1.0 and 1.8 % faster than at 32.
