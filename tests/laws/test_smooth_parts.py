@@ -46,8 +46,9 @@ def grid(path):
 
 
 @pytest.fixture(scope="module")
-def setup(chain):
-    """The transcription of the chain at its time-scaled start: model, mesh, motion."""
+def started(chain):
+    """The chain's limits (all, second- and third-order), table, second-order law and
+    start."""
     dyn, path = chain
     cons = motor_constraints(MOTORS)
     second = [c for c in cons if c.order == 2]
@@ -55,6 +56,15 @@ def setup(chain):
     tab = table.make_table(dyn, grid(path))
     base = solve._second_order(dyn, tab, second, None)
     st = solve._start(dyn, tab, second, third, base, None)
+    return SimpleNamespace(cons=cons, second=second, third=third, tab=tab, base=base, st=st)
+
+
+@pytest.fixture(scope="module")
+def setup(chain, started):
+    """The transcription of the chain at its time-scaled start: model, mesh, motion."""
+    dyn = chain[0]
+    cons, second, third, tab, st = (started.cons, started.second, started.third,
+                                    started.tab, started.st)
     me = start.pinned(start.fractions(st, tab, cons, 32, solve.KNOT_TOL), st, tab.joints)
     J = start.start_jerks(st, me, dyn.length)
     model = rows.RowModel(me, tab, second, third, dyn.length)
@@ -760,19 +770,14 @@ def test_a_mesh_far_finer_than_its_rows_ask_is_reached_from_a_coarser_search(cha
     assert law.duration <= calls[0][1].law.duration * (1 + 1e-12)
 
 
-def test_the_coarser_searchs_motion_is_split_exactly(chain, monkeypatch):
+def test_the_coarser_searchs_motion_is_split_exactly(chain, started, monkeypatch):
     """The fine mesh starts from the coarser search's law itself: each of its intervals
     split into ``COARSE`` keeps its jerk and its share of the time, so the states agree at
     every sample to rounding. A mesh not four times finer than the rows ask has none; a
     coarser law outside the limits is no start (the search is kept: its programmes
     count)."""
-    dyn, path = chain
-    cons = motor_constraints(MOTORS)
-    second = [c for c in cons if c.order == 2]
-    third = [c for c in cons if c.order == 3]
-    tab = table.make_table(dyn, grid(path))
-    base = solve._second_order(dyn, tab, second, None)
-    st = solve._start(dyn, tab, second, third, base, None)
+    dyn = chain[0]
+    cons, tab, base, st = started.cons, started.tab, started.base, started.st
     args = (1e-3, solve.RATE_TOL, None)
     assert solve._coarser(dyn, tab, cons, base, st, 200, *args) is None
     co = solve._coarser(dyn, tab, cons, base, st, 800, *args)
