@@ -982,6 +982,25 @@ def test_a_bad_grid_is_named(chain, bad, words):
         solve_jerk_limited_law(dyn, motors=MOTORS, grid=bad)
 
 
+@pytest.mark.parametrize("bad", [10, 15, -3, 2000.5, "2000", float("nan"), float("inf"),
+                                 None])
+def test_bad_segments_are_named(chain, bad):
+    """The fewest intervals: a whole number of at least 16, whatever the caller passes (NaN,
+    infinity and None raised Python's own errors, not the package's)."""
+    from dextar.errors import ParameterError
+
+    with pytest.raises(ParameterError, match=r"segments = .* must be a whole number of at "
+                                             r"least 16"):
+        solve_jerk_limited_law(chain[0], motors=MOTORS, segments=bad)
+
+
+def test_whole_segments_of_any_number_type_plan(chain):
+    """A whole float or a numpy integer is a number of segments (the check must not refuse
+    what it should take)."""
+    for good in (32.0, np.int64(40)):
+        assert solve_jerk_limited_law(chain[0], motors=MOTORS, segments=good).status == 0
+
+
 def _stop_and_go(idle):
     """A jerk-limited law that moves, stops for ``idle`` s and moves again (each move four
     intervals of 0.05 s at jerk +-100: rest to rest)."""

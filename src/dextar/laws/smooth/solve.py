@@ -168,7 +168,12 @@ def solve_jerk_limited_law(dynamics: PathDynamics, *, motors: MotorLimits | None
         cons = motor_constraints(motors)
     else:
         raise ParameterError("a jerk-limited law needs the motors' limits (or constraints)")
-    if int(segments) != segments or segments < 16:
+    try:  # (a whole number: not NaN, infinite, None or text)
+        whole = isinstance(segments, (int, float, np.integer, np.floating)) and \
+            int(segments) == segments
+    except (ValueError, OverflowError):
+        whole = False
+    if not whole or segments < 16:
         raise ParameterError(f"segments = {segments!r} must be a whole number of at least 16")
     if not (0 < tol < 1 and 0 < rate_tol < 1):
         raise ParameterError(f"tolerances {tol!r}, {rate_tol!r} must be in (0, 1)")
