@@ -23,6 +23,17 @@ def as_points(values: object, name: str, *, finite: bool = True) -> Array:
     return arr
 
 
+def whole_at_least(value: object, least: int) -> bool:
+    """Whether ``value`` (a number or a 0-d array) is real, whole and at least ``least``
+    (False for NaN, infinity, None, text or a bool, rather than Python's own errors)."""
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        value = value.item()
+    if isinstance(value, (bool, np.bool_)) or not isinstance(
+            value, (int, float, np.integer, np.floating)):
+        return False
+    return bool(np.isfinite(value) and int(value) == value and value >= least)
+
+
 def check_finite(arr: Array, name: str) -> None:
     if not np.isfinite(arr).all():
         idx = first_index(~np.isfinite(arr))

@@ -983,7 +983,7 @@ def test_a_bad_grid_is_named(chain, bad, words):
 
 
 @pytest.mark.parametrize("bad", [10, 15, -3, 2000.5, "2000", float("nan"), float("inf"),
-                                 None])
+                                 None, True])
 def test_bad_segments_are_named(chain, bad):
     """The fewest intervals: a whole number of at least 16, whatever the caller passes (NaN,
     infinity and None raised Python's own errors, not the package's)."""
@@ -997,7 +997,7 @@ def test_bad_segments_are_named(chain, bad):
 def test_whole_segments_of_any_number_type_plan(chain):
     """A whole float or a numpy integer is a number of segments (the check must not refuse
     what it should take)."""
-    for good in (32.0, np.int64(40)):
+    for good in (32.0, np.int64(40), np.array(48)):
         assert solve_jerk_limited_law(chain[0], motors=MOTORS, segments=good).status == 0
 
 

@@ -181,14 +181,24 @@ def test_a_graded_grid_holds_the_limits_and_converges_with_the_uniform_one():
 
 @pytest.mark.parametrize("grid, words", [
     (5, "at least 10 segments"), (50.5, "whole number"),
+    (np.nan, "whole number"), (np.inf, "whole number"), (None, "whole number"),
+    ("400", "whole number"), (True, "whole number"),
     (np.linspace(0.0, 1.0, 8), "at least 11 points"),
     (np.r_[0.0, 0.5, 0.4, np.linspace(0.6, SEMI.length, 10)], "strictly increasing"),
     (np.linspace(0.1, SEMI.length, 20), "from 0 to the path's length"),
     (np.linspace(0.0, 2 * SEMI.length, 20), "from 0 to the path's length"),
     (np.r_[np.linspace(0.0, 1.0, 12), np.nan, SEMI.length], "finite")])
 def test_bad_grids_are_named(grid, words):
+    """(NaN, infinity and None raised Python's own errors, not the package's.)"""
     with pytest.raises(dx.DextarError, match=words):
         solve_time_optimal_law(MODEL, SEMI, torque_limit=(20.0, 20.0), grid=grid)
+
+
+@pytest.mark.parametrize("grid", [400, 400.0, np.int64(400), np.array(400)])
+def test_a_whole_grid_of_any_number_type_is_taken(grid):
+    """A whole float, a numpy integer or a 0-d array is a number of segments."""
+    law = solve_time_optimal_law(MODEL, SEMI, torque_limit=(20.0, 20.0), grid=grid)
+    assert law.success and law.knots_s.size >= 401
 
 
 @pytest.mark.parametrize("third, words", [

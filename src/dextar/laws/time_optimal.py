@@ -41,7 +41,7 @@ from typing import Any
 
 import numpy as np
 
-from .._arrays import Array
+from .._arrays import Array, whole_at_least
 from .._compiled import usable
 from ..errors import ConfigError, InfeasibleError, ParameterError
 from ..motors import MotorLimits
@@ -412,7 +412,7 @@ def grid_points(grid: int | Array, length: float) -> Array:
     (checked: a whole number of at least 10 segments, or at least 11 finite increasing arc
     lengths from 0 to ``length``)."""
     if np.ndim(grid) == 0:
-        if int(grid) != grid or int(grid) < 10:
+        if not whole_at_least(grid, 10):
             raise ParameterError(f"grid = {grid} must be a whole number of at least 10 segments")
         return np.linspace(0.0, length, int(grid) + 1)
     s = np.asarray(grid, float)

@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from ..._arrays import Array
+from ..._arrays import Array, whole_at_least
 from ...errors import InfeasibleError, ParameterError
 from ...motors import MotorLimits
 from ...units import Units
@@ -168,12 +168,7 @@ def solve_jerk_limited_law(dynamics: PathDynamics, *, motors: MotorLimits | None
         cons = motor_constraints(motors)
     else:
         raise ParameterError("a jerk-limited law needs the motors' limits (or constraints)")
-    try:  # (a whole number: not NaN, infinite, None or text)
-        whole = isinstance(segments, (int, float, np.integer, np.floating)) and \
-            int(segments) == segments
-    except (ValueError, OverflowError):
-        whole = False
-    if not whole or segments < 16:
+    if not whole_at_least(segments, 16):
         raise ParameterError(f"segments = {segments!r} must be a whole number of at least 16")
     if not (0 < tol < 1 and 0 < rate_tol < 1):
         raise ParameterError(f"tolerances {tol!r}, {rate_tol!r} must be in (0, 1)")
