@@ -413,7 +413,8 @@ def grid_points(grid: int | Array, length: float) -> Array:
     lengths from 0 to ``length``)."""
     if np.ndim(grid) == 0:
         if not whole_at_least(grid, 10):
-            raise ParameterError(f"grid = {grid} must be a whole number of at least 10 segments")
+            shown = repr(grid) if isinstance(grid, str) else grid  # (text quoted)
+            raise ParameterError(f"grid = {shown} must be a whole number of at least 10 segments")
         return np.linspace(0.0, length, int(grid) + 1)
     s = np.asarray(grid, float)
     if s.ndim != 1 or s.size < 11:

@@ -169,7 +169,8 @@ def solve_jerk_limited_law(dynamics: PathDynamics, *, motors: MotorLimits | None
     else:
         raise ParameterError("a jerk-limited law needs the motors' limits (or constraints)")
     if not whole_at_least(segments, 16):
-        raise ParameterError(f"segments = {segments!r} must be a whole number of at least 16")
+        shown = repr(segments) if isinstance(segments, str) else segments  # (text quoted)
+        raise ParameterError(f"segments = {shown} must be a whole number of at least 16")
     if not (0 < tol < 1 and 0 < rate_tol < 1):
         raise ParameterError(f"tolerances {tol!r}, {rate_tol!r} must be in (0, 1)")
     if not any(c.order == 3 for c in cons):
