@@ -21,7 +21,14 @@ from ..compiled import skip_without_a_compiler
 from ..program.test_program import EXAMPLES
 
 # (the chain's fixtures, shared)
-from .test_smooth_parts import MOTORS, as_linprog, chain, programmes, setup  # noqa: F401
+from .test_smooth_parts import (  # noqa: F401
+    MOTORS,
+    as_linprog,
+    chain,
+    programmes,
+    setup,
+    started,
+)
 
 
 def both(monkeypatch, lp, x0, **kw):

@@ -16,7 +16,7 @@ from dextar.motors import MotorLimits
 from ..compiled import skip_without_a_compiler
 
 # (the chain's fixtures, shared)
-from .test_smooth_parts import chain, setup  # noqa: F401
+from .test_smooth_parts import chain, setup, started  # noqa: F401
 
 #: A torque-rate limit with a speed limit (a speed cap on the rows) and friction on the
 #: table (the torque rate's friction slope), beside the chain's jerk limit.
