@@ -23,15 +23,17 @@ def as_points(values: object, name: str, *, finite: bool = True) -> Array:
     return arr
 
 
-def whole_at_least(value: object, least: int) -> bool:
-    """Whether ``value`` (a number or a 0-d array) is real, whole and at least ``least``
-    (False for NaN, infinity, None, text or a bool, rather than Python's own errors)."""
-    if isinstance(value, np.ndarray) and value.ndim == 0:
-        value = value.item()
-    if isinstance(value, (bool, np.bool_)) or not isinstance(
-            value, (int, float, np.integer, np.floating)):
-        return False
-    return bool(np.isfinite(value) and int(value) == value and value >= least)
+def check_whole(value: object, least: int, name: str, unit: str = "") -> None:
+    """Raise naming ``name`` unless ``value`` (a number or a 0-d array) is real, whole and at
+    least ``least`` (NaN, infinity, None, text and bools too, rather than Python's own
+    errors; text quoted in the message)."""
+    v = value.item() if isinstance(value, np.ndarray) and value.ndim == 0 else value
+    if not (isinstance(v, (int, float, np.integer, np.floating))
+            and not isinstance(v, (bool, np.bool_))
+            and np.isfinite(v) and int(v) == v and v >= least):
+        shown = repr(value) if isinstance(value, str) else value
+        raise ParameterError(f"{name} = {shown} must be a whole number of at least "
+                             f"{least}{unit}")
 
 
 def check_finite(arr: Array, name: str) -> None:

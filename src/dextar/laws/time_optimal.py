@@ -41,7 +41,7 @@ from typing import Any
 
 import numpy as np
 
-from .._arrays import Array, whole_at_least
+from .._arrays import Array, check_whole
 from .._compiled import usable
 from ..errors import ConfigError, InfeasibleError, ParameterError
 from ..motors import MotorLimits
@@ -412,9 +412,7 @@ def grid_points(grid: int | Array, length: float) -> Array:
     (checked: a whole number of at least 10 segments, or at least 11 finite increasing arc
     lengths from 0 to ``length``)."""
     if np.ndim(grid) == 0:
-        if not whole_at_least(grid, 10):
-            shown = repr(grid) if isinstance(grid, str) else grid  # (text quoted)
-            raise ParameterError(f"grid = {shown} must be a whole number of at least 10 segments")
+        check_whole(grid, 10, "grid", " segments")
         return np.linspace(0.0, length, int(grid) + 1)
     s = np.asarray(grid, float)
     if s.ndim != 1 or s.size < 11:

@@ -412,10 +412,9 @@ class RowModel:
         # the middles (after the inner knots) only above the chord of the interval's ends
         # (the rows at its start and end: the first quarters' and the third quarters'
         # chords' own, kq being the intervals kM twice)
-        ends = (fa[:len(kM)] + fb[len(kM):]) / 2
         mid = np.zeros((len(F), m), bool)
-        mid[n2 - len(kM):n2] = ~(self._outer(kM)[:, None]
-                                 | (F[n2 - len(kM):n2] > ends + MIDDLE_BULGE))
+        mid[n2 - len(kM):n2] = ~self._middles_kept(kM, F[n2 - len(kM):n2], fa[:len(kM)],
+                                                   fb[len(kM):])
         keep &= ~mid.reshape(-1)
 
         Cs = [self._loc(h, kk, tt, flat((dpu * a_ + dpx * w_ * w_ - dph * T * T) / c),
@@ -458,9 +457,12 @@ class RowModel:
                     np.concatenate(norms), sizes,
                     tuple((n, len(f)) for n, f in zip(names, Fs, strict=True)))
 
-    def _outer(self, k: Array) -> Array:
-        """Whether the intervals ``k`` are the mesh's first or last (their middles kept)."""
-        return np.asarray((k == 0) | (k == self.mesh.M - 1))
+    def _middles_kept(self, k: Array, mid: Array, start: Array, end: Array) -> Array:
+        """Which rows ``mid`` (n, columns) at the middles of the intervals ``k`` (n,) are
+        kept: those above the chord of the same rows at the intervals' ``start`` and ``end``
+        by more than :data:`MIDDLE_BULGE`, and all of the mesh's first and last intervals."""
+        outer = (k == 0) | (k == self.mesh.M - 1)
+        return np.asarray(outer[:, None] | (mid > (start + end) / 2 + MIDDLE_BULGE))
 
     def _room(self, m: int, k0: int, k1: int) -> int:
         """The most rows the intervals ``k0`` to ``k1`` (excluded) can have (_rows.c's
@@ -608,5 +610,5 @@ class RowModel:
         n = len(k) // 3
         F3 = F.reshape(3, n, 2)
         keep = np.ones((3, n, 2), bool)
-        keep[1] = self._outer(k[:n])[:, None] | (F3[1] > (F3[0] + F3[2]) / 2 + MIDDLE_BULGE)
+        keep[1] = self._middles_kept(k[:n], F3[1], F3[0], F3[2])
         return np.asarray(keep.reshape(-1))

@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from ..._arrays import Array, whole_at_least
+from ..._arrays import Array, check_whole
 from ...errors import InfeasibleError, ParameterError
 from ...motors import MotorLimits
 from ...units import Units
@@ -168,9 +168,7 @@ def solve_jerk_limited_law(dynamics: PathDynamics, *, motors: MotorLimits | None
         cons = motor_constraints(motors)
     else:
         raise ParameterError("a jerk-limited law needs the motors' limits (or constraints)")
-    if not whole_at_least(segments, 16):
-        shown = repr(segments) if isinstance(segments, str) else segments  # (text quoted)
-        raise ParameterError(f"segments = {shown} must be a whole number of at least 16")
+    check_whole(segments, 16, "segments")
     if not (0 < tol < 1 and 0 < rate_tol < 1):
         raise ParameterError(f"tolerances {tol!r}, {rate_tol!r} must be in (0, 1)")
     if not any(c.order == 3 for c in cons):
@@ -414,10 +412,11 @@ def _solve(dynamics: PathDynamics, table: Table, cons: Sequence[Constraint], seg
 #: 1.53 and 6.96 s (2408 and 8280 intervals, M^1.23); at once from the rows' own mesh
 #: (about 150 intervals) 2.25 and 17.2 s, 0.9476 s. The benchmark's line, whose start is
 #: near its answer on any mesh, pays for the coarser searches: 0.06, 0.24 and 1.10 s at
-#: 1000, 4000 and 16000 intervals (0.04, 0.17 and 0.75 s), the same motion to 3e-5. 80 random corners at 800
-#: intervals: half the CPU time, the motions 0.35 and 0.76 % slower on average (two seeds;
-#: -2.9 to +6.8 %, the local search's spread: one corner planned directly at 100 to 3200
-#: intervals lands between 0.378 and 0.413 s), both 1.0 and 1.8 % faster than at 32.
+#: 1000, 4000 and 16000 intervals (0.04, 0.17 and 0.75 s), the same motion to 3e-5. 80
+#: random corners at 800 intervals: half the CPU time, the motions 0.35 and 0.76 % slower
+#: on average (two seeds; -2.9 to +6.8 %, the local search's spread: one corner planned
+#: directly at 100 to 3200 intervals lands between 0.378 and 0.413 s), both 1.0 and 1.8 %
+#: faster than at 32.
 COARSE = 4
 #: The trust region of the first programme on the split mesh (a fraction of the largest knot
 #: acceleration, as :data:`.slp.START_DELTA`): the coarser motion is near the answer, and a
